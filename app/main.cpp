@@ -1,0 +1,83 @@
+// magbrush — the user-facing driver. `magbrush <subcommand> --help` explains each step.
+#include "subcommand.h"
+
+#include <algorithm>
+#include <climits>
+#include <cstdio>
+#include <exception>
+#include <iostream>
+#include <unistd.h>
+
+namespace magbrush {
+
+namespace {
+std::vector<Subcommand> &table()
+{
+  static std::vector<Subcommand> commands;
+  return commands;
+}
+} // namespace
+
+bool register_subcommand(const Subcommand &command)
+{
+  table().push_back(command);
+  std::stable_sort(table().begin(), table().end(),
+                   [](const Subcommand &a, const Subcommand &b) { return a.order < b.order; });
+  return true;
+}
+
+const std::vector<Subcommand> &subcommands() { return table(); }
+
+std::string executable_dir()
+{
+  char buffer[PATH_MAX];
+  const ssize_t n = readlink("/proc/self/exe", buffer, sizeof(buffer) - 1);
+  if (n <= 0)
+    return ".";
+  std::string path(buffer, static_cast<size_t>(n));
+  return path.substr(0, path.find_last_of('/'));
+}
+
+} // namespace magbrush
+
+static void print_usage()
+{
+  std::cout << "magbrush " << MAGBRUSH_VERSION
+            << " — magnetic-brush development simulator\n\n"
+               "Usage: magbrush <command> [options]   (magbrush <command> --help for details)\n\n"
+               "Commands:\n";
+  for (const auto &c : magbrush::subcommands())
+    std::printf("  %-8s %s\n", c.name.c_str(), c.summary.c_str());
+}
+
+int main(int argc, char **argv)
+{
+  if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h")
+  {
+    print_usage();
+    return argc < 2 ? 2 : 0;
+  }
+  if (std::string(argv[1]) == "--version")
+  {
+    std::cout << "magbrush " << MAGBRUSH_VERSION << "\n";
+    return 0;
+  }
+  const std::string name = argv[1];
+  for (const auto &c : magbrush::subcommands())
+    if (c.name == name)
+    {
+      std::vector<std::string> args(argv + 1, argv + argc);
+      try
+      {
+        return c.run(args);
+      }
+      catch (const std::exception &e)
+      {
+        std::cerr << "magbrush " << name << ": error: " << e.what() << "\n";
+        return 1;
+      }
+    }
+  std::cerr << "magbrush: unknown command '" << name << "'\n\n";
+  print_usage();
+  return 2;
+}

@@ -1,0 +1,34 @@
+// Derived quantities of the case model (see case_model.h for conventions).
+#include "case_model.h"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace magbrush {
+
+namespace {
+constexpr double two_pi = 2.0 * M_PI;
+double rpm_to_rad_per_s(double rpm) { return rpm * two_pi / 60.0; }
+} // namespace
+
+double Sleeve::omega() const { return rpm_to_rad_per_s(rpm); }
+double Sleeve::surface_speed() const { return std::abs(omega()) * radius; }
+
+double Drum::omega() const { return rpm_to_rad_per_s(rpm); }
+
+Vec2 Drum::center(double sleeve_radius) const
+{
+  // The drum surface is `gap` away from the sleeve surface along the line of centres.
+  const double d = sleeve_radius + gap + radius;
+  return {d * std::cos(angle), d * std::sin(angle)};
+}
+
+const Material &Case::material(const std::string &name) const
+{
+  for (const auto &m : materials)
+    if (m.name == name)
+      return m;
+  throw std::runtime_error("case '" + source_file + "': no material named '" + name + "'");
+}
+
+} // namespace magbrush

@@ -1,0 +1,222 @@
+// The resolved case: what one YAML case file describes, after parsing, unit conversion
+// and validation. Every stage (geometry, field solver, DEM, tools) reads this struct and
+// never the YAML itself, so there is one meaning for every key.
+//
+// Conventions (the same everywhere in magbrush):
+//  * SI units throughout: m, s, T, A/m, V, Pa, kg, C. Angles in radians.
+//  * The roller axis is z. The cross-section is the x-y plane with the roller centre at the
+//    origin. Angles are measured counter-clockwise from +x (the sleeve-scan convention).
+//  * A positive rpm turns counter-clockwise seen from +z.
+//
+// The parser (case_parser.h) fills this struct; the schema (case_schema.h) is the single
+// place where each key's type, dimension, default, range and documentation live.
+// Fields are only ever added to this header, never renamed, so that all stages stay in step.
+#pragma once
+
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace magbrush {
+
+using Vec2 = std::array<double, 2>;
+using Vec3 = std::array<double, 3>;
+
+// ---------------------------------------------------------------------------------------
+// Magnet roller (Kweon eq. 9–10): radial magnetisation in R_shaft < r < R_magnet,
+//   M_r(θ) = Σ_i M_i exp(−α_i wrap(θ − φ_i)²)
+// with the pole's sign carried by M_i (north pole: M_i > 0, pointing outward).
+struct Pole
+{
+  std::string name;        // e.g. "N1" (development pole), "S1", ...
+  double angle = 0.0;      // φ_i [rad], in [0, 2π)
+  double strength = 0.0;   // M_i [A/m], signed: > 0 north (outward), < 0 south
+  double shape_factor = 10.0; // α_i [1/rad²]
+};
+
+struct Roller
+{
+  double shaft_radius = 0.0;   // R_shaft [m]; 0 = no shaft
+  double shaft_mu_r = 1.0;     // iron shaft relative permeability (large = ideal iron)
+  double magnet_radius = 0.0;  // R_magnet [m], outer radius of the magnet annulus
+  double magnet_mu_r = 1.0;    // recoil permeability of the magnet material
+  std::vector<Pole> poles;
+};
+
+struct Sleeve
+{
+  double radius = 0.0;     // outer radius [m]
+  double thickness = 0.0;  // wall thickness [m] (non-magnetic, e.g. aluminium)
+  double rpm = 0.0;        // signed rotation speed [rev/min]; > 0 counter-clockwise
+  double omega() const;    // angular velocity [rad/s]
+  double surface_speed() const; // |ω| R [m/s]
+};
+
+struct Drum
+{
+  bool present = false;
+  double radius = 0.0;             // outer radius of the photoconductor surface [m]
+  double rpm = 0.0;                // signed [rev/min]
+  double gap = 0.0;                // development gap: sleeve surface to drum surface [m]
+  double angle = 0.0;              // direction of the drum centre seen from the roller centre [rad]
+  double pc_thickness = 0.0;       // photoconductor layer thickness [m]
+  double pc_eps_r = 3.0;           // photoconductor relative permittivity
+  Vec2 center(double sleeve_radius) const; // drum centre [m]
+  double omega() const;
+};
+
+// A doctor blade or a guide wall: a polygon in the x-y plane extruded along the roller axis.
+struct BladeOrGuide
+{
+  std::string name;
+  std::vector<Vec2> polygon;   // closed polygon (counter-clockwise), in the roller frame [m]
+  double mu_r = 1.0;           // > 1: soft-magnetic blade (enters the magnetostatic problem)
+  std::string material = "wall"; // contact material name (key in Case::materials)
+  bool is_doctor_blade = false;
+  double gap = 0.0;            // doctor blades: nearest distance to the sleeve surface [m]
+};
+
+// Contact and bulk properties of one material (Kawamoto A2–A7).
+struct Material
+{
+  std::string name;
+  double youngs_modulus = 0.0;  // E [Pa]
+  double poisson_ratio = 0.3;   // ν
+  double density = 0.0;         // ρ [kg/m³] (walls: unused)
+  double mu_r = 1.0;            // relative permeability (carrier beads)
+  double saturation_magnetisation = 0.0; // M_s [A/m]; 0 = linear (no saturation)
+  double friction = 0.0;        // sliding friction coefficient μ
+  double rolling_friction = 0.0;// rolling friction coefficient μ_r (0 = derive from polygon_angles)
+  int polygon_angles = 0;       // Kawamoto's polygon rule (0 = use rolling_friction as given)
+  double damping = 0.0;         // Kawamoto's Voigt damping constant α (c_n = α √(m* k_n) δ^¼)
+  double restitution = -1.0;    // coefficient of restitution e (LIGGGHTS ln e form); < 0 = unused
+  double hamaker = 0.0;         // Hamaker constant A [J] for van der Waals adhesion
+};
+
+enum class ParticleKind { carrier, toner };
+
+// One particle population. Diameters follow a normal distribution truncated to positive
+// values. Exactly one of count / mass / concentration fixes how many are made.
+struct Population
+{
+  std::string name;
+  ParticleKind kind = ParticleKind::carrier;
+  std::string material;          // key in Case::materials
+  double diameter_mean = 0.0;    // [m]
+  double diameter_std = 0.0;     // [m]
+  long count = 0;                // number of particles (0 = derive from mass or concentration)
+  double mass = 0.0;             // total mass [kg] (0 = unused)
+  double concentration = 0.0;    // toner only: toner mass / carrier mass (0 = unused)
+  double charge_to_mass = 0.0;   // q/m [C/kg]
+  // Where they are inserted: a box (min, max corners) in the scene frame, or, when
+  // layer_thickness > 0, a layer of this thickness on the sleeve surface.
+  std::optional<std::array<Vec3, 2>> insert_box;
+  double layer_thickness = 0.0;  // [m]
+};
+
+// Latent image on the photoconductor: strips along the drum surface.
+struct LatentImage
+{
+  enum class Kind { none, surface_charge, surface_potential } kind = Kind::none;
+  double dark_value = 0.0;       // C/m² or V, in the unexposed (dark) areas
+  double light_value = 0.0;      // C/m² or V, in the exposed (image) areas
+  double period = 0.0;           // strip period along the drum surface [m] (0 = uniform dark)
+  double duty = 0.5;             // exposed fraction of one period
+};
+
+struct Electric
+{
+  bool enabled = false;
+  double bias = 0.0;             // sleeve potential against the grounded drum substrate [V]
+  LatentImage image;
+};
+
+// Applied magnetic field: from the roller (field solver grid) or uniform (the compression test).
+struct AppliedField
+{
+  enum class Kind { none, roller, uniform } kind = Kind::none;
+  Vec3 uniform_direction{0.0, 0.0, 1.0};
+  double uniform_magnitude = 0.0; // |B| [T] at the end of the ramp
+  double ramp_time = 0.0;         // linear ramp 0 → |B| over this time [s] (0 = on at once)
+};
+
+// Explicit walls for scenes without a roller (Kawamoto's compression test: stage and plate).
+struct PlaneWall
+{
+  std::string name;
+  Vec3 point{0, 0, 0};
+  Vec3 normal{0, 0, 1};          // particles live on the side the normal points to
+  std::string material = "wall";
+  // Prescribed motion: piecewise-linear path of the point, (t, displacement) samples.
+  std::vector<std::pair<double, Vec3>> path;
+};
+
+struct FieldSettings
+{
+  double mesh_size_far = 2.0e-3;     // element size away from the sleeve [m]
+  double mesh_size_sleeve = 0.1e-3;  // element size at the sleeve surface [m]
+  double mesh_size_gap = 20e-6;      // element size in the development gap [m]
+  int element_degree = 2;
+  double outer_radius_factor = 2.0;  // open-boundary shell starts at this × sleeve radius
+  double grid_radial_spacing = 50e-6;   // polar magnetic grid Δr [m]
+  double grid_angular_spacing = 0.25 * 3.14159265358979323846 / 180.0; // Δθ [rad]
+  double grid_outer_radius = 0.0;       // polar grid outer radius [m] (0 = sleeve + 3 mm)
+  double grid_electric_spacing = 10e-6; // Cartesian nip grid spacing [m]
+  double probe_radius = 0.0;            // sleeve-profile probe radius [m] (0 = sleeve radius)
+  std::string output_dir = "fields";
+};
+
+struct DemSettings
+{
+  double time_step = 0.0;            // [s]; 0 = automatic (Rayleigh/Hertz criterion)
+  double time_step_safety = 0.2;     // auto step = safety × Rayleigh time
+  double duration = 0.0;             // simulated time [s]
+  double output_interval = 0.0;      // snapshot interval [s]
+  double checkpoint_interval = 0.0;  // [s] (0 = only at the end)
+  double periodic_length = 0.0;      // slab length along the roller axis z [m] (0 = none)
+  double periodic_length_x = 0.0;    // optional periodic length along x [m]
+  double periodic_length_y = 0.0;    // optional periodic length along y [m]
+  std::string magnetic_model = "corrected"; // "point_dipole" | "mutual_dipole" | "corrected"
+  double magnetic_cutoff = 8.0;      // cutoff radius in mean carrier diameters
+  double magnetic_refresh = 0.0;     // refresh interval [s] (0 = every step)
+  double magnetic_tolerance = 1e-6;  // mutual-induction relative tolerance
+  double verlet_skin = 0.3;          // skin as a fraction of the mean diameter
+  double air_viscosity = 1.81e-5;    // η [Pa s] for Stokes drag (0 = no drag)
+  Vec3 gravity{0.0, -9.81, 0.0};     // [m/s²]
+  unsigned long seed = 1;
+  int threads = 0;                   // 0 = OpenMP default
+  double max_overlap_fraction = 0.1; // stability guard: overlap / radius
+};
+
+struct OutputSettings
+{
+  std::string directory = "results";
+  bool vtu = true;
+  bool xdmf = true;
+};
+
+struct Case
+{
+  std::string name;             // scene name (defaults to the file stem)
+  std::string source_file;      // path of the YAML file it came from
+  std::string scene = "roller"; // "roller" (sleeve, optional drum/blade) | "box" (walls only)
+
+  std::optional<Roller> roller;
+  std::optional<Sleeve> sleeve;
+  Drum drum;
+  std::vector<BladeOrGuide> blades;   // doctor blade and guides
+  std::vector<PlaneWall> planes;      // explicit plane walls (box scenes)
+  std::vector<Material> materials;    // by name: "carrier", "toner", "wall", "drum", ...
+  std::vector<Population> populations;
+  Electric electric;
+  AppliedField applied_field;
+  FieldSettings field;
+  DemSettings dem;
+  OutputSettings output;
+  std::string measured_flux_file;     // optional gaussmeter scan to overlay in the report
+
+  const Material &material(const std::string &name) const; // throws if absent
+};
+
+} // namespace magbrush

@@ -187,6 +187,13 @@ struct DemSettings
   unsigned long seed = 1;
   int threads = 0;                   // 0 = OpenMP default
   double max_overlap_fraction = 0.1; // stability guard: overlap / radius
+  // Added by the DEM engine:
+  std::string restitution_model = "ln_e"; // materials with `restitution`: "ln_e" (LIGGGHTS/LAMMPS
+                                          // form, inexact for Hertz) | "hertz_exact" (damping
+                                          // fitted so that Hertz gives exactly e)
+  double settle_time = 0.0;          // after insertion, settle this long with walls at rest [s]
+  double max_kinetic_energy_growth = 1e3; // stability guard: KE may not grow by more than this
+                                          // factor between two guard checks (100 steps)
 };
 
 struct OutputSettings

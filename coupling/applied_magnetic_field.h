@@ -1,0 +1,119 @@
+// The applied magnetic field the DEM holds: B and ∇B at a particle and a time.
+//
+// Three kinds, chosen once from the case (AppliedField in case_model.h), dispatched by a
+// switch on a small enum — no virtual call, no allocation per lookup:
+//  * none:    B = 0, ∇B = 0;
+//  * uniform: B = s(t) B_0 d̂, ∇B = 0, no grid lookup at all (Kawamoto's compression test);
+//  * roller:  s(t) × the polar-grid interpolator of the roller's A_z (polar_field_interpolator.h).
+// The ramp s(t) = min(1, t / ramp_time) (s = 1 when ramp_time = 0) multiplies either kind.
+//
+// With a uniform (or no) field, ∇B = 0 and the applied force (p·∇)B vanishes:
+// has_gradient() lets the DEM skip that term and report it as off.
+//
+// The object is cheap to copy (the grid interpolator is shared, read-only) and safe to call
+// from many OpenMP threads at once.
+#pragma once
+
+#include "case_model.h"
+#include "polar_field_interpolator.h"
+
+#include <array>
+#include <memory>
+#include <string>
+
+namespace magbrush {
+
+class AppliedMagneticField
+{
+public:
+  enum class Kind { none, uniform, roller };
+
+  AppliedMagneticField() = default; // none
+  static AppliedMagneticField uniform(const Vec3 &direction, double magnitude,
+                                      double ramp_time = 0.0);
+  static AppliedMagneticField roller(std::shared_ptr<const PolarFieldInterpolator> grid,
+                                     double ramp_time = 0.0);
+  // From the case's AppliedField; `grid` is required for Kind::roller (read it with
+  // read_magnetic_grid after check_provenance) and ignored otherwise.
+  static AppliedMagneticField from_settings(const AppliedField &settings,
+                                            std::shared_ptr<const PolarFieldInterpolator> grid = {});
+
+  Kind kind() const { return kind_; }
+  const char *kind_name() const;
+  bool has_gradient() const { return kind_ == Kind::roller; }
+  double ramp_time() const { return ramp_time_; }
+  const PolarFieldInterpolator *grid() const { return grid_.get(); }
+
+  // The ramp factor s(t) ∈ [0, 1].
+  double ramp(double t) const
+  {
+    if (ramp_time_ <= 0.0 || t >= ramp_time_)
+      return 1.0;
+    return t > 0.0 ? t / ramp_time_ : 0.0;
+  }
+
+  // B [T] and gradB[i][j] = ∂B_i/∂x_j [T/m] at x [m], time t [s]. Roller kind: throws
+  // FieldLookupError inside the sleeve (see PolarFieldInterpolator).
+  void evaluate(const Vec3 &x, double t, Vec3 &B, std::array<Vec3, 3> &gradB) const
+  {
+    const double s = ramp(t);
+    switch (kind_)
+    {
+    case Kind::none:
+      B = {0.0, 0.0, 0.0};
+      gradB = {};
+      return;
+    case Kind::uniform:
+      B = {s * uniform_B_[0], s * uniform_B_[1], s * uniform_B_[2]};
+      gradB = {};
+      return;
+    case Kind::roller:
+      grid_->evaluate(x, B, gradB);
+      if (s != 1.0)
+        scale(s, B, gradB);
+      return;
+    }
+  }
+
+  Vec3 field(const Vec3 &x, double t) const
+  {
+    Vec3 B;
+    std::array<Vec3, 3> gradB;
+    evaluate(x, t, B, gradB);
+    return B;
+  }
+
+  // The same with plain arrays, for code that takes a callable
+  // void(const double x[3], double B[3], double gradB[3][3]) (dem/magnetics): bind t with
+  //   [&field, t](const double *x, double *B, double (*g)[3]) { field.evaluate(x, t, B, g); }
+  void evaluate(const double x[3], double t, double B[3], double gradB[3][3]) const
+  {
+    Vec3 b;
+    std::array<Vec3, 3> g;
+    evaluate(Vec3{x[0], x[1], x[2]}, t, b, g);
+    for (int i = 0; i < 3; ++i)
+    {
+      B[i] = b[i];
+      for (int j = 0; j < 3; ++j)
+        gradB[i][j] = g[i][j];
+    }
+  }
+
+private:
+  static void scale(double s, Vec3 &B, std::array<Vec3, 3> &gradB)
+  {
+    for (int i = 0; i < 3; ++i)
+    {
+      B[i] *= s;
+      for (int j = 0; j < 3; ++j)
+        gradB[i][j] *= s;
+    }
+  }
+
+  Kind kind_ = Kind::none;
+  Vec3 uniform_B_{0.0, 0.0, 0.0}; // final field B_0 d̂ [T]
+  double ramp_time_ = 0.0;
+  std::shared_ptr<const PolarFieldInterpolator> grid_;
+};
+
+} // namespace magbrush

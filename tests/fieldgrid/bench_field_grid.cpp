@@ -1,0 +1,202 @@
+// Accuracy against cost of the magnetic field grid: for each grid spacing (Δr, Δθ), the
+// maximum error of B and of ∇|B|² on a roller-like field (5 Gaussian poles, sleeve radius
+// 12.5 mm, annulus 12.5..16 mm; exact multipole-ring reference), the memory the grid takes,
+// and the time of one B+∇B lookup (Google Benchmark, random points in the annulus).
+// Errors are relative to the largest exact value over the annulus (|B|max, |∇|B|²|max).
+// Prints its table and exits 0; nothing here is asserted.
+#include "applied_magnetic_field.h"
+#include "cartesian_field_interpolator.h"
+#include "exact_multipole.h"
+#include "polar_field_interpolator.h"
+
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <string>
+
+using namespace magbrush;
+using namespace magbrush::testing;
+
+namespace {
+
+constexpr double r_min = 12.5e-3, r_max = 16e-3, deg = M_PI / 180.0;
+
+struct Spacing
+{
+  double dr;     // [m]
+  double dtheta; // [rad]
+};
+
+// Joint refinement, plus mixed rows that show which of the two spacings limits the error.
+const std::vector<Spacing> spacings = {
+    {200e-6, 1.0 * deg},  {100e-6, 0.5 * deg},  {50e-6, 0.25 * deg}, {25e-6, 0.125 * deg},
+    {100e-6, 0.25 * deg}, {50e-6, 0.5 * deg},   {25e-6, 0.25 * deg}, {50e-6, 0.125 * deg}};
+
+PolarGrid make_grid(const MultipoleField &f, const Spacing &s)
+{
+  const int n_r = 1 + static_cast<int>(std::ceil((r_max - r_min) / s.dr - 1e-9));
+  const int n_theta = static_cast<int>(std::ceil(2 * M_PI / s.dtheta - 1e-9));
+  return sample_polar_grid(r_min, r_max, n_r, n_theta,
+                           [&](double x, double y) { return f.A(x, y); });
+}
+
+struct Accuracy
+{
+  double B = 0, gradB2 = 0, B_sleeve = 0;
+};
+
+Accuracy measure(const PolarFieldInterpolator &interp, const MultipoleField &f,
+                 const std::vector<std::array<double, 2>> &points)
+{
+  Accuracy a;
+  double B_max = 0, G_max = 0;
+  for (const auto &p : points)
+  {
+    const auto e = f.B(p[0], p[1]);
+    Vec3 B;
+    std::array<Vec3, 3> g;
+    interp.evaluate({p[0], p[1], 0}, B, g);
+    const double Gx = 2 * (e.B[0] * e.gradB[0][0] + e.B[1] * e.gradB[1][0]);
+    const double Gy = 2 * (e.B[0] * e.gradB[0][1] + e.B[1] * e.gradB[1][1]);
+    const double Gix = 2 * (B[0] * g[0][0] + B[1] * g[1][0]);
+    const double Giy = 2 * (B[0] * g[0][1] + B[1] * g[1][1]);
+    B_max = std::max(B_max, std::hypot(e.B[0], e.B[1]));
+    G_max = std::max(G_max, std::hypot(Gx, Gy));
+    const double eB = std::hypot(B[0] - e.B[0], B[1] - e.B[1]);
+    a.B = std::max(a.B, eB);
+    a.gradB2 = std::max(a.gradB2, std::hypot(Gix - Gx, Giy - Gy));
+    if (std::hypot(p[0], p[1]) < r_min + 0.5e-3)
+      a.B_sleeve = std::max(a.B_sleeve, eB);
+  }
+  a.B /= B_max;
+  a.gradB2 /= G_max;
+  a.B_sleeve /= B_max;
+  return a;
+}
+
+// Random lookup points (a fixed cycle: the DEM's particles are spread over the annulus).
+const std::vector<Vec3> &lookup_points()
+{
+  static const std::vector<Vec3> points = [] {
+    std::vector<Vec3> v;
+    for (const auto &p : sample_annulus(r_min + 1e-6, r_max - 1e-6, 4096, 99))
+      v.push_back({p[0], p[1], 0.0});
+    return v;
+  }();
+  return points;
+}
+
+template <typename Lookup>
+void time_lookups(benchmark::State &state, Lookup lookup)
+{
+  const auto &points = lookup_points();
+  size_t k = 0;
+  Vec3 B;
+  std::array<Vec3, 3> g;
+  for (auto _ : state)
+  {
+    lookup(points[k], B, g);
+    benchmark::DoNotOptimize(B);
+    benchmark::DoNotOptimize(g);
+    k = (k + 1) & 4095;
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+
+// Collects the time per iteration of each benchmark by name, and prints the usual console
+// report too.
+class Collector : public benchmark::ConsoleReporter
+{
+public:
+  std::map<std::string, double> ns;
+  void ReportRuns(const std::vector<Run> &runs) override
+  {
+    for (const auto &run : runs)
+      ns[run.benchmark_name()] = run.GetAdjustedRealTime(); // default unit: ns
+    ConsoleReporter::ReportRuns(runs);
+  }
+};
+
+std::string label(const Spacing &s)
+{
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "grid dr=%.0fum dth=%.3fdeg", s.dr * 1e6, s.dtheta / deg);
+  return buffer;
+}
+
+} // namespace
+
+int main(int argc, char **argv)
+{
+  benchmark::Initialize(&argc, argv);
+  const MultipoleField field = roller_like_field();
+  const auto points = sample_annulus(r_min, r_max, 40000, 2024);
+
+  struct Row
+  {
+    Spacing s;
+    int n_r, n_theta;
+    size_t bytes;
+    Accuracy a;
+    std::shared_ptr<const PolarFieldInterpolator> interp;
+  };
+  std::vector<Row> rows;
+  for (const Spacing &s : spacings)
+  {
+    const PolarGrid grid = make_grid(field, s);
+    auto interp = std::make_shared<const PolarFieldInterpolator>(grid);
+    rows.push_back({s, grid.n_r, grid.n_theta, interp->memory_bytes(), measure(*interp, field, points),
+                    interp});
+    benchmark::RegisterBenchmark(label(s).c_str(), [interp](benchmark::State &st) {
+      time_lookups(st, [&](const Vec3 &x, Vec3 &B, std::array<Vec3, 3> &g) { interp->evaluate(x, B, g); });
+    })->MinTime(0.2);
+  }
+  // The other paths a DEM step may take, for comparison.
+  const auto applied = AppliedMagneticField::roller(rows[2].interp);
+  benchmark::RegisterBenchmark("AppliedMagneticField roller (default grid)", [&](benchmark::State &st) {
+    time_lookups(st, [&](const Vec3 &x, Vec3 &B, std::array<Vec3, 3> &g) { applied.evaluate(x, 1.0, B, g); });
+  })->MinTime(0.2);
+  const auto uniform = AppliedMagneticField::uniform({0, 0, 1}, 0.13, 1e-3);
+  benchmark::RegisterBenchmark("AppliedMagneticField uniform+ramp", [&](benchmark::State &st) {
+    time_lookups(st, [&](const Vec3 &x, Vec3 &B, std::array<Vec3, 3> &g) { uniform.evaluate(x, 5e-4, B, g); });
+  })->MinTime(0.2);
+  const auto tail_interp = rows[2].interp;
+  benchmark::RegisterBenchmark("multipole tail beyond r_max", [&](benchmark::State &st) {
+    time_lookups(st, [&](const Vec3 &x, Vec3 &B, std::array<Vec3, 3> &g) {
+      tail_interp->evaluate({1.2 * x[0], 1.2 * x[1], 0}, B, g); // r in 15..19.2 mm: mostly the tail
+    });
+  })->MinTime(0.2);
+  const CartesianFieldInterpolator electric(sample_cartesian_grid(
+      -1e-3, 1e-3, 201, 12.5e-3, 13e-3, 51, [](double x, double y) { return 600 * x * y * 1e3; }));
+  benchmark::RegisterBenchmark("electric E lookup (Cartesian)", [&](benchmark::State &st) {
+    time_lookups(st, [&](const Vec3 &x, Vec3 &B, std::array<Vec3, 3> &) {
+      electric.evaluate({x[0] * 0.05, 12.5e-3 + 0.02 * (x[1] + 16e-3), 0}, B);
+    });
+  })->MinTime(0.2);
+
+  Collector collector;
+  benchmark::RunSpecifiedBenchmarks(&collector);
+
+  std::printf("\nMagnetic field grid: accuracy against cost (roller-like field, 5 poles, annulus "
+              "12.5..16 mm, %zu random points)\n",
+              points.size());
+  std::printf("errors relative to max|B| = exact maximum over the annulus; 'near sleeve' = r < 13 mm\n");
+  std::printf("%9s %9s %6s %6s %10s %12s %12s %12s %10s\n", "dr[um]", "dth[deg]", "n_r", "n_th",
+              "memory", "err B", "err B(slv)", "err grad|B|2", "ns/lookup");
+  for (const Row &r : rows)
+  {
+    const auto it = collector.ns.find(label(r.s));
+    std::printf("%9.1f %9.3f %6d %6d %8.2fMB %12.3e %12.3e %12.3e %10.1f\n", r.s.dr * 1e6,
+                r.s.dtheta / deg, r.n_r, r.n_theta, r.bytes / 1048576.0, r.a.B, r.a.B_sleeve,
+                r.a.gradB2, it == collector.ns.end() ? NAN : it->second);
+  }
+  std::printf("\ntargets: err B <= 1e-4, err grad|B|^2 <= 1e-3, <= 100 ns per B+gradB lookup\n");
+  for (const char *name : {"AppliedMagneticField roller (default grid)", "AppliedMagneticField uniform+ramp",
+                           "multipole tail beyond r_max", "electric E lookup (Cartesian)"})
+    std::printf("%-45s %8.1f ns\n", name, collector.ns[name]);
+  benchmark::Shutdown();
+  return 0;
+}

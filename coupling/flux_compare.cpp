@@ -1,0 +1,225 @@
+// Profile comparison: errors, per-pole peaks, residual file (see flux_compare.h).
+#include "flux_compare.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include <unistd.h>
+
+namespace magbrush {
+
+namespace {
+
+constexpr double pi = M_PI;
+constexpr double to_deg = 180.0 / M_PI;
+
+double wrap_pm_pi(double a)
+{
+  a = std::remainder(a, 2.0 * pi);
+  return a <= -pi ? a + 2.0 * pi : a;
+}
+
+double wrap_0_2pi(double a)
+{
+  a = std::fmod(a, 2.0 * pi);
+  return a < 0 ? a + 2.0 * pi : a;
+}
+
+ComponentErrors errors_of(const std::vector<double> &angle, const std::vector<double> &measured,
+                          const std::vector<double> &computed)
+{
+  ComponentErrors e;
+  double sum = 0.0;
+  for (size_t k = 0; k < measured.size(); ++k)
+  {
+    const double d = measured[k] - computed[k];
+    sum += d * d;
+    if (std::abs(d) > e.max)
+    {
+      e.max = std::abs(d);
+      e.max_angle = angle[k];
+    }
+    e.peak = std::max(e.peak, std::abs(measured[k]));
+  }
+  e.rms = std::sqrt(sum / std::max<size_t>(measured.size(), 1));
+  return e;
+}
+
+} // namespace
+
+std::vector<PeakMatch> find_pole_peaks(const std::vector<Pole> &poles,
+                                       const std::vector<double> &angle,
+                                       const std::vector<double> &B, double offset)
+{
+  const size_t m = angle.size();
+  std::vector<PeakMatch> peaks(poles.size());
+  if (m < 3)
+    return peaks;
+  // Does the scan close on itself (a full turn)? Then index neighbours wrap around.
+  const double step = std::abs(angle[1] - angle[0]);
+  const bool full_turn = std::abs(angle.back() - angle.front()) + 1.5 * step >= 2.0 * pi;
+  for (size_t i = 0; i < poles.size(); ++i)
+  {
+    const double target = poles[i].angle - offset;
+    double half_window = pi;
+    for (size_t j = 0; j < poles.size(); ++j)
+      if (j != i)
+        half_window = std::min(half_window, 0.5 * std::abs(wrap_pm_pi(poles[j].angle - poles[i].angle)));
+    half_window = std::max(half_window, 5.0 * pi / 180.0);
+    const double sign = poles[i].strength >= 0 ? 1.0 : -1.0;
+    long best = -1;
+    for (size_t k = 0; k < m; ++k)
+      if (std::abs(wrap_pm_pi(angle[k] - target)) <= half_window &&
+          (best < 0 || sign * B[k] > sign * B[best]))
+        best = static_cast<long>(k);
+    if (best < 0 || sign * B[best] <= 0.0)
+      continue;
+    long prev = best - 1, next = best + 1;
+    if (full_turn)
+    {
+      prev = (prev + long(m)) % long(m);
+      next = next % long(m);
+    }
+    if (prev < 0 || next >= long(m))
+      continue; // the extremum sits on the end of a partial scan: not a resolved peak
+    const double h1 = wrap_pm_pi(angle[prev] - angle[best]);
+    const double h2 = wrap_pm_pi(angle[next] - angle[best]);
+    // A peak inside the window, not on its edge.
+    if (sign * B[prev] > sign * B[best] || sign * B[next] > sign * B[best])
+      continue;
+    // Parabola y = a + b x + c x² through (h1, y1), (0, y0), (h2, y2).
+    const double y0 = B[best], y1 = B[prev], y2 = B[next];
+    const double d1 = (y1 - y0) / h1, d2 = (y2 - y0) / h2;
+    const double c = (d2 - d1) / (h2 - h1);
+    const double b = d1 - c * h1;
+    double x = 0.0, value = y0;
+    if (c != 0.0)
+    {
+      x = std::clamp(-b / (2.0 * c), std::min(h1, h2), std::max(h1, h2));
+      value = y0 + b * x + c * x * x;
+    }
+    if (std::abs(wrap_pm_pi(angle[best] + x - target)) > half_window)
+      continue;
+    peaks[i].found = true;
+    peaks[i].angle = wrap_0_2pi(angle[best] + x);
+    peaks[i].value = value;
+  }
+  return peaks;
+}
+
+FluxComparison compare_flux(const FluxScan &scan, const std::vector<double> &computed_Bn,
+                            const std::vector<double> &computed_Bt, const std::vector<Pole> &poles)
+{
+  if (computed_Bn.size() != scan.size() ||
+      (scan.has_tangential() && computed_Bt.size() != scan.size()))
+    throw std::invalid_argument("compare_flux: the computed profile must be sampled at the "
+                                "scan's angles");
+  FluxComparison c;
+  c.angle = scan.angle;
+  c.measured_Bn = scan.Bn;
+  c.measured_Bt = scan.Bt;
+  c.computed_Bn = computed_Bn;
+  c.computed_Bt = computed_Bt;
+  c.has_tangential = scan.has_tangential();
+  c.Bn = errors_of(scan.angle, scan.Bn, computed_Bn);
+  if (c.has_tangential)
+    c.Bt = errors_of(scan.angle, scan.Bt, computed_Bt);
+  const auto computed = find_pole_peaks(poles, scan.angle, computed_Bn);
+  const auto measured = find_pole_peaks(poles, scan.angle, scan.Bn);
+  for (size_t i = 0; i < poles.size(); ++i)
+    c.peaks.push_back({poles[i].name, computed[i], measured[i]});
+  return c;
+}
+
+std::string format_errors(const FluxComparison &c)
+{
+  char buf[512];
+  std::ostringstream out;
+  out << "  component   RMS error    max error   (at angle)   max |measured|   RMS/max\n";
+  auto row = [&](const char *name, const ComponentErrors &e) {
+    std::snprintf(buf, sizeof buf, "  %-9s  %7.3f mT   %7.3f mT   (%6.1f deg)   %8.2f mT     %5.2f %%\n",
+                  name, e.rms * 1e3, e.max * 1e3, wrap_0_2pi(e.max_angle) * to_deg, e.peak * 1e3,
+                  e.peak > 0 ? 100.0 * e.rms / e.peak : 0.0);
+    out << buf;
+  };
+  row("Bn", c.Bn);
+  if (c.has_tangential)
+    row("Bt", c.Bt);
+  return out.str();
+}
+
+std::string format_peaks(const FluxComparison &c)
+{
+  char buf[512];
+  std::ostringstream out;
+  out << "  pole   computed: angle   Bn peak    measured: angle   Bn peak     Δangle    Δ|Bn|\n";
+  for (const auto &p : c.peaks)
+  {
+    auto cell = [](const PeakMatch &m, char *s, size_t n) {
+      if (m.found)
+        std::snprintf(s, n, "%7.2f deg %8.2f mT", m.angle * to_deg, m.value * 1e3);
+      else
+        std::snprintf(s, n, "%-22s", "    (no peak)");
+    };
+    char a[64], b[64], d[96] = "";
+    cell(p.computed, a, sizeof a);
+    cell(p.measured, b, sizeof b);
+    if (p.computed.found && p.measured.found)
+      std::snprintf(d, sizeof d, "%+7.2f deg %+6.2f %%",
+                    wrap_pm_pi(p.measured.angle - p.computed.angle) * to_deg,
+                    100.0 * (std::abs(p.measured.value) - std::abs(p.computed.value)) /
+                        std::abs(p.computed.value));
+    std::snprintf(buf, sizeof buf, "  %-5s  %s    %s   %s\n", p.pole.c_str(), a, b, d);
+    out << buf;
+  }
+  return out.str();
+}
+
+void write_file_atomically(const std::string &path, const std::string &text)
+{
+  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
+  {
+    std::ofstream out(tmp);
+    if (!out)
+      throw std::runtime_error("cannot write " + tmp + " (does the directory exist, is it writable?)");
+    out << text;
+    out.flush();
+    if (!out)
+      throw std::runtime_error("error while writing " + tmp + " (disk full?)");
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0)
+  {
+    std::remove(tmp.c_str());
+    throw std::runtime_error("cannot move " + tmp + " to " + path);
+  }
+}
+
+void write_residuals_csv(const std::string &path, const FluxComparison &c)
+{
+  std::ostringstream out;
+  char buf[256];
+  out << "# magbrush flux: measured and computed sleeve flux density, residual = measured - computed\n";
+  out << (c.has_tangential
+              ? "angle_deg,Bn_measured_mT,Bn_computed_mT,Bn_residual_mT,Bt_measured_mT,Bt_computed_mT,Bt_residual_mT\n"
+              : "angle_deg,Bn_measured_mT,Bn_computed_mT,Bn_residual_mT\n");
+  for (size_t k = 0; k < c.angle.size(); ++k)
+  {
+    std::snprintf(buf, sizeof buf, "%.6g,%.6g,%.6g,%.6g", c.angle[k] * to_deg, c.measured_Bn[k] * 1e3,
+                  c.computed_Bn[k] * 1e3, (c.measured_Bn[k] - c.computed_Bn[k]) * 1e3);
+    out << buf;
+    if (c.has_tangential)
+    {
+      std::snprintf(buf, sizeof buf, ",%.6g,%.6g,%.6g", c.measured_Bt[k] * 1e3,
+                    c.computed_Bt[k] * 1e3, (c.measured_Bt[k] - c.computed_Bt[k]) * 1e3);
+      out << buf;
+    }
+    out << "\n";
+  }
+  write_file_atomically(path, out.str());
+}
+
+} // namespace magbrush

@@ -1,0 +1,466 @@
+// Printing a resolved case, its derived numbers, and the schema reference.
+#include "case_format.h"
+
+#include "case_schema.h"
+#include "units.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <sstream>
+
+namespace magbrush {
+
+namespace {
+
+constexpr double pi = 3.14159265358979323846;
+constexpr double mu0 = 4.0e-7 * pi;
+
+std::string exact(double v)
+{
+  char b[40];
+  std::snprintf(b, sizeof(b), "%.17g", v);
+  return b;
+}
+
+// Collects entries, taking type and dimension from the schema pattern.
+class Emitter
+{
+public:
+  std::vector<ResolvedEntry> entries;
+
+  void q(const std::string &path, const std::string &pattern, double si)
+  {
+    const Dimension d = spec(pattern).dimension;
+    entries.push_back({path, pattern, exact(si), format_quantity(si, d)});
+  }
+  void i(const std::string &path, const std::string &pattern, long long v)
+  {
+    spec(pattern);
+    entries.push_back({path, pattern, std::to_string(v), std::to_string(v)});
+  }
+  void b(const std::string &path, const std::string &pattern, bool v)
+  {
+    spec(pattern);
+    entries.push_back({path, pattern, v ? "true" : "false", v ? "true" : "false"});
+  }
+  void s(const std::string &path, const std::string &pattern, const std::string &v)
+  {
+    spec(pattern);
+    entries.push_back({path, pattern, v, v.empty() ? "\"\"" : v});
+  }
+  void v3(const std::string &path, const std::string &pattern, const Vec3 &v)
+  {
+    const Dimension d = spec(pattern).dimension;
+    entries.push_back({path, pattern, "[" + exact(v[0]) + ", " + exact(v[1]) + ", " + exact(v[2]) + "]",
+                       "[" + format_quantity(v[0], d) + ", " + format_quantity(v[1], d) + ", " +
+                           format_quantity(v[2], d) + "]"});
+  }
+  void polygon(const std::string &path, const std::string &pattern, const std::vector<Vec2> &p)
+  {
+    spec(pattern);
+    std::string e = "[", s = "[";
+    for (size_t k = 0; k < p.size(); ++k)
+    {
+      e += std::string(k ? ", " : "") + "[" + exact(p[k][0]) + ", " + exact(p[k][1]) + "]";
+      s += std::string(k ? ", " : "") + "[" + format_quantity(p[k][0], Dimension::length) + ", " +
+           format_quantity(p[k][1], Dimension::length) + "]";
+    }
+    entries.push_back({path, pattern, e + "]", s + "]"});
+  }
+
+private:
+  static const KeySpec &spec(const std::string &pattern)
+  {
+    const KeySpec *k = find_key_spec(pattern);
+    if (!k)
+      throw std::logic_error("case_format: '" + pattern + "' is not in the schema");
+    return *k;
+  }
+};
+
+} // namespace
+
+std::vector<ResolvedEntry> resolved_entries(const Case &c)
+{
+  Emitter e;
+  e.s("name", "name", c.name);
+  e.s("scene", "scene", c.scene);
+  e.s("measured_flux_file", "measured_flux_file", c.measured_flux_file);
+  if (c.roller)
+  {
+    const Roller &r = *c.roller;
+    e.q("roller.shaft_radius", "roller.shaft_radius", r.shaft_radius);
+    e.q("roller.shaft_mu_r", "roller.shaft_mu_r", r.shaft_mu_r);
+    e.q("roller.magnet_radius", "roller.magnet_radius", r.magnet_radius);
+    e.q("roller.magnet_mu_r", "roller.magnet_mu_r", r.magnet_mu_r);
+    for (const auto &p : r.poles)
+    {
+      const std::string at = "roller.poles." + p.name;
+      e.s(at + ".name", "roller.poles[].name", p.name);
+      e.q(at + ".angle", "roller.poles[].angle", p.angle);
+      e.q(at + ".strength", "roller.poles[].strength", p.strength);
+      e.q(at + ".shape_factor", "roller.poles[].shape_factor", p.shape_factor);
+    }
+  }
+  if (c.sleeve)
+  {
+    e.q("sleeve.radius", "sleeve.radius", c.sleeve->radius);
+    e.q("sleeve.thickness", "sleeve.thickness", c.sleeve->thickness);
+    e.q("sleeve.rpm", "sleeve.rpm", c.sleeve->omega());
+  }
+  if (c.drum.present)
+  {
+    e.q("drum.radius", "drum.radius", c.drum.radius);
+    e.q("drum.rpm", "drum.rpm", c.drum.omega());
+    e.q("drum.gap", "drum.gap", c.drum.gap);
+    e.q("drum.angle", "drum.angle", c.drum.angle);
+    e.q("drum.pc_thickness", "drum.pc_thickness", c.drum.pc_thickness);
+    e.q("drum.pc_eps_r", "drum.pc_eps_r", c.drum.pc_eps_r);
+  }
+  for (const auto &b : c.blades)
+  {
+    const std::string at = "blades." + b.name;
+    e.s(at + ".name", "blades[].name", b.name);
+    e.s(at + ".kind", "blades[].kind", b.is_doctor_blade ? "doctor_blade" : "guide");
+    e.polygon(at + ".profile", "blades[].profile", b.polygon);
+    e.q(at + ".gap", "blades[].gap", b.gap);
+    e.q(at + ".mu_r", "blades[].mu_r", b.mu_r);
+    e.s(at + ".material", "blades[].material", b.material);
+  }
+  for (const auto &p : c.planes)
+  {
+    const std::string at = "planes." + p.name;
+    e.s(at + ".name", "planes[].name", p.name);
+    e.v3(at + ".point", "planes[].point", p.point);
+    e.v3(at + ".normal", "planes[].normal", p.normal);
+    e.s(at + ".material", "planes[].material", p.material);
+    for (size_t k = 0; k < p.path.size(); ++k)
+    {
+      const std::string s = at + ".path[" + std::to_string(k) + "]";
+      e.q(s + ".time", "planes[].path[].time", p.path[k].first);
+      e.v3(s + ".displacement", "planes[].path[].displacement", p.path[k].second);
+    }
+  }
+  for (const auto &m : c.materials)
+  {
+    const std::string at = "materials." + m.name;
+    e.q(at + ".youngs_modulus", "materials.*.youngs_modulus", m.youngs_modulus);
+    e.q(at + ".poisson_ratio", "materials.*.poisson_ratio", m.poisson_ratio);
+    e.q(at + ".density", "materials.*.density", m.density);
+    e.q(at + ".mu_r", "materials.*.mu_r", m.mu_r);
+    e.q(at + ".saturation_magnetisation", "materials.*.saturation_magnetisation", m.saturation_magnetisation);
+    e.q(at + ".friction", "materials.*.friction", m.friction);
+    e.q(at + ".rolling_friction", "materials.*.rolling_friction", m.rolling_friction);
+    e.i(at + ".polygon_angles", "materials.*.polygon_angles", m.polygon_angles);
+    e.q(at + ".damping", "materials.*.damping", m.damping);
+    e.q(at + ".restitution", "materials.*.restitution", m.restitution);
+    e.q(at + ".hamaker", "materials.*.hamaker", m.hamaker);
+  }
+  for (const auto &p : c.populations)
+  {
+    const std::string at = "populations." + p.name;
+    e.s(at + ".name", "populations[].name", p.name);
+    e.s(at + ".kind", "populations[].kind", p.kind == ParticleKind::toner ? "toner" : "carrier");
+    e.s(at + ".material", "populations[].material", p.material);
+    e.q(at + ".diameter", "populations[].diameter", p.diameter_mean);
+    e.q(at + ".diameter_std", "populations[].diameter_std", p.diameter_std);
+    e.i(at + ".count", "populations[].count", p.count);
+    e.q(at + ".mass", "populations[].mass", p.mass);
+    e.q(at + ".concentration", "populations[].concentration", p.concentration);
+    e.q(at + ".charge_to_mass", "populations[].charge_to_mass", p.charge_to_mass);
+    if (p.insert_box)
+    {
+      const auto &bx = *p.insert_box;
+      std::string ex = "[", pr = "[";
+      for (int k = 0; k < 2; ++k)
+      {
+        ex += std::string(k ? ", " : "") + "[" + exact(bx[k][0]) + ", " + exact(bx[k][1]) + ", " + exact(bx[k][2]) + "]";
+        pr += std::string(k ? ", " : "") + "[" + format_quantity(bx[k][0], Dimension::length) + ", " +
+              format_quantity(bx[k][1], Dimension::length) + ", " + format_quantity(bx[k][2], Dimension::length) + "]";
+      }
+      e.entries.push_back({at + ".insert_box", "populations[].insert_box", ex + "]", pr + "]"});
+    }
+    e.q(at + ".layer_thickness", "populations[].layer_thickness", p.layer_thickness);
+  }
+  e.b("electric.enabled", "electric.enabled", c.electric.enabled);
+  e.q("electric.bias", "electric.bias", c.electric.bias);
+  const auto &im = c.electric.image;
+  if (im.kind == LatentImage::Kind::surface_potential)
+  {
+    e.q("electric.image.dark_potential", "electric.image.dark_potential", im.dark_value);
+    e.q("electric.image.light_potential", "electric.image.light_potential", im.light_value);
+  }
+  else if (im.kind == LatentImage::Kind::surface_charge)
+  {
+    e.q("electric.image.dark_charge", "electric.image.dark_charge", im.dark_value);
+    e.q("electric.image.light_charge", "electric.image.light_charge", im.light_value);
+  }
+  e.q("electric.image.period", "electric.image.period", im.period);
+  e.q("electric.image.duty", "electric.image.duty", im.duty);
+
+  const auto &f = c.applied_field;
+  e.s("applied_field.kind", "applied_field.kind",
+      f.kind == AppliedField::Kind::roller ? "roller" : f.kind == AppliedField::Kind::uniform ? "uniform" : "none");
+  e.v3("applied_field.direction", "applied_field.direction", f.uniform_direction);
+  e.q("applied_field.magnitude", "applied_field.magnitude", f.uniform_magnitude);
+  e.q("applied_field.ramp_time", "applied_field.ramp_time", f.ramp_time);
+
+  const auto &fs = c.field;
+  e.q("field.mesh_size_far", "field.mesh_size_far", fs.mesh_size_far);
+  e.q("field.mesh_size_sleeve", "field.mesh_size_sleeve", fs.mesh_size_sleeve);
+  e.q("field.mesh_size_gap", "field.mesh_size_gap", fs.mesh_size_gap);
+  e.i("field.element_degree", "field.element_degree", fs.element_degree);
+  e.q("field.outer_radius_factor", "field.outer_radius_factor", fs.outer_radius_factor);
+  e.q("field.grid_radial_spacing", "field.grid_radial_spacing", fs.grid_radial_spacing);
+  e.q("field.grid_angular_spacing", "field.grid_angular_spacing", fs.grid_angular_spacing);
+  e.q("field.grid_outer_radius", "field.grid_outer_radius", fs.grid_outer_radius);
+  e.q("field.grid_electric_spacing", "field.grid_electric_spacing", fs.grid_electric_spacing);
+  e.q("field.probe_radius", "field.probe_radius", fs.probe_radius);
+  e.s("field.output_dir", "field.output_dir", fs.output_dir);
+
+  const auto &d = c.dem;
+  e.q("dem.time_step", "dem.time_step", d.time_step);
+  e.q("dem.time_step_safety", "dem.time_step_safety", d.time_step_safety);
+  e.q("dem.duration", "dem.duration", d.duration);
+  e.q("dem.output_interval", "dem.output_interval", d.output_interval);
+  e.q("dem.checkpoint_interval", "dem.checkpoint_interval", d.checkpoint_interval);
+  e.q("dem.periodic_length", "dem.periodic_length", d.periodic_length);
+  e.q("dem.periodic_length_x", "dem.periodic_length_x", d.periodic_length_x);
+  e.q("dem.periodic_length_y", "dem.periodic_length_y", d.periodic_length_y);
+  e.s("dem.magnetic_model", "dem.magnetic_model", d.magnetic_model);
+  e.q("dem.magnetic_cutoff", "dem.magnetic_cutoff", d.magnetic_cutoff);
+  e.q("dem.magnetic_refresh", "dem.magnetic_refresh", d.magnetic_refresh);
+  e.q("dem.magnetic_tolerance", "dem.magnetic_tolerance", d.magnetic_tolerance);
+  e.q("dem.verlet_skin", "dem.verlet_skin", d.verlet_skin);
+  e.q("dem.air_viscosity", "dem.air_viscosity", d.air_viscosity);
+  e.v3("dem.gravity", "dem.gravity", d.gravity);
+  e.i("dem.seed", "dem.seed", static_cast<long long>(d.seed));
+  e.i("dem.threads", "dem.threads", d.threads);
+  e.q("dem.max_overlap_fraction", "dem.max_overlap_fraction", d.max_overlap_fraction);
+  e.s("dem.restitution_model", "dem.restitution_model", d.restitution_model);
+  e.q("dem.settle_time", "dem.settle_time", d.settle_time);
+  e.q("dem.max_kinetic_energy_growth", "dem.max_kinetic_energy_growth", d.max_kinetic_energy_growth);
+
+  e.s("output.directory", "output.directory", c.output.directory);
+  e.b("output.vtu", "output.vtu", c.output.vtu);
+  e.b("output.xdmf", "output.xdmf", c.output.xdmf);
+  return e.entries;
+}
+
+std::string format_case(const Case &c)
+{
+  const auto entries = resolved_entries(c);
+  size_t width = 0;
+  for (const auto &e : entries)
+    width = std::max(width, e.path.size());
+  std::ostringstream out;
+  for (const auto &e : entries)
+    out << e.path << std::string(width - e.path.size() + 1, ' ') << "= " << e.pretty << "\n";
+  return out.str();
+}
+
+namespace {
+
+// Exterior radial field of the Gaussian pole model for mu_r = 1 and no iron shaft: each
+// Fourier harmonic n of M_r(theta) is a multipole ring (DESIGN.md, exact check), whose
+// radial field at radius r is mu0 n/(2(n+1)) (Ro/r)^(n+1) (1 - rho^(n+1)) times the harmonic.
+double estimate_radial_field(const Roller &r, double radius, double theta)
+{
+  const int samples = 1440, harmonics = 80;
+  std::vector<double> m(samples);
+  for (int k = 0; k < samples; ++k)
+  {
+    const double t = 2.0 * pi * k / samples;
+    double s = 0.0;
+    for (const auto &p : r.poles)
+    {
+      const double w = std::remainder(t - p.angle, 2.0 * pi);
+      s += p.strength * std::exp(-p.shape_factor * w * w);
+    }
+    m[k] = s;
+  }
+  const double rho = r.shaft_radius / r.magnet_radius;
+  double b = 0.0;
+  for (int n = 1; n <= harmonics; ++n)
+  {
+    double a = 0.0, s = 0.0;
+    for (int k = 0; k < samples; ++k)
+    {
+      const double t = 2.0 * pi * k / samples;
+      a += m[k] * std::cos(n * t);
+      s += m[k] * std::sin(n * t);
+    }
+    a *= 2.0 / samples;
+    s *= 2.0 / samples;
+    const double gain = mu0 * n / (2.0 * (n + 1)) * std::pow(r.magnet_radius / radius, n + 1) *
+                        (1.0 - std::pow(rho, n + 1));
+    b += gain * (a * std::cos(n * theta) + s * std::sin(n * theta));
+  }
+  return b;
+}
+
+std::string fmt(const char *format, double v)
+{
+  char b[64];
+  std::snprintf(b, sizeof(b), format, v);
+  return b;
+}
+
+} // namespace
+
+std::string format_derived(const Case &c)
+{
+  std::ostringstream out;
+  const auto V = [](double v) { return format_quantity(v, Dimension::velocity); };
+  if (c.sleeve)
+    out << "sleeve surface speed        " << V(c.sleeve->surface_speed()) << "\n";
+  if (c.drum.present)
+  {
+    out << "drum surface speed          " << V(std::abs(c.drum.omega()) * c.drum.radius) << "\n";
+    if (c.sleeve)
+    {
+      // Tangential surface velocities at the nip along t = (-sin a, cos a): the sleeve point
+      // R u moves at omega_s R, the drum point c - R_d u at -omega_d R_d.
+      const double vs = c.sleeve->omega() * c.sleeve->radius;
+      const double vd = -c.drum.omega() * c.drum.radius;
+      out << "relative speed at the nip   " << V(std::abs(vs - vd)) << "  (surfaces move "
+          << (vs * vd > 0 ? "in the same direction" : vs * vd < 0 ? "in opposite directions" : "-")
+          << " at the nip)\n";
+      const Vec2 centre = c.drum.center(c.sleeve->radius);
+      out << "drum centre                 (" << format_quantity(centre[0], Dimension::length) << ", "
+          << format_quantity(centre[1], Dimension::length) << ")\n";
+    }
+  }
+  if (c.roller && c.sleeve && !c.roller->poles.empty())
+  {
+    const Pole *peak = &c.roller->poles.front();
+    for (const auto &p : c.roller->poles)
+      if (std::abs(p.strength) > std::abs(peak->strength))
+        peak = &p;
+    out << "pole field on the sleeve (estimate: Fourier multipole rings, mu_r = 1 everywhere):\n";
+    for (const auto &p : c.roller->poles)
+    {
+      const double b = estimate_radial_field(*c.roller, c.sleeve->radius, p.angle);
+      out << "  " << p.name << " at " << format_quantity(p.angle, Dimension::angle) << ": Bn = "
+          << format_quantity(b, Dimension::magnetic_flux_density) << ", B^2/2mu0 = "
+          << format_quantity(b * b / (2.0 * mu0), Dimension::pressure) << "\n";
+    }
+    if (c.drum.present)
+    {
+      const double b = estimate_radial_field(*c.roller, c.sleeve->radius, c.drum.angle);
+      out << "  at the nip (" << format_quantity(c.drum.angle, Dimension::angle)
+          << "): Bn = " << format_quantity(b, Dimension::magnetic_flux_density) << "\n";
+    }
+  }
+  if (c.applied_field.kind == AppliedField::Kind::uniform)
+  {
+    const double b = c.applied_field.uniform_magnitude;
+    out << "uniform field B^2/2mu0      " << format_quantity(b * b / (2.0 * mu0), Dimension::pressure) << "\n";
+  }
+  // Populations: mean sphere volume uses <d^3> = mu^3 + 3 mu sigma^2 (normal distribution).
+  double carrier_mass = 0.0;
+  std::vector<std::pair<double, double>> count_mass(c.populations.size());
+  for (size_t i = 0; i < c.populations.size(); ++i)
+  {
+    const auto &p = c.populations[i];
+    double rho = 0.0;
+    for (const auto &m : c.materials)
+      if (m.name == p.material)
+        rho = m.density;
+    const double d3 = std::pow(p.diameter_mean, 3) + 3.0 * p.diameter_mean * p.diameter_std * p.diameter_std;
+    const double one = rho * pi / 6.0 * d3;
+    double n = static_cast<double>(p.count), mass = p.mass;
+    if (p.count > 0)
+      mass = n * one;
+    else if (p.mass > 0.0 && one > 0.0)
+      n = p.mass / one;
+    count_mass[i] = {n, mass};
+    if (p.kind == ParticleKind::carrier)
+      carrier_mass += mass;
+  }
+  for (size_t i = 0; i < c.populations.size(); ++i)
+  {
+    const auto &p = c.populations[i];
+    auto [n, mass] = count_mass[i];
+    if (p.concentration > 0.0)
+    {
+      mass = p.concentration * carrier_mass;
+      double rho = 0.0;
+      for (const auto &m : c.materials)
+        if (m.name == p.material)
+          rho = m.density;
+      const double d3 = std::pow(p.diameter_mean, 3) + 3.0 * p.diameter_mean * p.diameter_std * p.diameter_std;
+      n = rho > 0.0 ? mass / (rho * pi / 6.0 * d3) : 0.0;
+    }
+    out << "population " << p.name << ": " << fmt("%.0f", n) << " particles, "
+        << format_quantity(mass, Dimension::mass);
+    if (p.charge_to_mass != 0.0)
+      out << ", total charge " << format_quantity(p.charge_to_mass * mass, Dimension::charge)
+          << ", mean particle charge "
+          << format_quantity(n > 0 ? p.charge_to_mass * mass / n : 0.0, Dimension::charge);
+    out << "\n";
+  }
+  if (c.dem.time_step > 0.0 && c.dem.duration > 0.0)
+    out << "time steps                  " << fmt("%.0f", c.dem.duration / c.dem.time_step) << "\n";
+  return out.str();
+}
+
+std::string format_schema(bool markdown)
+{
+  std::ostringstream out;
+  const auto affects = [](Affects a) {
+    switch (a)
+    {
+    case Affects::magnetic: return "magnetic";
+    case Affects::electric: return "electric";
+    case Affects::both: return "magnetic, electric";
+    default: return "";
+    }
+  };
+  const auto default_of = [](const KeySpec &k) {
+    if (k.required)
+      return std::string("required");
+    return k.default_text.empty() ? std::string("-") : k.default_text;
+  };
+  if (markdown)
+  {
+    out << "# Case file reference\n\n"
+           "Generated by `magbrush check --explain --markdown` from the schema in "
+           "`coupling/case_schema.cpp`; do not edit by hand.\n\n"
+           "Values carry units (`25 mm`, `219 rpm`, `130 mT`, `-600 V`, `60 um`, `-30 uC/g`); a bare number "
+           "is SI (angles: radians). Units: m, s, g, rad, deg, rpm, Hz, N, Pa, J, C, V, T, G (gauss), A, %, "
+           "with prefixes f p n u (or µ) m c k M G, combined with `*`, `/` and `^` (`kg/m^3`, `Pa*s`).\n"
+           "List elements are addressed by name in key paths and overrides: "
+           "`magbrush check case.yaml --set roller.poles.N1.angle=95deg`.\n\n"
+           "The last column says which stored field must be recomputed when the key changes.\n\n"
+           "| key | type | default | range | field | meaning |\n|---|---|---|---|---|---|\n";
+    for (const auto &k : case_schema())
+    {
+      std::string doc = k.doc, type = k.type_description();
+      for (auto *s : {&doc, &type})
+        for (size_t p = 0; (p = s->find('|', p)) != std::string::npos; p += 2)
+          s->replace(p, 1, "\\|");
+      out << "| `" << k.path << "` | " << type << " | " << default_of(k) << " | " << k.range_description()
+          << " | " << affects(k.affects) << " | " << doc << " |\n";
+    }
+    return out.str();
+  }
+  for (const auto &k : case_schema())
+  {
+    const size_t depth = static_cast<size_t>(std::count(k.path.begin(), k.path.end(), '.'));
+    out << std::string(2 * depth, ' ') << last_component(k.path) << (k.is_container() ? ":" : "")
+        << "  [" << k.type_description();
+    if (!k.is_container() || k.required)
+      out << "; " << default_of(k);
+    if (!k.range_description().empty())
+      out << "; " << k.range_description();
+    if (k.affects != Affects::none)
+      out << "; affects " << affects(k.affects) << " field";
+    out << "]\n" << std::string(2 * depth + 4, ' ') << k.doc << "\n";
+  }
+  return out.str();
+}
+
+} // namespace magbrush

@@ -1,0 +1,28 @@
+// Which case inputs a stored field depends on, and a stable digest of them. A field file
+// records the hash; a stage regenerates the field only when the hash of the current case
+// differs (and can say which key changed by comparing field_inputs()).
+#pragma once
+
+#include "case_model.h"
+
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace magbrush {
+
+enum class FieldKind
+{
+  magnetic,
+  electric
+};
+
+// Canonical "key path" -> value (SI, full precision) of every input the field depends on,
+// as marked in the schema (case_schema.h). A non-magnetic blade (mu_r = 1) does not enter the
+// magnetic inputs: moving it does not change the roller field.
+std::vector<std::pair<std::string, std::string>> field_inputs(const Case &c, FieldKind k);
+
+// FNV-1a 64-bit digest of field_inputs as 16 hex digits.
+std::string field_hash(const Case &c, FieldKind k);
+
+} // namespace magbrush

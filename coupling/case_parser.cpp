@@ -12,6 +12,7 @@
 #include "case_validation.h"
 #include "units.h"
 
+#include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -223,6 +224,11 @@ private:
         error(location(root.Mark()), "", "expected the case file to be a YAML section of keys "
                                          "(e.g. 'sleeve:'), found " + node_kind(root));
       return root;
+    }
+    catch (const YAML::DeepRecursion &e)
+    {
+      error(location(e.mark), "", "the YAML is nested " + std::to_string(e.depth()) +
+                                      " levels deep here; case files are a few levels deep");
     }
     catch (const YAML::Exception &e)
     {
@@ -752,8 +758,11 @@ private:
       pole.shape_factor = has(p, "shape_factor") ? q(p, "shape_factor") : default_alpha;
       if (has(p, "polarity"))
       {
+        // An unsigned strength takes the polarity's sign; an explicit sign must agree.
         const double sign = str(p, "polarity") == "N" ? 1.0 : -1.0;
-        if (pole.strength * sign < 0.0)
+        const std::string &written = leaf(p, "strength").written;
+        const bool explicit_sign = written.find_first_of("+-") == written.find_first_not_of(" ");
+        if (explicit_sign && pole.strength * sign < 0.0)
           error_at_path(p.display + ".strength",
                         "the strength's sign contradicts 'polarity: " + str(p, "polarity") +
                             "'; give an unsigned strength or drop the polarity");

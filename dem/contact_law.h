@@ -1,0 +1,175 @@
+// The contact law of Kawamoto et al., appendix A2–A7, as four small sub-models in the manner
+// of LAMMPS GRANULAR (normal, damping, tangential, rolling), and the function that combines
+// them for one contact. Particle–particle and particle–wall contacts use the same law; a wall
+// is a partner of infinite mass and inertia (its 1/m and 1/I are zero).
+//
+// Sign conventions: n is the unit normal from particle i towards its partner; δ > 0 is the
+// overlap; v_rel is the velocity of i's contact point relative to the partner's contact point;
+// the returned force acts on i (the partner receives −F).
+#pragma once
+
+#include "vector3.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace magbrush::dem {
+
+// Coefficients of one interaction type (species–species or species–wall material).
+struct ContactCoefficients
+{
+  double effective_modulus = 0.0;  // E* = [(1−ν_i²)/E_i + (1−ν_j²)/E_j]⁻¹ [Pa]
+  double effective_shear = 0.0;    // G* = [(2−ν_i)/G_i + (2−ν_j)/G_j]⁻¹ [Pa]
+  double friction = 0.0;           // Coulomb sliding coefficient μ
+  double rolling_friction = 0.0;   // μ_r in Kawamoto A7 (torque r μ_r |F_n|)
+  double damping_normal = 0.0;     // α_n in c_n = α_n √(m* k_n) δ^¼
+  double damping_tangential = 0.0; // α_t in c_t = α_t √(m* k_t)
+};
+
+// Hertz normal spring (A2–A3): F = k_n δ^{3/2}, k_n = (4/3) E* √R*.
+struct HertzNormal
+{
+  static double stiffness(double E_star, double R_star) { return 4.0 / 3.0 * E_star * std::sqrt(R_star); }
+  static double force(double k_n, double delta) { return k_n * delta * std::sqrt(delta); }
+  static double energy(double k_n, double delta) { return 0.4 * k_n * delta * delta * std::sqrt(delta); }
+};
+
+// Voigt dashpot of Kawamoto (A3): c_n = α √(m* k_n) δ^{1/4}. The LIGGGHTS/LAMMPS restitution
+// form (γ_n = 2√(5/6) β √(S_n m*), S_n = 2E*√(R*δ), β = ln e/√(ln²e + π²)) is the same
+// function of δ with α = √5 |β| (contact_parameters.h), so one dashpot serves both.
+struct ViscoelasticDamping
+{
+  static double normal(double alpha, double m_star, double k_n, double delta)
+  {
+    return alpha * std::sqrt(m_star * k_n * std::sqrt(delta));
+  }
+  static double tangential(double alpha, double m_star, double k_t)
+  {
+    return alpha * std::sqrt(m_star * k_t);
+  }
+};
+
+// Mindlin tangential spring with dashpot and Coulomb limit (A4–A6):
+//   F_t = −k_t ξ − c_t v_t,  k_t = 8 G* √(R* δ),  |F_t| ≤ μ F_n.
+// ξ is the accumulated tangential displacement (the contact history). Each step it is first
+// turned into the current tangent plane (the pair frame rotates as the particles roll round
+// each other), then incremented by v_t dt. We remove the normal component WITHOUT restoring
+// the old magnitude: that equals the exact rotation to first order in the step's rotation
+// angle, and — unlike LAMMPS's magnitude-preserving rescale — can never pump the spring up,
+// which made small particles stick to large ones there (lammps/lammps PR #4244).
+// When sliding, ξ is reset to the spring extension that carries the Coulomb force
+// (ξ = −(F_t + c_t v_t)/k_t, as in LAMMPS and Luding 2008), so stick resumes without a jump.
+struct MindlinTangential
+{
+  static double stiffness(double G_star, double R_star, double delta)
+  {
+    return 8.0 * G_star * std::sqrt(R_star * delta);
+  }
+  static void rotate_into_tangent_plane(Vector3 &xi, const Vector3 &n)
+  {
+    xi = xi - dot(xi, n) * n;
+  }
+  // Returns the tangential force on i and updates ξ.
+  static Vector3 force(Vector3 &xi, const Vector3 &v_t, double k_t, double c_t, double mu,
+                       double f_n, double dt)
+  {
+    xi += dt * v_t;
+    Vector3 f = -(k_t * xi) - c_t * v_t;
+    const double limit = mu * f_n;
+    const double f2 = dot(f, f);
+    if (f2 > limit * limit)
+    {
+      f = (limit / std::sqrt(f2)) * f;
+      xi = (k_t > 0.0 ? -1.0 / k_t : 0.0) * (f + c_t * v_t);
+    }
+    return f;
+  }
+};
+
+// Rolling friction (A7, second term): a torque of magnitude r μ_r |F_n| opposing rolling.
+// Kawamoto uses each particle's own ω direction; we use the RELATIVE rolling velocity
+// (ω_i − ω_j with the twist along n removed), which is the same for one particle on a fixed
+// wall and is frame-independent (a bead riding rigidly on a turning sleeve feels none).
+// A constant-magnitude torque chatters when ω_roll ≈ 0; it is therefore capped so that one
+// step cannot reverse the relative rolling velocity (then it acts like a stiff viscous lock).
+struct RollingFriction
+{
+  struct Torques
+  {
+    Vector3 on_i, on_j;
+  };
+  static Torques torque(const Vector3 &w_rel, const Vector3 &n, double mu_r, double f_n,
+                        double r_i, double r_j, double inv_I_i, double inv_I_j, double dt)
+  {
+    Torques t;
+    if (mu_r <= 0.0 || f_n <= 0.0)
+      return t;
+    const Vector3 w_roll = w_rel - dot(w_rel, n) * n;
+    const double w = norm(w_roll);
+    if (w <= 0.0)
+      return t;
+    const double m = mu_r * f_n;
+    // Change of |ω_roll| in one step under the full torques: m dt (r_i/I_i + r_j/I_j).
+    const double full_change = m * dt * (r_i * inv_I_i + r_j * inv_I_j);
+    const double scale = full_change > w ? w / full_change : 1.0;
+    const Vector3 dir = (1.0 / w) * w_roll;
+    t.on_i = -(scale * m * r_i) * dir;
+    t.on_j = (scale * m * r_j) * dir;
+    return t;
+  }
+};
+
+// What one contact needs to know about its two bodies.
+struct ContactKinematics
+{
+  Vector3 n;                 // unit normal from i towards the partner
+  double overlap = 0.0;      // δ > 0
+  double lever_i = 0.0;      // distance from i's centre to the contact plane
+  double lever_j = 0.0;      // same for the partner (0 for walls)
+  Vector3 v_rel;             // contact-point velocity of i relative to the partner
+  Vector3 w_rel;             // ω_i − ω_partner
+  double R_star = 0.0;       // r_i r_j / (r_i + r_j) (walls: r_i)
+  double m_star = 0.0;       // m_i m_j / (m_i + m_j) (walls: m_i)
+  double radius_i = 0.0, radius_j = 0.0;
+  double inv_inertia_i = 0.0, inv_inertia_j = 0.0; // partner: 0 for walls
+};
+
+struct ContactOutcome
+{
+  Vector3 force_i;   // total contact force on i (partner receives the opposite)
+  Vector3 torque_i;  // torque on i
+  Vector3 torque_j;  // torque on the partner (about its own centre)
+  double normal_force = 0.0;
+};
+
+// The whole law for one touching contact: normal + damping + tangential + rolling.
+inline ContactOutcome evaluate_contact(const ContactCoefficients &c, const ContactKinematics &k,
+                                       Vector3 &history, double dt)
+{
+  ContactOutcome out;
+  const double k_n = HertzNormal::stiffness(c.effective_modulus, k.R_star);
+  // v_rel·n > 0: i moves towards the partner (approach); the dashpot opposes it.
+  const double approach = dot(k.v_rel, k.n);
+  const double c_n = ViscoelasticDamping::normal(c.damping_normal, k.m_star, k_n, k.overlap);
+  // Magnitude of the repulsive normal force; a dashpot may not pull the bodies together.
+  const double f_n = std::max(0.0, HertzNormal::force(k_n, k.overlap) + c_n * approach);
+  out.normal_force = f_n;
+
+  const Vector3 v_t = k.v_rel - dot(k.v_rel, k.n) * k.n;
+  const double k_t = MindlinTangential::stiffness(c.effective_shear, k.R_star, k.overlap);
+  const double c_t = ViscoelasticDamping::tangential(c.damping_tangential, k.m_star, k_t);
+  MindlinTangential::rotate_into_tangent_plane(history, k.n);
+  const Vector3 f_t = MindlinTangential::force(history, v_t, k_t, c_t, c.friction, f_n, dt);
+
+  out.force_i = (-f_n) * k.n + f_t;
+  // Lever arms to the contact plane: torque on i is (a_i n) × F_t; the partner gets −F_t at
+  // −a_j n, i.e. (a_j n) × F_t.
+  const Vector3 n_x_ft = cross(k.n, f_t);
+  const auto roll = RollingFriction::torque(k.w_rel, k.n, c.rolling_friction, f_n, k.radius_i,
+                                            k.radius_j, k.inv_inertia_i, k.inv_inertia_j, dt);
+  out.torque_i = k.lever_i * n_x_ft + roll.on_i;
+  out.torque_j = k.lever_j * n_x_ft + roll.on_j;
+  return out;
+}
+
+} // namespace magbrush::dem

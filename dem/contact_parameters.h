@@ -1,0 +1,71 @@
+// From materials to contact coefficients: the mixing rules, the two damping forms and
+// Kawamoto's polygon rule for the rolling-friction coefficient.
+#pragma once
+
+#include "contact_law.h"
+
+#include "case_model.h"
+
+#include <string>
+#include <vector>
+
+namespace magbrush::dem {
+
+// Kawamoto's polygon rule. A sphere is modelled as a regular n-gon of circumradius r resting
+// on one side. Tipping it over a corner needs a torque W r sin(π/n) about the centre, so the
+// rolling resistance torque is r μ_r |F_n| with
+//     μ_r = sin(π / n)          (n = 12, Kawamoto's carrier: μ_r = 0.2588).
+double rolling_friction_from_polygon(int corners);
+
+// LIGGGHTS/LAMMPS restitution form, β = ln e / √(ln²e + π²):
+//   normal     γ_n = 2√(5/6) |β| √(S_n m*), S_n = 2E*√(R*δ)  ⇔  α_n = √5 |β|
+//   tangential γ_t = 2√(5/6) |β| √(S_t m*), S_t = k_t       ⇔  α_t = 2√(5/6) |β|
+// It is exact only for a linear spring; with Hertz it gives a restitution that differs from e
+// (see hertz_restitution and the verification test).
+double ln_e_alpha_normal(double e);
+double ln_e_alpha_tangential(double e);
+
+// The restitution coefficient that Hertz + the dashpot c_n = α √(m* k_n) δ^¼ gives in a
+// head-on impact. For this dashpot it is independent of the impact speed, so it is one number
+// per α, computed by integrating the dimensionless contact ODE
+//     ξ'' = −ξ^{3/2} − α ξ^{1/4} ξ',  ξ(0) = 0, ξ'(0) = 1
+// until the (non-attractive) force vanishes; e = −ξ'(end).
+double hertz_restitution(double alpha);
+// Its inverse by bisection: the α for which Hertz gives exactly e (restitution_model
+// "hertz_exact").
+double hertz_alpha_for_restitution(double e);
+
+// A table of coefficients for every interaction type: species × (species ∪ wall materials).
+class ContactTable
+{
+public:
+  // `species_materials[s]` names the material of population s, `wall_materials[w]` that of
+  // wall w. Mixing: E*, G* exactly as in Hertz–Mindlin; μ, μ_r, damping of two particles the
+  // mean of both; against a wall: the wall's μ (Kawamoto quotes particle–wall friction as a
+  // wall property), the particle's μ_r and damping (or the wall's restitution if it has one).
+  void build(const Case &c, const std::vector<std::string> &species_materials,
+             const std::vector<std::string> &wall_materials);
+
+  const ContactCoefficients &particle_pair(int s, int t) const
+  {
+    return table_[static_cast<std::size_t>(s) * columns_ + static_cast<std::size_t>(t)];
+  }
+  const ContactCoefficients &particle_wall(int s, int w) const
+  {
+    return table_[static_cast<std::size_t>(s) * columns_ + n_species_ + static_cast<std::size_t>(w)];
+  }
+  std::size_t species() const { return n_species_; }
+  // One line per interaction type, for the log.
+  std::string describe() const;
+
+private:
+  std::size_t n_species_ = 0, columns_ = 0;
+  std::vector<ContactCoefficients> table_;
+  std::vector<std::string> names_;
+};
+
+// The coefficients of one pair of materials (used by the table and by tests).
+ContactCoefficients mix_materials(const Material &a, const Material &b, bool b_is_wall,
+                                  const std::string &restitution_model);
+
+} // namespace magbrush::dem

@@ -1,0 +1,747 @@
+// The DEM engine's step and state (see dem_system.h).
+#include "dem_system.h"
+
+#include "contact_law.h"
+#include "insertion.h"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <limits>
+
+namespace magbrush::dem {
+
+namespace {
+std::size_t U(std::int32_t v) { return static_cast<std::size_t>(v); }
+
+// Scoped wall-clock accumulation into one PhaseTimes slot.
+class PhaseTimer
+{
+public:
+  explicit PhaseTimer(double &slot) : slot_(slot), start_(omp_get_wtime()) {}
+  ~PhaseTimer() { slot_ += omp_get_wtime() - start_; }
+
+private:
+  double &slot_;
+  double start_;
+};
+} // namespace
+
+DemSystem::DemSystem(const Case &c) : case_(c), walls_(build_wall_primitives(c))
+{
+  box_.length = {c.dem.periodic_length_x, c.dem.periodic_length_y, c.dem.periodic_length};
+}
+
+void DemSystem::insert_particles()
+{
+  insert_populations(case_, walls_, box_, particles_);
+}
+
+void DemSystem::add_force_term(std::unique_ptr<ForceTerm> term)
+{
+  times_.terms.push_back(0.0);
+  terms_.push_back(std::move(term));
+}
+
+void DemSystem::setup_derived()
+{
+  const std::size_t n = particles_.size();
+  if (n == 0)
+    throw std::invalid_argument("dem: the scene has no particles (check the populations' count/mass)");
+  std::vector<std::string> species_materials, species_names;
+  std::vector<Material> materials;
+  for (const auto &p : case_.populations)
+  {
+    species_materials.push_back(p.material);
+    species_names.push_back(p.name);
+    materials.push_back(case_.material(p.material));
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    if (particles_.species[i] < 0 || U(particles_.species[i]) >= species_materials.size())
+      throw std::invalid_argument("dem: particle " + std::to_string(particles_.id[i]) + " has species " +
+                                  std::to_string(particles_.species[i]) + " but the case has " +
+                                  std::to_string(species_materials.size()) + " populations");
+  table_.build(case_, species_materials, walls_.materials());
+  stable_ = stable_time_step(particles_, materials, species_names, table_, walls_.size(),
+                             std::max(1.0, 2.0 * walls_.max_surface_speed()));
+  dt_ = choose_time_step(case_.dem, stable_);
+
+  double mean_d = 0.0, mass = 0.0;
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    mean_d += 2.0 * particles_.radius[i];
+    mass += particles_.mass[i];
+  }
+  mean_d /= static_cast<double>(n);
+  skin_ = case_.dem.verlet_skin * mean_d;
+  energy_floor_ = 0.5 * mass * 1.0; // (1 m/s)²: the runaway guard ignores growth below this
+  forces_.resize(n);
+  contact_count_.assign(n, 0);
+  if (walls_.size() > 0)
+  {
+    const std::size_t k = n * max_wall_contacts;
+    wall_id_.assign(k, -1);
+    for (auto *a : {&wall_hx_, &wall_hy_, &wall_hz_, &wall_fx_, &wall_fy_, &wall_fz_, &wall_tx_, &wall_ty_, &wall_tz_})
+      a->assign(k, 0.0);
+  }
+  times_.terms.resize(terms_.size(), 0.0);
+}
+
+void DemSystem::initialize()
+{
+  setup_derived();
+  rebuild_neighbor_list();
+  // Forces at t = 0, so that the first half kick uses them.
+  compute_particle_contacts();
+  compute_wall_contacts();
+  for (std::size_t t = 0; t < terms_.size(); ++t)
+    terms_[t]->add_forces(particles_, forces_, time_);
+  initialized_ = true;
+}
+
+void DemSystem::permute_particles(const std::vector<std::int32_t> &order)
+{
+  particles_.permute(order, scratch_, iscratch_);
+  forces_.permute(order, scratch_);
+  permute_array(contact_count_, order, iscratch_);
+  if (!wall_id_.empty())
+  {
+    // Slots move in blocks of max_wall_contacts.
+    std::vector<std::int32_t> slot_order(order.size() * max_wall_contacts);
+    for (std::size_t k = 0; k < order.size(); ++k)
+      for (int s = 0; s < max_wall_contacts; ++s)
+        slot_order[k * max_wall_contacts + U(s)] = order[k] * max_wall_contacts + s;
+    permute_array(wall_id_, slot_order, iscratch_);
+    for (auto *a : {&wall_hx_, &wall_hy_, &wall_hz_, &wall_fx_, &wall_fy_, &wall_fz_, &wall_tx_, &wall_ty_, &wall_tz_})
+      permute_array(*a, slot_order, scratch_);
+  }
+  for (auto &t : terms_)
+    t->particles_reordered(order);
+}
+
+void DemSystem::rebuild_neighbor_list()
+{
+  PhaseTimer timer(times_.neighbor);
+  list_.rebuild(particles_, box_, skin_, [this](const std::vector<std::int32_t> &order) { permute_particles(order); });
+  x0_ = particles_.x;
+  y0_ = particles_.y;
+  z0_ = particles_.z;
+  max_drift2_ = 0.0;
+  force_rebuild_ = false;
+  ++rebuilds_;
+}
+
+void DemSystem::kick_and_drift()
+{
+  PhaseTimer timer(times_.integrate);
+  const long n = static_cast<long>(particles_.size());
+  const double h = 0.5 * dt_, dt = dt_;
+  ParticleState &s = particles_;
+  const ForceBuffers &f = forces_;
+  double drift2 = 0.0;
+#pragma omp parallel for schedule(static) reduction(max : drift2) if (n > 512)
+  for (long k = 0; k < n; ++k)
+  {
+    const std::size_t i = static_cast<std::size_t>(k);
+    const double im = s.inv_mass[i], iI = s.inv_inertia[i];
+    s.vx[i] += h * f.fx[i] * im;
+    s.vy[i] += h * f.fy[i] * im;
+    s.vz[i] += h * f.fz[i] * im;
+    s.wx[i] += h * f.tx[i] * iI;
+    s.wy[i] += h * f.ty[i] * iI;
+    s.wz[i] += h * f.tz[i] * iI;
+    s.x[i] += dt * s.vx[i];
+    s.y[i] += dt * s.vy[i];
+    s.z[i] += dt * s.vz[i];
+    const double dx = s.x[i] - x0_[i], dy = s.y[i] - y0_[i], dz = s.z[i] - z0_[i];
+    drift2 = std::max(drift2, dx * dx + dy * dy + dz * dz);
+  }
+  max_drift2_ = drift2;
+}
+
+void DemSystem::final_kick()
+{
+  PhaseTimer timer(times_.integrate);
+  const long n = static_cast<long>(particles_.size());
+  const double h = 0.5 * dt_;
+  ParticleState &s = particles_;
+  const ForceBuffers &f = forces_;
+  int bad = 0;
+#pragma omp parallel for schedule(static) reduction(| : bad) if (n > 512)
+  for (long k = 0; k < n; ++k)
+  {
+    const std::size_t i = static_cast<std::size_t>(k);
+    const double im = s.inv_mass[i], iI = s.inv_inertia[i];
+    s.vx[i] += h * f.fx[i] * im;
+    s.vy[i] += h * f.fy[i] * im;
+    s.vz[i] += h * f.fz[i] * im;
+    s.wx[i] += h * f.tx[i] * iI;
+    s.wy[i] += h * f.ty[i] * iI;
+    s.wz[i] += h * f.tz[i] * iI;
+    if (!std::isfinite(s.vx[i] + s.vy[i] + s.vz[i] + s.wx[i] + s.wy[i] + s.wz[i] + s.x[i] + s.y[i] + s.z[i]))
+      bad = 1;
+  }
+  if (bad)
+    for (std::size_t i = 0; i < particles_.size(); ++i)
+      if (!std::isfinite(s.vx[i] + s.vy[i] + s.vz[i] + s.wx[i] + s.wy[i] + s.wz[i] + s.x[i] + s.y[i] + s.z[i]))
+      {
+        char msg[512];
+        std::snprintf(msg, sizeof msg,
+                      "stability guard: NaN/Inf at step %ld (t = %.6g s) in the state of %s. The time step "
+                      "(%.3g s) is probably too large for the stiffest contact or force term: reduce "
+                      "dem.time_step (or time_step_safety), or check the material stiffness and the force terms",
+                      step_, time_, describe_particle(i).c_str(), dt_);
+        throw StabilityError(msg);
+      }
+}
+
+std::string DemSystem::describe_particle(std::size_t i) const
+{
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "particle id %d (species %d, r = %.3g m, at (%.4g, %.4g, %.4g) m)",
+                particles_.id[i], particles_.species[i], particles_.radius[i], particles_.x[i],
+                particles_.y[i], particles_.z[i]);
+  return buf;
+}
+
+void DemSystem::compute_particle_contacts()
+{
+  PhaseTimer timer(times_.particle_contacts);
+  const ParticleState &s = particles_;
+  NeighborList &L = list_;
+  const long n = static_cast<long>(s.size());
+  const double dt = dt_;
+  const double guard = case_.dem.max_overlap_fraction;
+  int overlap_alarm = 0;
+  // 1. Each pair computes its contact into its own slots (no races, no order dependence).
+#pragma omp parallel for schedule(dynamic, 64) reduction(| : overlap_alarm) if (n > 512)
+  for (long k = 0; k < n; ++k)
+  {
+    const std::size_t i = static_cast<std::size_t>(k);
+    const double xi = s.x[i], yi = s.y[i], zi = s.z[i], ri = s.radius[i], mi = s.mass[i];
+    const Vector3 vi = s.velocity(i), wi = s.angular_velocity(i);
+    const int si = s.species[i];
+    for (std::int32_t pp = L.row_start[i]; pp < L.row_start[i + 1]; ++pp)
+    {
+      const std::size_t p = U(pp);
+      const std::size_t j = U(L.partner[p]);
+      const Vector3 sh = L.shift(p);
+      const Vector3 d{s.x[j] - xi + sh.x, s.y[j] - yi + sh.y, s.z[j] - zi + sh.z};
+      const double rj = s.radius[j], reach = ri + rj;
+      const double r2 = dot(d, d);
+      if (r2 >= reach * reach)
+      {
+        L.touching[p] = 0;
+        L.hist_x[p] = L.hist_y[p] = L.hist_z[p] = 0.0;
+        continue;
+      }
+      const double dist = std::sqrt(r2);
+      ContactKinematics c;
+      c.n = (1.0 / dist) * d;
+      c.overlap = reach - dist;
+      if (c.overlap > guard * std::min(ri, rj))
+        overlap_alarm = 1;
+      // Distances from the centres to the plane of the contact circle.
+      c.lever_i = 0.5 * (dist + (ri * ri - rj * rj) / dist);
+      c.lever_j = dist - c.lever_i;
+      const Vector3 wj = s.angular_velocity(j);
+      c.v_rel = vi - s.velocity(j) + cross(c.lever_i * wi + c.lever_j * wj, c.n);
+      c.w_rel = wi - wj;
+      c.R_star = ri * rj / reach;
+      const double mj = s.mass[j];
+      c.m_star = mi * mj / (mi + mj);
+      c.radius_i = ri;
+      c.radius_j = rj;
+      c.inv_inertia_i = s.inv_inertia[i];
+      c.inv_inertia_j = s.inv_inertia[j];
+      Vector3 xi_t{L.hist_x[p], L.hist_y[p], L.hist_z[p]};
+      const ContactOutcome o = evaluate_contact(table_.particle_pair(si, s.species[j]), c, xi_t, dt);
+      L.hist_x[p] = xi_t.x;
+      L.hist_y[p] = xi_t.y;
+      L.hist_z[p] = xi_t.z;
+      L.force_x[p] = o.force_i.x;
+      L.force_y[p] = o.force_i.y;
+      L.force_z[p] = o.force_i.z;
+      L.torque_i_x[p] = o.torque_i.x;
+      L.torque_i_y[p] = o.torque_i.y;
+      L.torque_i_z[p] = o.torque_i.z;
+      L.torque_j_x[p] = o.torque_j.x;
+      L.torque_j_y[p] = o.torque_j.y;
+      L.torque_j_z[p] = o.torque_j.z;
+      L.touching[p] = 1;
+    }
+  }
+  // 2. Each particle gathers its pairs in a fixed order: its own row, then its column.
+  ForceBuffers &f = forces_;
+#pragma omp parallel for schedule(static) if (n > 512)
+  for (long k = 0; k < n; ++k)
+  {
+    const std::size_t i = static_cast<std::size_t>(k);
+    double fx = 0, fy = 0, fz = 0, tx = 0, ty = 0, tz = 0;
+    std::int32_t count = 0;
+    for (std::int32_t pp = L.row_start[i]; pp < L.row_start[i + 1]; ++pp)
+    {
+      const std::size_t p = U(pp);
+      if (!L.touching[p])
+        continue;
+      ++count;
+      fx += L.force_x[p];
+      fy += L.force_y[p];
+      fz += L.force_z[p];
+      tx += L.torque_i_x[p];
+      ty += L.torque_i_y[p];
+      tz += L.torque_i_z[p];
+    }
+    for (std::int32_t q = L.col_start[i]; q < L.col_start[i + 1]; ++q)
+    {
+      const std::size_t p = U(L.col_pair[U(q)]);
+      if (!L.touching[p])
+        continue;
+      ++count;
+      fx -= L.force_x[p];
+      fy -= L.force_y[p];
+      fz -= L.force_z[p];
+      tx += L.torque_j_x[p];
+      ty += L.torque_j_y[p];
+      tz += L.torque_j_z[p];
+    }
+    f.fx[i] = fx;
+    f.fy[i] = fy;
+    f.fz[i] = fz;
+    f.tx[i] = tx;
+    f.ty[i] = ty;
+    f.tz[i] = tz;
+    contact_count_[i] = count;
+  }
+  if (overlap_alarm)
+    check_overlaps();
+}
+
+void DemSystem::check_overlaps() const
+{
+  // Serial scan for the worst pair, only when the parallel kernel raised the alarm.
+  const ParticleState &s = particles_;
+  double worst = 0.0;
+  std::size_t wi = 0, wj = 0;
+  for (std::size_t i = 0; i < s.size(); ++i)
+    for (std::int32_t pp = list_.row_start[i]; pp < list_.row_start[i + 1]; ++pp)
+    {
+      const std::size_t p = U(pp), j = U(list_.partner[p]);
+      const Vector3 sh = list_.shift(p);
+      const Vector3 d{s.x[j] - s.x[i] + sh.x, s.y[j] - s.y[i] + sh.y, s.z[j] - s.z[i] + sh.z};
+      const double frac = (s.radius[i] + s.radius[j] - norm(d)) / std::min(s.radius[i], s.radius[j]);
+      if (frac > worst)
+      {
+        worst = frac;
+        wi = i;
+        wj = j;
+      }
+    }
+  char msg[768];
+  std::snprintf(msg, sizeof msg,
+                "stability guard: at step %ld (t = %.6g s) %s overlaps particle id %d by %.1f %% of the smaller "
+                "radius (limit dem.max_overlap_fraction = %.1f %%). Contacts are too soft for the loads or "
+                "the time step (%.3g s) is too large: increase Young's modulus, reduce dem.time_step, or check "
+                "the insertion and the force terms",
+                step_, time_, describe_particle(wi).c_str(), s.id[wj], 100.0 * worst,
+                100.0 * case_.dem.max_overlap_fraction, dt_);
+  throw StabilityError(msg);
+}
+
+void DemSystem::compute_wall_contacts()
+{
+  if (walls_.size() == 0)
+    return;
+  PhaseTimer timer(times_.wall_contacts);
+  ParticleState &s = particles_;
+  ForceBuffers &f = forces_;
+  const long n = static_cast<long>(s.size());
+  const std::size_t W = walls_.size();
+  const double t = time_, dt = dt_, guard = case_.dem.max_overlap_fraction;
+  const bool frozen = walls_frozen_;
+  long alarm = -1, too_many = -1;
+#pragma omp parallel for schedule(dynamic, 256) reduction(max : alarm, too_many) if (n > 512)
+  for (long k = 0; k < n; ++k)
+  {
+    const std::size_t i = static_cast<std::size_t>(k);
+    const Vector3 p = s.position(i);
+    const double r = s.radius[i];
+    // Pass 1: which walls touch this particle now.
+    WallContactGeometry g[max_wall_contacts];
+    int which[max_wall_contacts];
+    int m = 0;
+    for (std::size_t w = 0; w < W; ++w)
+    {
+      WallContactGeometry tmp;
+      if (!walls_.contact(w, p, r, t, frozen, tmp))
+        continue;
+      if (m == max_wall_contacts)
+      {
+        too_many = k;
+        break;
+      }
+      g[m] = tmp;
+      which[m++] = static_cast<int>(w);
+    }
+    // Pass 2: free the slots of walls no longer touched.
+    const std::size_t base = i * max_wall_contacts;
+    for (int q = 0; q < max_wall_contacts; ++q)
+    {
+      const std::size_t sl = base + U(q);
+      if (wall_id_[sl] < 0)
+        continue;
+      bool still = false;
+      for (int c = 0; c < m; ++c)
+        still = still || which[c] == wall_id_[sl];
+      if (!still)
+      {
+        wall_id_[sl] = -1;
+        wall_hx_[sl] = wall_hy_[sl] = wall_hz_[sl] = 0.0;
+        wall_fx_[sl] = wall_fy_[sl] = wall_fz_[sl] = wall_tx_[sl] = wall_ty_[sl] = wall_tz_[sl] = 0.0;
+      }
+    }
+    // Pass 3: evaluate each contact with its slot's history.
+    for (int c = 0; c < m; ++c)
+    {
+      std::size_t sl = base + max_wall_contacts;
+      for (int q = 0; q < max_wall_contacts && sl == base + max_wall_contacts; ++q)
+        if (wall_id_[base + U(q)] == which[c])
+          sl = base + U(q);
+      for (int q = 0; q < max_wall_contacts && sl == base + max_wall_contacts; ++q)
+        if (wall_id_[base + U(q)] < 0)
+          sl = base + U(q);
+      wall_id_[sl] = which[c];
+      if (g[c].overlap > guard * r)
+        alarm = k;
+      ContactKinematics ck;
+      ck.n = g[c].n;
+      ck.overlap = g[c].overlap;
+      ck.lever_i = r - g[c].overlap; // rigid wall: the contact plane is the wall surface
+      ck.lever_j = 0.0;
+      const Vector3 w = s.angular_velocity(i);
+      ck.v_rel = s.velocity(i) + cross(ck.lever_i * w, ck.n) - g[c].surface_velocity;
+      ck.w_rel = w - g[c].angular_velocity;
+      ck.R_star = r;
+      ck.m_star = s.mass[i];
+      ck.radius_i = r;
+      ck.inv_inertia_i = s.inv_inertia[i];
+      Vector3 xi_t{wall_hx_[sl], wall_hy_[sl], wall_hz_[sl]};
+      const ContactOutcome o = evaluate_contact(table_.particle_wall(s.species[i], which[c]), ck, xi_t, dt);
+      wall_hx_[sl] = xi_t.x;
+      wall_hy_[sl] = xi_t.y;
+      wall_hz_[sl] = xi_t.z;
+      f.fx[i] += o.force_i.x;
+      f.fy[i] += o.force_i.y;
+      f.fz[i] += o.force_i.z;
+      f.tx[i] += o.torque_i.x;
+      f.ty[i] += o.torque_i.y;
+      f.tz[i] += o.torque_i.z;
+      // Load on the wall: −F at the contact point, torque about the wall's reference point.
+      wall_fx_[sl] = -o.force_i.x;
+      wall_fy_[sl] = -o.force_i.y;
+      wall_fz_[sl] = -o.force_i.z;
+      const Vector3 arm = p + ck.lever_i * ck.n - g[c].torque_origin;
+      const Vector3 tq = cross(arm, -o.force_i);
+      wall_tx_[sl] = tq.x;
+      wall_ty_[sl] = tq.y;
+      wall_tz_[sl] = tq.z;
+    }
+  }
+  if (too_many >= 0)
+    throw StabilityError("wall contacts: " + describe_particle(U(static_cast<std::int32_t>(too_many))) +
+                         " touches more than " + std::to_string(max_wall_contacts) +
+                         " walls at once at step " + std::to_string(step_) +
+                         "; the walls overlap or leave a gap smaller than a particle: check the geometry");
+  if (alarm >= 0)
+  {
+    const std::size_t i = static_cast<std::size_t>(alarm);
+    char msg[768];
+    std::snprintf(msg, sizeof msg,
+                  "stability guard: at step %ld (t = %.6g s) %s overlaps a wall by more than %.1f %% of its "
+                  "radius (dem.max_overlap_fraction). The wall pushes too hard for the contact stiffness or "
+                  "the time step (%.3g s) is too large: reduce dem.time_step, slow the wall, or increase the "
+                  "stiffness",
+                  step_, time_, describe_particle(i).c_str(), 100.0 * guard, dt_);
+    throw StabilityError(msg);
+  }
+}
+
+void DemSystem::check_energy()
+{
+  PhaseTimer timer(times_.guards);
+  const double ke = kinetic_energy() + rotational_energy();
+  if (!std::isfinite(ke))
+    throw StabilityError("stability guard: kinetic energy is not finite at step " + std::to_string(step_) +
+                         ": reduce dem.time_step");
+  if (guard_energy_ >= 0.0 && ke > case_.dem.max_kinetic_energy_growth * std::max(guard_energy_, energy_floor_))
+  {
+    // Name the fastest particle: the likely origin of the runaway.
+    std::size_t worst = 0;
+    double v2max = -1;
+    for (std::size_t i = 0; i < particles_.size(); ++i)
+    {
+      const double v2 = particles_.vx[i] * particles_.vx[i] + particles_.vy[i] * particles_.vy[i] +
+                        particles_.vz[i] * particles_.vz[i];
+      if (v2 > v2max)
+      {
+        v2max = v2;
+        worst = i;
+      }
+    }
+    char msg[768];
+    std::snprintf(msg, sizeof msg,
+                  "stability guard: kinetic energy grew from %.4g J to %.4g J (more than x%.3g, "
+                  "dem.max_kinetic_energy_growth) within 100 steps at step %ld (t = %.6g s); fastest: %s at "
+                  "%.4g m/s. Energy is being created numerically: reduce dem.time_step (now %.3g s) or the "
+                  "contact stiffness, or check the force terms",
+                  guard_energy_, ke, case_.dem.max_kinetic_energy_growth, step_, time_,
+                  describe_particle(worst).c_str(), std::sqrt(v2max), dt_);
+    throw StabilityError(msg);
+  }
+  guard_energy_ = ke;
+}
+
+void DemSystem::step()
+{
+  if (!initialized_)
+    throw std::logic_error("DemSystem::step() before initialize()");
+  kick_and_drift();
+  ++step_;
+  time_ = static_cast<double>(step_) * dt_;
+  if (force_rebuild_ || max_drift2_ > 0.25 * skin_ * skin_)
+    rebuild_neighbor_list();
+  compute_particle_contacts(); // overwrites the force buffers (gather)
+  compute_wall_contacts();     // adds
+  for (std::size_t t = 0; t < terms_.size(); ++t)
+  {
+    PhaseTimer timer(times_.terms[t]);
+    terms_[t]->add_forces(particles_, forces_, time_);
+  }
+  final_kick();
+  if (step_ % 100 == 0)
+    check_energy();
+}
+
+void DemSystem::settle(double duration)
+{
+  if (duration <= 0.0)
+    return;
+  walls_frozen_ = true;
+  const long steps = static_cast<long>(std::ceil(duration / dt_));
+  for (long k = 0; k < steps; ++k)
+    step();
+  walls_frozen_ = false;
+  step_ = 0;
+  time_ = 0.0;
+  guard_energy_ = -1.0;
+}
+
+double DemSystem::kinetic_energy() const
+{
+  double e = 0.0;
+  const auto &s = particles_;
+  for (std::size_t i = 0; i < s.size(); ++i)
+    e += 0.5 * s.mass[i] * (s.vx[i] * s.vx[i] + s.vy[i] * s.vy[i] + s.vz[i] * s.vz[i]);
+  return e;
+}
+
+double DemSystem::rotational_energy() const
+{
+  double e = 0.0;
+  const auto &s = particles_;
+  for (std::size_t i = 0; i < s.size(); ++i)
+    e += 0.5 / s.inv_inertia[i] * (s.wx[i] * s.wx[i] + s.wy[i] * s.wy[i] + s.wz[i] * s.wz[i]);
+  return e;
+}
+
+double DemSystem::elastic_energy() const
+{
+  double e = 0.0;
+  const auto &s = particles_;
+  for (std::size_t i = 0; i < s.size(); ++i)
+    for (std::int32_t pp = list_.row_start[i]; pp < list_.row_start[i + 1]; ++pp)
+    {
+      const std::size_t p = U(pp), j = U(list_.partner[p]);
+      const Vector3 sh = list_.shift(p);
+      const Vector3 d{s.x[j] - s.x[i] + sh.x, s.y[j] - s.y[i] + sh.y, s.z[j] - s.z[i] + sh.z};
+      const double delta = s.radius[i] + s.radius[j] - norm(d);
+      if (delta <= 0.0)
+        continue;
+      const auto &c = table_.particle_pair(s.species[i], s.species[j]);
+      const double R = s.radius[i] * s.radius[j] / (s.radius[i] + s.radius[j]);
+      e += HertzNormal::energy(HertzNormal::stiffness(c.effective_modulus, R), delta);
+    }
+  return e;
+}
+
+long DemSystem::particle_contacts() const
+{
+  long c = 0;
+  for (auto t : list_.touching)
+    c += t;
+  return c;
+}
+
+std::vector<WallLoad> DemSystem::wall_loads() const
+{
+  std::vector<WallLoad> loads(walls_.size());
+  for (std::size_t sl = 0; sl < wall_id_.size(); ++sl)
+  {
+    if (wall_id_[sl] < 0)
+      continue;
+    WallLoad &l = loads[U(wall_id_[sl])];
+    l.force[0] += wall_fx_[sl];
+    l.force[1] += wall_fy_[sl];
+    l.force[2] += wall_fz_[sl];
+    l.torque[0] += wall_tx_[sl];
+    l.torque[1] += wall_ty_[sl];
+    l.torque[2] += wall_tz_[sl];
+    ++l.contacts;
+  }
+  return loads;
+}
+
+std::size_t DemSystem::memory_bytes() const
+{
+  const auto &s = particles_;
+  std::size_t b = 0;
+  for (const auto *a : {&s.x, &s.y, &s.z, &s.vx, &s.vy, &s.vz, &s.wx, &s.wy, &s.wz, &s.radius, &s.mass,
+                        &s.inv_mass, &s.inv_inertia, &s.charge, &forces_.fx, &forces_.fy, &forces_.fz,
+                        &forces_.tx, &forces_.ty, &forces_.tz, &x0_, &y0_, &z0_, &wall_hx_, &wall_hy_,
+                        &wall_hz_, &wall_fx_, &wall_fy_, &wall_fz_, &wall_tx_, &wall_ty_, &wall_tz_, &scratch_})
+    b += a->capacity() * sizeof(double);
+  for (const auto *a : {&s.species, &s.id, &contact_count_, &wall_id_, &iscratch_})
+    b += a->capacity() * sizeof(std::int32_t);
+  return b + list_.memory_bytes();
+}
+
+// ---------------------------------------------------------------------------------------
+// Checkpoints: a flat binary file, "MBDEMCK1", then the clock and every dynamic array with
+// its length. Written to <path>.tmp and renamed, so a crash never leaves half a checkpoint.
+namespace {
+constexpr char checkpoint_magic[9] = "MBDEMCK1";
+
+template <typename T>
+void put(std::ofstream &o, const T &v) { o.write(reinterpret_cast<const char *>(&v), sizeof(T)); }
+template <typename T>
+void put_vec(std::ofstream &o, const std::vector<T> &v)
+{
+  put<std::uint64_t>(o, v.size());
+  o.write(reinterpret_cast<const char *>(v.data()), static_cast<std::streamsize>(v.size() * sizeof(T)));
+}
+template <typename T>
+T get(std::ifstream &in)
+{
+  T v{};
+  in.read(reinterpret_cast<char *>(&v), sizeof(T));
+  return v;
+}
+template <typename T>
+void get_vec(std::ifstream &in, std::vector<T> &v, const std::string &path)
+{
+  const auto n = get<std::uint64_t>(in);
+  if (!in || n > (1ull << 34))
+    throw std::runtime_error("checkpoint '" + path + "' is truncated or corrupt");
+  v.resize(n);
+  in.read(reinterpret_cast<char *>(v.data()), static_cast<std::streamsize>(n * sizeof(T)));
+  if (!in)
+    throw std::runtime_error("checkpoint '" + path + "' is truncated");
+}
+} // namespace
+
+void DemSystem::write_checkpoint(const std::string &path)
+{
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream o(tmp, std::ios::binary | std::ios::trunc);
+    if (!o)
+      throw std::runtime_error("cannot write checkpoint '" + tmp + "': check that the directory exists and is writable");
+    o.write(checkpoint_magic, 8);
+    put(o, step_);
+    put(o, time_);
+    put(o, dt_);
+    put(o, guard_energy_);
+    put<std::uint64_t>(o, walls_.size());
+    const auto &s = particles_;
+    const ForceBuffers &fb = forces_;
+    for (const auto *a : {&s.x, &s.y, &s.z, &s.vx, &s.vy, &s.vz, &s.wx, &s.wy, &s.wz, &s.radius, &s.mass,
+                          &s.inv_mass, &s.inv_inertia, &s.charge, &fb.fx, &fb.fy, &fb.fz,
+                          &fb.tx, &fb.ty, &fb.tz})
+      put_vec(o, *a);
+    put_vec(o, s.species);
+    put_vec(o, s.id);
+    put_vec(o, contact_count_);
+    put_vec(o, list_.row_start);
+    put_vec(o, list_.partner);
+    put_vec(o, list_.touching);
+    put_vec(o, list_.hist_x);
+    put_vec(o, list_.hist_y);
+    put_vec(o, list_.hist_z);
+    put_vec(o, wall_id_);
+    for (const auto *a : {&wall_hx_, &wall_hy_, &wall_hz_, &wall_fx_, &wall_fy_, &wall_fz_, &wall_tx_, &wall_ty_, &wall_tz_})
+      put_vec(o, *a);
+    if (!o)
+      throw std::runtime_error("writing checkpoint '" + tmp + "' failed (disk full?)");
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0)
+    throw std::runtime_error("cannot rename '" + tmp + "' to '" + path + "'");
+  // Both this run and a run restarted from the file rebuild the list at the next step, so
+  // that they continue through identical lists.
+  force_rebuild_ = true;
+}
+
+void DemSystem::read_checkpoint(const std::string &path)
+{
+  std::ifstream in(path, std::ios::binary);
+  if (!in)
+    throw std::runtime_error("cannot open checkpoint '" + path + "'");
+  char magic[8];
+  in.read(magic, 8);
+  if (!in || std::memcmp(magic, checkpoint_magic, 8) != 0)
+    throw std::runtime_error("'" + path + "' is not a magbrush DEM checkpoint (expected header MBDEMCK1)");
+  step_ = get<long>(in);
+  time_ = get<double>(in);
+  const double dt = get<double>(in);
+  guard_energy_ = get<double>(in);
+  const auto n_walls = get<std::uint64_t>(in);
+  if (n_walls != walls_.size())
+    throw std::runtime_error("checkpoint '" + path + "' has " + std::to_string(n_walls) + " walls, the case has " +
+                             std::to_string(walls_.size()) + ": restart with the case that wrote it");
+  auto &s = particles_;
+  for (auto *a : {&s.x, &s.y, &s.z, &s.vx, &s.vy, &s.vz, &s.wx, &s.wy, &s.wz, &s.radius, &s.mass, &s.inv_mass,
+                  &s.inv_inertia, &s.charge, &forces_.fx, &forces_.fy, &forces_.fz, &forces_.tx, &forces_.ty,
+                  &forces_.tz})
+    get_vec(in, *a, path);
+  get_vec(in, s.species, path);
+  get_vec(in, s.id, path);
+  get_vec(in, contact_count_, path);
+  // Derived set-up (contact table, time-step check, skin) as for a fresh run, then the state.
+  const long step = step_;
+  const double time = time_, guard = guard_energy_;
+  ForceBuffers saved_forces = forces_;
+  std::vector<std::int32_t> saved_counts = contact_count_;
+  setup_derived();
+  get_vec(in, list_.row_start, path);
+  get_vec(in, list_.partner, path);
+  get_vec(in, list_.touching, path);
+  get_vec(in, list_.hist_x, path);
+  get_vec(in, list_.hist_y, path);
+  get_vec(in, list_.hist_z, path);
+  get_vec(in, wall_id_, path);
+  for (auto *a : {&wall_hx_, &wall_hy_, &wall_hz_, &wall_fx_, &wall_fy_, &wall_fz_, &wall_tx_, &wall_ty_, &wall_tz_})
+    get_vec(in, *a, path);
+  forces_ = saved_forces;
+  contact_count_ = saved_counts;
+  step_ = step;
+  time_ = time;
+  guard_energy_ = guard;
+  dt_ = dt;
+  force_rebuild_ = true;
+  initialized_ = true;
+}
+
+} // namespace magbrush::dem

@@ -1,0 +1,143 @@
+// The DEM engine: particles, walls, the neighbour list with its contact history, the force
+// terms, and the velocity-Verlet step that ties them together.
+//
+//   step():  half kick → drift → (rebuild the neighbour list if stale) →
+//            forces: particle contacts, wall contacts, every ForceTerm → half kick → guards
+//
+// Everything here is deterministic: the same input gives the same bits on any number of
+// OpenMP threads, and a restart from a checkpoint continues bit-identically.
+#pragma once
+
+#include "contact_parameters.h"
+#include "force_term.h"
+#include "neighbor_list.h"
+#include "particle_state.h"
+#include "time_step.h"
+#include "wall_contacts.h"
+
+#include "case_model.h"
+
+#include <array>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace magbrush::dem {
+
+// Thrown by the stability guards: the message names step, particle, cause and likely fix.
+class StabilityError : public std::runtime_error
+{
+public:
+  using std::runtime_error::runtime_error;
+};
+
+// Total load of the particles on one wall [N, N m] (torque about the wall's axis for
+// cylinders, about the z axis through the origin otherwise).
+struct WallLoad
+{
+  std::array<double, 3> force{0, 0, 0};
+  std::array<double, 3> torque{0, 0, 0};
+  long contacts = 0;
+};
+
+// Wall time spent in each phase of the step [s].
+struct PhaseTimes
+{
+  double neighbor = 0, particle_contacts = 0, wall_contacts = 0, integrate = 0, guards = 0;
+  std::vector<double> terms; // one per force term
+};
+
+class DemSystem
+{
+public:
+  // Walls, periodic box and materials come from the case; particles are added separately
+  // (insert_particles, or directly through particles() in tests, then initialize()).
+  explicit DemSystem(const Case &c);
+
+  void insert_particles();                 // the case's populations
+  ParticleState &particles() { return particles_; }
+  const ParticleState &particles() const { return particles_; }
+  // Derives the contact table, the time step (throws if the user step is unstable) and builds
+  // the first neighbour list. Call once after the particles are in place.
+  void initialize();
+
+  void add_force_term(std::unique_ptr<ForceTerm> term);
+  const std::vector<std::unique_ptr<ForceTerm>> &force_terms() const { return terms_; }
+
+  void step();
+  // Runs with the walls at rest for `duration`, then resets the clock to t = 0.
+  void settle(double duration);
+
+  double time() const { return time_; }
+  long step_count() const { return step_; }
+  double time_step() const { return dt_; }
+  const StableTimeStep &stable_time_step_info() const { return stable_; }
+  const ContactTable &contact_table() const { return table_; }
+  const DemWalls &walls() const { return walls_; }
+  const PeriodicBox &box() const { return box_; }
+  const NeighborList &neighbor_list() const { return list_; }
+  const ForceBuffers &forces() const { return forces_; }
+  const std::vector<std::int32_t> &contact_count() const { return contact_count_; }
+  const PhaseTimes &phase_times() const { return times_; }
+  long neighbor_rebuilds() const { return rebuilds_; }
+  double skin() const { return skin_; }
+
+  // Diagnostics, summed in a fixed order (thread-independent).
+  double kinetic_energy() const;      // translational
+  double rotational_energy() const;
+  double elastic_energy() const;      // Hertz normal springs of touching particle pairs
+  long particle_contacts() const;     // touching particle pairs
+  std::vector<WallLoad> wall_loads() const;
+  std::size_t memory_bytes() const;   // particle, list, history and wall-slot storage
+
+  // Checkpoint: the complete dynamic state (particles in their current order, forces,
+  // neighbour list with contact history, wall slots, clock). Written atomically.
+  void write_checkpoint(const std::string &path);
+  // Replaces the state by the checkpoint's; the case must be the same scene.
+  void read_checkpoint(const std::string &path);
+
+  // Maximum number of walls one particle may touch at once.
+  static constexpr int max_wall_contacts = 3;
+
+private:
+  Case case_;
+  DemWalls walls_;
+  PeriodicBox box_;
+  ContactTable table_;
+  StableTimeStep stable_;
+  ParticleState particles_;
+  ForceBuffers forces_;
+  NeighborList list_;
+  std::vector<std::unique_ptr<ForceTerm>> terms_;
+  std::vector<std::int32_t> contact_count_;
+  std::vector<double> x0_, y0_, z0_; // positions at the last list build
+  // Wall contact slots, max_wall_contacts per particle: wall index (−1 free), history ξ,
+  // force on the wall and its torque (for the wall loads).
+  std::vector<std::int32_t> wall_id_;
+  std::vector<double> wall_hx_, wall_hy_, wall_hz_;
+  std::vector<double> wall_fx_, wall_fy_, wall_fz_, wall_tx_, wall_ty_, wall_tz_;
+  std::vector<double> scratch_;
+  std::vector<std::int32_t> iscratch_;
+
+  double dt_ = 0.0, time_ = 0.0, skin_ = 0.0;
+  long step_ = 0, rebuilds_ = 0;
+  bool walls_frozen_ = false, force_rebuild_ = true, initialized_ = false;
+  double max_drift2_ = 0.0;          // largest squared displacement since the last build
+  double guard_energy_ = -1.0;       // KE at the last guard check
+  double energy_floor_ = 0.0;
+  PhaseTimes times_;
+
+  void setup_derived();
+  void rebuild_neighbor_list();
+  void permute_particles(const std::vector<std::int32_t> &order);
+  void kick_and_drift();
+  void final_kick();
+  void compute_particle_contacts();
+  void compute_wall_contacts();
+  void check_overlaps() const;
+  void check_energy();
+  std::string describe_particle(std::size_t i) const;
+};
+
+} // namespace magbrush::dem

@@ -1,0 +1,53 @@
+// The plug-in interface for body forces and long-range interactions: gravity, Stokes drag
+// (Kawamoto A12), and — plugged in by the scene set-up — the induced-dipole magnetics
+// (dem/magnetics), Coulomb, qE and van der Waals. Each term is called ONCE per step with the
+// whole particle state (structure of arrays) and ADDS its forces and torques, so a term is
+// free to vectorise, parallelise, or refresh itself only every few steps.
+//
+// Determinism contract: a term must produce the same bits on any number of threads (each
+// particle's contribution computed in a fixed order), or the engine's 1-vs-N-threads
+// guarantee is lost.
+#pragma once
+
+#include "particle_state.h"
+
+#include <array>
+
+namespace magbrush::dem {
+
+class ForceTerm
+{
+public:
+  virtual ~ForceTerm() = default;
+  virtual const char *name() const = 0;
+  virtual void add_forces(const ParticleState &state, ForceBuffers &forces, double t) = 0;
+  // Particle arrays were re-sorted (new[k] = old[order[k]]): terms that cache per-particle
+  // data (e.g. dipole moments) reorder it here.
+  virtual void particles_reordered(const std::vector<std::int32_t> & /*order*/) {}
+};
+
+// Gravity (A12): F = m g.
+class Gravity : public ForceTerm
+{
+public:
+  explicit Gravity(const std::array<double, 3> &g) : g_(g) {}
+  const char *name() const override { return "gravity"; }
+  void add_forces(const ParticleState &s, ForceBuffers &f, double) override;
+
+private:
+  std::array<double, 3> g_;
+};
+
+// Stokes drag of still air (A12): F = −6π η r v.
+class StokesDrag : public ForceTerm
+{
+public:
+  explicit StokesDrag(double viscosity) : eta_(viscosity) {}
+  const char *name() const override { return "Stokes drag"; }
+  void add_forces(const ParticleState &s, ForceBuffers &f, double) override;
+
+private:
+  double eta_;
+};
+
+} // namespace magbrush::dem

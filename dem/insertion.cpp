@@ -1,0 +1,211 @@
+// Population sampling and random sequential insertion (see insertion.h).
+#include "insertion.h"
+
+#include <algorithm>
+#include <functional>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
+
+namespace magbrush::dem {
+
+namespace {
+double sphere_mass(double d, double rho) { return rho * M_PI / 6.0 * d * d * d; }
+
+// A hash grid of the spheres placed so far, for the overlap test.
+class PlacementGrid
+{
+public:
+  PlacementGrid(double cell, const PeriodicBox &box) : h_(cell), box_(box) {}
+
+  bool overlaps(const ParticleState &s, const Vector3 &p, double r) const
+  {
+    const long cx = cell(p.x), cy = cell(p.y), cz = cell(p.z);
+    for (long a = -1; a <= 1; ++a)
+      for (long b = -1; b <= 1; ++b)
+        for (long e = -1; e <= 1; ++e)
+        {
+          const auto it = cells_.find(key(wrap_cell(cx + a, 0), wrap_cell(cy + b, 1), wrap_cell(cz + e, 2)));
+          if (it == cells_.end())
+            continue;
+          for (std::size_t k : it->second)
+          {
+            double d[3] = {s.x[k] - p.x, s.y[k] - p.y, s.z[k] - p.z};
+            for (int q = 0; q < 3; ++q)
+              if (box_.periodic(q))
+              {
+                const double L = box_.length[static_cast<std::size_t>(q)];
+                d[q] -= L * std::round(d[q] / L);
+              }
+            const double reach = r + s.radius[k];
+            if (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < reach * reach)
+              return true;
+          }
+        }
+    return false;
+  }
+  void add(const Vector3 &p, std::size_t index)
+  {
+    cells_[key(wrap_cell(cell(p.x), 0), wrap_cell(cell(p.y), 1), wrap_cell(cell(p.z), 2))].push_back(index);
+  }
+
+private:
+  double h_;
+  PeriodicBox box_;
+  std::unordered_map<long long, std::vector<std::size_t>> cells_;
+  long cell(double v) const { return static_cast<long>(std::floor(v / h_)); }
+  long wrap_cell(long c, int d) const
+  {
+    if (!box_.periodic(d))
+      return c;
+    const long n = std::max(1L, static_cast<long>(std::floor(box_.length[static_cast<std::size_t>(d)] / h_)));
+    return ((c % n) + n) % n;
+  }
+  static long long key(long a, long b, long c)
+  {
+    return (static_cast<long long>(a & 0x1FFFFF) << 42) | (static_cast<long long>(b & 0x1FFFFF) << 21) |
+           static_cast<long long>(c & 0x1FFFFF);
+  }
+};
+} // namespace
+
+std::vector<double> draw_diameters(const Case &c, const Population &p, double carrier_mass,
+                                   std::mt19937_64 &rng)
+{
+  if (!(p.diameter_mean > 0.0))
+    throw std::invalid_argument("population '" + p.name + "': diameter mean must be > 0");
+  const double rho = c.material(p.material).density;
+  if (!(rho > 0.0))
+    throw std::invalid_argument("population '" + p.name + "': material '" + p.material +
+                                "' needs a density > 0");
+  std::normal_distribution<double> normal(p.diameter_mean, std::max(0.0, p.diameter_std));
+  auto draw = [&]() {
+    for (;;) // truncated to positive values: redraw the (rare) non-positive ones
+    {
+      const double d = p.diameter_std > 0.0 ? normal(rng) : p.diameter_mean;
+      if (d > 0.0)
+        return d;
+    }
+  };
+  std::vector<double> d;
+  if (p.count > 0)
+  {
+    d.reserve(static_cast<std::size_t>(p.count));
+    for (long k = 0; k < p.count; ++k)
+      d.push_back(draw());
+    return d;
+  }
+  double target = p.mass;
+  if (target <= 0.0 && p.concentration > 0.0)
+  {
+    if (carrier_mass <= 0.0)
+      throw std::invalid_argument("population '" + p.name +
+                                  "': a toner concentration needs carrier populations listed before it");
+    target = p.concentration * carrier_mass;
+  }
+  if (!(target > 0.0))
+    throw std::invalid_argument("population '" + p.name + "': give one of count, mass or concentration");
+  double m = 0.0;
+  while (m < target)
+  {
+    d.push_back(draw());
+    m += sphere_mass(d.back(), rho);
+  }
+  return d;
+}
+
+void insert_populations(const Case &c, const DemWalls &walls, const PeriodicBox &box,
+                        ParticleState &particles)
+{
+  std::mt19937_64 rng(c.dem.seed);
+  std::vector<std::vector<double>> diameters;
+  double carrier_mass = 0.0, d_max = 0.0;
+  for (const auto &p : c.populations)
+  {
+    diameters.push_back(draw_diameters(c, p, carrier_mass, rng));
+    const double rho = c.material(p.material).density;
+    for (double d : diameters.back())
+    {
+      if (p.kind == ParticleKind::carrier)
+        carrier_mass += sphere_mass(d, rho);
+      d_max = std::max(d_max, d);
+    }
+  }
+  PlacementGrid grid(std::max(d_max, 1e-12), box);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (std::size_t s = 0; s < c.populations.size(); ++s)
+  {
+    const Population &p = c.populations[s];
+    const Material &mat = c.material(p.material);
+    auto &d = diameters[s];
+    std::sort(d.begin(), d.end(), std::greater<double>()); // largest first: jams last
+    // The region's sampler, given the radius.
+    std::function<Vector3(double)> sample;
+    double region_volume = 0.0;
+    if (p.layer_thickness > 0.0)
+    {
+      if (!c.sleeve)
+        throw std::invalid_argument("population '" + p.name + "': a layer on the sleeve needs a sleeve");
+      if (!box.periodic(2))
+        throw std::invalid_argument("population '" + p.name +
+                                    "': a layer on the sleeve needs dem.periodic_length (the slab along z)");
+      const double R = c.sleeve->radius, Lz = box.length[2];
+      region_volume = M_PI * (std::pow(R + p.layer_thickness, 2) - R * R) * Lz;
+      sample = [&, R, Lz](double r) {
+        const double a = R + r, b = R + p.layer_thickness - r;
+        const double rr = std::sqrt(a * a + u(rng) * (b * b - a * a));
+        const double th = 2.0 * M_PI * u(rng);
+        return Vector3{rr * std::cos(th), rr * std::sin(th), Lz * u(rng)};
+      };
+    }
+    else if (p.insert_box)
+    {
+      const auto lo = (*p.insert_box)[0], hi = (*p.insert_box)[1];
+      region_volume = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
+      sample = [&, lo, hi](double r) {
+        Vector3 q;
+        double *out[3] = {&q.x, &q.y, &q.z};
+        for (int k = 0; k < 3; ++k)
+        {
+          const std::size_t ku = static_cast<std::size_t>(k);
+          const double margin = box.periodic(k) ? 0.0 : r;
+          *out[k] = lo[ku] + margin + u(rng) * (hi[ku] - lo[ku] - 2.0 * margin);
+        }
+        return q;
+      };
+    }
+    else
+      throw std::invalid_argument("population '" + p.name + "': no insertion region (give insert_box or layer_thickness)");
+
+    double solid = 0.0;
+    for (double di : d)
+      solid += M_PI / 6.0 * di * di * di;
+    for (std::size_t k = 0; k < d.size(); ++k)
+    {
+      const double r = 0.5 * d[k];
+      bool placed = false;
+      for (int attempt = 0; attempt < 5000 && !placed; ++attempt)
+      {
+        const Vector3 q = sample(r);
+        bool clear = !grid.overlaps(particles, q, r);
+        for (std::size_t w = 0; clear && w < walls.size(); ++w)
+          clear = walls.distance(w, q, 0.0) >= r;
+        if (!clear)
+          continue;
+        grid.add(q, particles.size());
+        particles.add(q, r, mat.density, static_cast<int>(s), p.charge_to_mass * sphere_mass(d[k], mat.density));
+        placed = true;
+      }
+      if (!placed)
+        throw std::runtime_error(
+            "insertion of population '" + p.name + "': could not place particle " + std::to_string(k + 1) +
+            " of " + std::to_string(d.size()) + " without overlap after 5000 attempts. The region's solid "
+            "fraction would be " + std::to_string(100.0 * solid / region_volume) +
+            " %; random insertion jams near 30-40 %: enlarge the insertion region (or layer) or insert fewer particles");
+    }
+  }
+}
+
+} // namespace magbrush::dem

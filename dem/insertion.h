@@ -1,0 +1,28 @@
+// Populations and insertion: draws each population's diameters (normal, mean ± std,
+// truncated to positive values) until its count, mass or toner concentration is reached,
+// then places the spheres without overlap at random in the population's region (a box, or a
+// layer on the sleeve), largest first, by random sequential addition. The engine then lets
+// them settle (DemSettings::settle_time).
+#pragma once
+
+#include "neighbor_list.h"
+#include "particle_state.h"
+#include "wall_contacts.h"
+
+#include "case_model.h"
+
+#include <random>
+#include <vector>
+
+namespace magbrush::dem {
+
+// Diameters of one population [m]. `carrier_mass` is the total mass of the carrier
+// populations drawn before it (for a toner concentration).
+std::vector<double> draw_diameters(const Case &c, const Population &p, double carrier_mass,
+                                   std::mt19937_64 &rng);
+
+// Fills `particles` with every population of the case, species = population index.
+void insert_populations(const Case &c, const DemWalls &walls, const PeriodicBox &box,
+                        ParticleState &particles);
+
+} // namespace magbrush::dem

@@ -1,0 +1,86 @@
+// Verlet neighbour list on a cell grid, with the per-pair data that lives on it.
+//
+// * Half list: each pair (i, j), i < j in the current particle order, appears once, in CSR
+//   rows by i. A transposed index (rows by j) lets a per-particle gather collect both sides
+//   in a fixed order — that is what makes the forces bit-identical on any number of threads.
+// * Verlet skin: pairs closer than r_i + r_j + skin are listed; the list stays valid until some
+//   particle has moved more than skin/2 since the build (the engine checks that).
+// * Spatial sorting: every build first re-sorts the particles in cell order (a stable counting
+//   sort), so neighbours are close in memory.
+// * Contact history (the Mindlin ξ of each touching pair) is keyed by the particles' stable
+//   ids while the list is rebuilt, so it survives both the rebuild and the re-sorting.
+// * Periodic directions use the minimum image; each pair stores which image it uses.
+#pragma once
+
+#include "particle_state.h"
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace magbrush::dem {
+
+// Periodic lengths along x, y, z (0 = not periodic). Periodic coordinates live in [0, L).
+struct PeriodicBox
+{
+  std::array<double, 3> length{0.0, 0.0, 0.0};
+  bool periodic(int d) const { return length[static_cast<std::size_t>(d)] > 0.0; }
+  // Wraps the coordinates of every particle into [0, L) along periodic directions.
+  void wrap(ParticleState &s) const;
+};
+
+class NeighborList
+{
+public:
+  // --- pair data, indexed by pair p -------------------------------------------------------
+  std::vector<std::int32_t> row_start; // N + 1
+  std::vector<std::int32_t> partner;   // j of pair p
+  std::vector<std::uint8_t> image;     // periodic image code of j relative to i (see shift())
+  std::vector<std::uint8_t> touching;  // 1 while the pair overlaps
+  std::vector<double> hist_x, hist_y, hist_z;                     // Mindlin ξ (on i)
+  std::vector<double> force_x, force_y, force_z;                  // contact force on i
+  std::vector<double> torque_i_x, torque_i_y, torque_i_z;         // torque on i
+  std::vector<double> torque_j_x, torque_j_y, torque_j_z;         // torque on j
+  // Transposed index: pairs in which particle k is the second member, ascending.
+  std::vector<std::int32_t> col_start, col_pair;
+
+  std::size_t pairs() const { return partner.size(); }
+  // Shift to add to (x_j − x_i) for pair p.
+  Vector3 shift(std::size_t p) const { return shifts_[image[p]]; }
+
+  // Rebuilds the list. Before: keeps the touching pairs' history keyed by id; then re-sorts
+  // all particle arrays in cell order through `permute` (a callback that applies an order
+  // to every per-particle array of the engine); then builds the pairs and restores history.
+  template <typename Permute>
+  void rebuild(ParticleState &s, const PeriodicBox &box, double skin, Permute &&permute)
+  {
+    stash_history(s);
+    box.wrap(s);
+    compute_cell_order(s, box, skin);
+    permute(order_);
+    build_pairs(s, box, skin);
+    restore_history(s);
+  }
+
+  // Statistics of the last build.
+  double cell_size() const { return cell_size_; }
+  std::size_t memory_bytes() const;
+
+private:
+  std::array<Vector3, 27> shifts_{};
+  // Cell grid.
+  std::array<double, 3> origin_{}, h_{};
+  std::array<int, 3> n_{1, 1, 1};
+  double cell_size_ = 0.0;
+  std::vector<std::int32_t> cell_of_, cell_start_, order_, counts_;
+  // Stashed history, CSR keyed by particle id.
+  std::vector<std::int32_t> old_start_, old_partner_id_;
+  std::vector<double> old_hx_, old_hy_, old_hz_;
+
+  void stash_history(const ParticleState &s);
+  void compute_cell_order(const ParticleState &s, const PeriodicBox &box, double skin);
+  void build_pairs(const ParticleState &s, const PeriodicBox &box, double skin);
+  void restore_history(const ParticleState &s);
+};
+
+} // namespace magbrush::dem

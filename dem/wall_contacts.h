@@ -1,0 +1,65 @@
+// The DEM's view of the walls: for each analytic primitive from geometry/wall_primitives.h
+// (rotating cylinders, moving planes, extruded polygons) the contact geometry with a sphere:
+// overlap, normal, and the velocity of the wall's surface at the contact point.
+#pragma once
+
+#include "vector3.h"
+
+#include "wall_primitives.h"
+
+#include <string>
+#include <vector>
+
+namespace magbrush::dem {
+
+struct WallContactGeometry
+{
+  double overlap = 0.0;     // δ > 0 when touching
+  Vector3 n;                // unit normal from the particle centre towards the wall
+  Vector3 surface_velocity; // velocity of the wall material at the contact point
+  Vector3 angular_velocity; // the wall's rigid-body angular velocity
+  Vector3 torque_origin;    // point about which the wall's torque is reported
+};
+
+class DemWalls
+{
+public:
+  DemWalls() = default;
+  explicit DemWalls(const WallSet &walls);
+
+  std::size_t size() const { return walls_.size(); }
+  const std::string &name(std::size_t w) const { return walls_[w].name; }
+  const std::string &material(std::size_t w) const { return walls_[w].material; }
+  std::vector<std::string> materials() const;
+
+  // Contact of a sphere (centre p, radius r) with wall w at time t. Returns false when not
+  // touching. `frozen`: walls at rest at their t = 0 position (the settling phase).
+  bool contact(std::size_t w, const Vector3 &p, double r, double t, bool frozen,
+               WallContactGeometry &g) const;
+
+  // Signed distance from p to wall w's surface at time t (> 0 on the particle side).
+  double distance(std::size_t w, const Vector3 &p, double t) const;
+
+  // Largest surface speed of any wall over the run (for the time-step criterion and guards).
+  double max_surface_speed() const;
+
+private:
+  enum class Kind { cylinder, plane, prism };
+  struct Wall
+  {
+    Kind kind;
+    std::string name, material;
+    std::size_t index; // into the primitive arrays below
+  };
+  std::vector<Wall> walls_;
+  std::vector<CylinderWall> cylinders_;
+  std::vector<PlaneWallPrimitive> planes_;
+  std::vector<PrismWall> prisms_;
+
+  // Closest point on polygon boundary to q; `inside` tells whether q is inside the polygon.
+  static void closest_on_polygon(const std::vector<Vec2> &poly, double qx, double qy, double &cx,
+                                 double &cy, bool &inside);
+  double cylinder_omega(const CylinderWall &c, double t, bool frozen) const;
+};
+
+} // namespace magbrush::dem

@@ -17,6 +17,8 @@ PolarFieldInterpolator::PolarFieldInterpolator(const PolarGrid &grid, int tail_h
   validate(grid, "PolarFieldInterpolator");
   dr_ = grid.dr();
   dtheta_ = grid.dtheta();
+  inv_dr_ = 1.0 / dr_;
+  inv_dtheta_ = 1.0 / dtheta_;
   nodes_ = spline::bicubic_hermite_data(grid.A_z, n_r_, n_theta_, /*periodic θ*/ true);
 
   // Fourier coefficients of A on the outer ring (the trigonometric interpolant of its nodes).
@@ -64,18 +66,17 @@ size_t PolarFieldInterpolator::memory_bytes() const
 PolarFieldInterpolator::Potential PolarFieldInterpolator::from_grid(double x, double y,
                                                                     double r) const
 {
-  // Cell and local coordinates: p along r, q along θ (periodic).
-  const double s = (r - r_min_) / dr_;
-  int i = static_cast<int>(std::floor(s));
-  i = i < 0 ? 0 : (i > n_r_ - 2 ? n_r_ - 2 : i);
+  // Cell and local coordinates: p along r, q along θ (periodic). locate() guarantees
+  // s ≥ −1/2, where truncation gives cell 0 and p < 0 (the boundary cell's extension).
+  const double s = (r - r_min_) * inv_dr_;
+  int i = static_cast<int>(s);
+  i = i > n_r_ - 2 ? n_r_ - 2 : i;
   const double p = s - i;
   double theta = std::atan2(y, x);
-  if (theta < 0)
-    theta += two_pi;
-  const double u = theta / dtheta_;
+  theta += theta < 0 ? two_pi : 0.0;
+  const double u = theta * inv_dtheta_;
   int j = static_cast<int>(u);
-  if (j >= n_theta_)
-    j = n_theta_ - 1;
+  j = j >= n_theta_ ? n_theta_ - 1 : j;
   const double q = u - j;
   const int j1 = j + 1 == n_theta_ ? 0 : j + 1;
 
@@ -85,12 +86,12 @@ PolarFieldInterpolator::Potential PolarFieldInterpolator::from_grid(double x, do
   spline::evaluate_patch(row0 + 4 * j, row0 + 4 * j1, row1 + 4 * j, row1 + 4 * j1, p, q, f);
 
   // Polar derivatives, then the chain rule to Cartesian (c = cos θ, sn = sin θ).
-  const double A_r = f[1] / dr_, A_t = f[2] / dtheta_;
-  const double A_rr = f[3] / (dr_ * dr_), A_rt = f[4] / (dr_ * dtheta_),
-               A_tt = f[5] / (dtheta_ * dtheta_);
+  const double A_r = f[1] * inv_dr_, A_t = f[2] * inv_dtheta_;
+  const double A_rr = f[3] * inv_dr_ * inv_dr_, A_rt = f[4] * inv_dr_ * inv_dtheta_,
+               A_tt = f[5] * inv_dtheta_ * inv_dtheta_;
   const double inv_r = 1.0 / r, c = x * inv_r, sn = y * inv_r;
   const double cc = c * c, ss = sn * sn, cs = c * sn;
-  const double A_t_r = A_t * inv_r, A_rt_r = A_rt * inv_r, A_t_rr = A_t * inv_r * inv_r,
+  const double A_t_r = A_t * inv_r, A_rt_r = A_rt * inv_r, A_t_rr = A_t_r * inv_r,
                A_tt_rr = A_tt * inv_r * inv_r, A_r_r = A_r * inv_r;
   Potential P;
   P.A = f[0];
@@ -106,27 +107,41 @@ PolarFieldInterpolator::Potential PolarFieldInterpolator::from_grid(double x, do
 // G' = −S1/z, G'' = S2/z² with S1 = Σ n c_n t^n, S2 = Σ n(n+1) c_n t^n; A_x − i A_y = G'.
 PolarFieldInterpolator::Potential PolarFieldInterpolator::from_tail(double x, double y) const
 {
-  const std::complex<double> z(x, y);
-  const std::complex<double> t = r_max_ / z;
-  std::complex<double> tn = 1.0, S0 = 0.0, S1 = 0.0, S2 = 0.0;
-  for (size_t k = 0; k < tail_.size(); ++k)
+  // t = r_max / z = r_max z̄ / |z|²; complex products written out (std::complex's operator*
+  // guards against NaN/Inf and is several times slower).
+  const double inv_r2 = 1.0 / (x * x + y * y);
+  const double tr = r_max_ * x * inv_r2, ti = -r_max_ * y * inv_r2;
+  double pr = 1.0, pi = 0.0; // t^n
+  double S0r = 0, S0i = 0, S1r = 0, S1i = 0, S2r = 0, S2i = 0;
+  const size_t K = tail_.size();
+  for (size_t k = 0; k < K; ++k)
   {
     const double n = static_cast<double>(k + 1);
-    tn *= t;
-    const std::complex<double> term = tail_[k] * tn;
-    S0 += term;
-    S1 += n * term;
-    S2 += n * (n + 1) * term;
+    const double npr = pr * tr - pi * ti;
+    pi = pr * ti + pi * tr;
+    pr = npr;
+    const double cr = tail_[k].real(), ci = tail_[k].imag();
+    const double termr = cr * pr - ci * pi, termi = cr * pi + ci * pr;
+    S0r += termr;
+    S0i += termi;
+    S1r += n * termr;
+    S1i += n * termi;
+    S2r += n * (n + 1) * termr;
+    S2i += n * (n + 1) * termi;
   }
-  const std::complex<double> G1 = -S1 / z, G2 = S2 / (z * z);
+  // 1/z = z̄/|z|², 1/z² = z̄²/|z|⁴.
+  const double izr = x * inv_r2, izi = -y * inv_r2;
+  const double iz2r = izr * izr - izi * izi, iz2i = 2 * izr * izi;
+  const double G1r = -(S1r * izr - S1i * izi), G1i = -(S1r * izi + S1i * izr);
+  const double G2r = S2r * iz2r - S2i * iz2i, G2i = S2r * iz2i + S2i * iz2r;
   Potential P;
-  P.A = tail_a0_ + S0.real();
-  P.A_x = G1.real();
-  P.A_y = -G1.imag();
+  P.A = tail_a0_ + S0r;
+  P.A_x = G1r;
+  P.A_y = -G1i;
   // G'' = A_xx − i A_xy, and A_yy = −A_xx (harmonic).
-  P.A_xx = G2.real();
-  P.A_xy = -G2.imag();
-  P.A_yy = -G2.real();
+  P.A_xx = G2r;
+  P.A_xy = -G2i;
+  P.A_yy = -G2r;
   return P;
 }
 

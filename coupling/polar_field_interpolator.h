@@ -82,7 +82,7 @@ private:
   Potential from_tail(double x, double y) const;
   [[noreturn]] void throw_inside_sleeve(const Vec3 &x, double r) const;
 
-  double r_min_, r_max_, dr_, dtheta_;
+  double r_min_, r_max_, dr_, dtheta_, inv_dr_ = 0, inv_dtheta_ = 0;
   int n_r_, n_theta_;
   std::vector<double> nodes_;                 // [f, f_p, f_q, f_pq] per node (field_grid.h)
   double tail_a0_ = 0.0;                      // mean of A on r = r_max

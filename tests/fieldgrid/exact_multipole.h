@@ -153,13 +153,13 @@ inline std::vector<RingTerm> gaussian_poles_as_rings(const std::vector<std::arra
 // The roller of the benchmark and of the accuracy tests: the 5-pole roller of
 // /work/shared/data/sleeve_profile_example.csv scaled to a 12.5 mm sleeve (magnet ring
 // 3.75..11.625 mm in air, α = 10 /rad², poles S1 0° −330, N1 72° 172, S2 144° −200,
-// S3 216° −170, N2 288° 142 kA/m).
-inline MultipoleField roller_like_field()
+// S3 216° −170, N2 288° 142 kA/m). A larger α makes sharper poles (more harmonics).
+inline MultipoleField roller_like_field(double alpha = 10.0)
 {
   const double deg = M_PI / 180.0;
   const std::vector<std::array<double, 2>> poles = {
       {0 * deg, -330e3}, {72 * deg, 172e3}, {144 * deg, -200e3}, {216 * deg, -170e3}, {288 * deg, 142e3}};
-  return MultipoleField(3.75e-3, 11.625e-3, gaussian_poles_as_rings(poles, 10.0, 60));
+  return MultipoleField(3.75e-3, 11.625e-3, gaussian_poles_as_rings(poles, alpha, 80));
 }
 
 // Points spread uniformly over the annulus r_min ≤ r ≤ r_max (fixed seed).

@@ -1,0 +1,433 @@
+#include "induced_dipoles.h"
+
+#include "dipole_physics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace magbrush::magnetics {
+
+namespace {
+// Below this many beads (or pairs) a loop runs on one thread: forking a team costs more than
+// it saves, and far more on an oversubscribed machine. The results do not depend on it.
+constexpr std::size_t parallel_threshold = 512;
+} // namespace
+
+AppliedFieldFunction uniform_field(double Bx, double By, double Bz)
+{
+  return [Bx, By, Bz](const double *, double B[3], double gradB[3][3]) {
+    B[0] = Bx;
+    B[1] = By;
+    B[2] = Bz;
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b)
+        gradB[a][b] = 0.0;
+  };
+}
+
+InducedDipoles::InducedDipoles(const MagneticSettings &settings, const std::array<double, 3> &box)
+  : settings_(settings), box_(box)
+{
+  if (!(settings_.cutoff_length > 0.0 || settings_.cutoff_diameters > 0.0))
+    throw std::invalid_argument("magnetics: expected a positive cutoff (cutoff_diameters or "
+                                "cutoff_length); found neither.");
+  if (!(settings_.tolerance > 0.0) || settings_.max_sweeps < 1)
+    throw std::invalid_argument("magnetics: expected tolerance > 0 and max_sweeps ≥ 1; found " +
+                                std::to_string(settings_.tolerance) + " and " +
+                                std::to_string(settings_.max_sweeps) + ".");
+  if (settings_.model == DipoleModel::corrected &&
+      !(settings_.switch_begin >= 2.0 && settings_.switch_end > settings_.switch_begin))
+    throw std::invalid_argument("magnetics: the corrected model needs 2 ≤ switch_begin < "
+                                "switch_end (in radii); found " +
+                                std::to_string(settings_.switch_begin) + ", " +
+                                std::to_string(settings_.switch_end) + ".");
+  for (double L : box_)
+    if (L < 0.0)
+      throw std::invalid_argument("magnetics: periodic box lengths must be ≥ 0 (0 = open).");
+}
+
+double InducedDipoles::cutoff_length(const BeadArrays &beads) const
+{
+  if (settings_.cutoff_length > 0.0)
+    return settings_.cutoff_length;
+  double sum = 0.0;
+  for (std::size_t b = 0; b < beads.n; ++b)
+    sum += beads.radius[b];
+  const double mean_diameter = beads.n ? 2.0 * sum / beads.n : 0.0;
+  return settings_.cutoff_diameters * mean_diameter;
+}
+
+MagneticStats InducedDipoles::compute(const BeadArrays &beads, const AppliedFieldFunction &field,
+                                      double time, const ForceArrays &out)
+{
+  MagneticStats stats;
+  const std::size_t n = beads.n;
+  if (n == 0)
+    return stats;
+  if (!beads.x || !beads.y || !beads.z || !beads.radius || !beads.mu_r)
+    throw std::invalid_argument("magnetics: bead arrays x, y, z, radius and mu_r are required.");
+
+  beta_.resize(n);
+  Ms_.resize(n);
+  for (std::size_t b = 0; b < n; ++b)
+  {
+    beta_[b] = clausius_mossotti(beads.mu_r[b]);
+    Ms_[b] = beads.saturation_magnetisation ? beads.saturation_magnetisation[b] : 0.0;
+  }
+
+  const double cutoff = cutoff_length(beads);
+  stats.cutoff = cutoff;
+  refresh_list_if_needed(beads, cutoff, stats);
+  evaluate_applied_field(beads, field);
+  evaluate_pair_tensors(beads, cutoff, stats);
+  solve_dipoles(beads, stats);
+  if (settings_.model == DipoleModel::corrected)
+    prepare_correction_tables();
+  evaluate_pair_forces(beads, stats);
+  gather_forces(out);
+
+  x_last_.resize(3 * n);
+  for (std::size_t b = 0; b < n; ++b)
+  {
+    x_last_[3 * b] = beads.x[b];
+    x_last_[3 * b + 1] = beads.y[b];
+    x_last_[3 * b + 2] = beads.z[b];
+  }
+  t_last_ = time;
+  computed_ = true;
+  return stats;
+}
+
+void InducedDipoles::refresh_list_if_needed(const BeadArrays &beads, double cutoff,
+                                            MagneticStats &stats)
+{
+  const double mean_diameter = settings_.cutoff_length > 0.0 && settings_.cutoff_diameters > 0.0
+                                 ? cutoff / settings_.cutoff_diameters
+                                 : cutoff / std::max(settings_.cutoff_diameters, 1e-300);
+  double skin = settings_.skin_fraction * mean_diameter;
+  if (settings_.cutoff_length > 0.0) // no diameter scale given: skin relative to the mean radius
+  {
+    double sum = 0.0;
+    for (std::size_t b = 0; b < beads.n; ++b)
+      sum += beads.radius[b];
+    skin = settings_.skin_fraction * 2.0 * sum / beads.n;
+  }
+  const bool stale = !list_.built() || list_.particle_count() != beads.n || list_.box() != box_ ||
+                     std::abs(list_.list_radius() - (cutoff + skin)) > 1e-12 * cutoff ||
+                     list_.max_displacement(beads.n, beads.x, beads.y, beads.z) > 0.5 * skin;
+  if (stale)
+  {
+    list_.build(beads.n, beads.x, beads.y, beads.z, box_, cutoff + skin);
+    stats.list_rebuilt = true;
+  }
+  stats.listed_pairs = list_.size();
+}
+
+void InducedDipoles::evaluate_applied_field(const BeadArrays &beads,
+                                            const AppliedFieldFunction &field)
+{
+  const std::size_t n = beads.n;
+  B0_.resize(3 * n);
+  gradB0_.resize(9 * n);
+#pragma omp parallel for schedule(static) if (n >= parallel_threshold)
+  for (long b = 0; b < static_cast<long>(n); ++b)
+  {
+    const double x[3] = {beads.x[b], beads.y[b], beads.z[b]};
+    double B[3], g[3][3];
+    field(x, B, g);
+    for (int a = 0; a < 3; ++a)
+    {
+      B0_[3 * b + a] = B[a];
+      for (int c = 0; c < 3; ++c)
+        gradB0_[9 * b + 3 * a + c] = g[a][c];
+    }
+  }
+}
+
+void InducedDipoles::evaluate_pair_tensors(const BeadArrays &beads, double cutoff,
+                                           MagneticStats &stats)
+{
+  const auto &pairs = list_.pairs();
+  const std::size_t np = pairs.size();
+  tensor_.resize(np);
+  r_.resize(3 * np);
+  active_.resize(np);
+  const double rc2 = cutoff * cutoff;
+  std::size_t count = 0;
+#pragma omp parallel for schedule(static) reduction(+ : count) if (np >= parallel_threshold)
+  for (long k = 0; k < static_cast<long>(np); ++k)
+  {
+    const auto &p = pairs[k];
+    double r[3] = {beads.x[p.j] - beads.x[p.i] + p.shift[0],
+                   beads.y[p.j] - beads.y[p.i] + p.shift[1],
+                   beads.z[p.j] - beads.z[p.i] + p.shift[2]};
+    const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+    for (int d = 0; d < 3; ++d)
+      r_[3 * k + d] = r[d];
+    // Hard cutoff (as Kawamoto): pairs beyond it do not interact at all. Coincident
+    // centres (r = 0) cannot occur between non-overlapping beads; they are skipped.
+    active_[k] = (r2 < rc2 && r2 > 0.0);
+    if (active_[k])
+    {
+      tensor_[k] = DipoleTensor::at(r);
+      ++count;
+    }
+    else
+      tensor_[k] = {0, 0, 0, 0, 0, 0};
+  }
+  stats.pairs = count;
+}
+
+void InducedDipoles::gather_local_field(std::size_t b, const std::vector<double> &p,
+                                        double B[3]) const
+{
+  B[0] = B0_[3 * b];
+  B[1] = B0_[3 * b + 1];
+  B[2] = B0_[3 * b + 2];
+  const auto &begin = list_.incident_begin();
+  const auto &pair_of = list_.incident_pair();
+  const auto &first = list_.incident_first();
+  const auto &pairs = list_.pairs();
+  for (std::size_t q = begin[b]; q < begin[b + 1]; ++q)
+  {
+    const std::uint32_t k = pair_of[q];
+    if (!active_[k])
+      continue;
+    const std::uint32_t other = first[q] ? pairs[k].j : pairs[k].i;
+    tensor_[k].add_field(&p[3 * other], B);
+  }
+}
+
+void InducedDipoles::solve_dipoles(const BeadArrays &beads, MagneticStats &stats)
+{
+  const std::size_t n = beads.n;
+  B_local_.resize(3 * n);
+  p_next_.resize(3 * n);
+  const bool warm_start = (p_.size() == 3 * n) && settings_.model != DipoleModel::point_dipole;
+  if (!warm_start)
+  {
+    p_.resize(3 * n);
+#pragma omp parallel for schedule(static) if (n >= parallel_threshold)
+    for (long b = 0; b < static_cast<long>(n); ++b)
+      induced_moment(beads.radius[b], beta_[b], Ms_[b], &B0_[3 * b], &p_[3 * b]);
+  }
+
+  if (settings_.model == DipoleModel::point_dipole)
+  {
+    // Dipoles from the applied field only; the local field is needed only for the papers'
+    // torque diagnostic.
+    if (settings_.torque == TorqueModel::paper)
+    {
+#pragma omp parallel for schedule(static) if (n >= parallel_threshold)
+      for (long b = 0; b < static_cast<long>(n); ++b)
+        gather_local_field(b, p_, &B_local_[3 * b]);
+    }
+    else
+      B_local_ = B0_;
+    stats.sweeps = 0;
+    stats.residual = 0.0;
+    stats.converged = true;
+    return;
+  }
+
+  // Jacobi sweeps: every bead's new dipole from the old dipoles of its neighbours. Order-free
+  // within a sweep, hence parallel and thread-count independent.
+  stats.converged = false;
+  for (int sweep = 1; sweep <= settings_.max_sweeps; ++sweep)
+  {
+    double max_change2 = 0.0, max_p2 = 0.0;
+#pragma omp parallel for schedule(static) reduction(max : max_change2, max_p2) if (n >= parallel_threshold)
+    for (long b = 0; b < static_cast<long>(n); ++b)
+    {
+      double *B = &B_local_[3 * b];
+      gather_local_field(b, p_, B);
+      double *p = &p_next_[3 * b];
+      induced_moment(beads.radius[b], beta_[b], Ms_[b], B, p);
+      double change2 = 0.0, p2 = 0.0;
+      for (int d = 0; d < 3; ++d)
+      {
+        const double dp = p[d] - p_[3 * b + d];
+        change2 += dp * dp;
+        p2 += p[d] * p[d];
+      }
+      max_change2 = std::max(max_change2, change2);
+      max_p2 = std::max(max_p2, p2);
+    }
+    p_.swap(p_next_);
+    stats.sweeps = sweep;
+    stats.residual = max_p2 > 0.0 ? std::sqrt(max_change2 / max_p2) : 0.0;
+    if (stats.residual <= settings_.tolerance)
+    {
+      stats.converged = true;
+      break;
+    }
+  }
+}
+
+void InducedDipoles::prepare_correction_tables()
+{
+  // One table per distinct pair β; almost always a single carrier material.
+  std::vector<double> distinct(beta_.begin(), beta_.end());
+  std::sort(distinct.begin(), distinct.end());
+  distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
+  for (std::size_t a = 0; a < distinct.size(); ++a)
+    for (std::size_t b = a; b < distinct.size(); ++b)
+    {
+      const double beta = 0.5 * (distinct[a] + distinct[b]);
+      if (!tables_.count(beta))
+        tables_[beta] = TwoSphereTable::shared(beta, settings_.switch_end);
+    }
+}
+
+void InducedDipoles::evaluate_pair_forces(const BeadArrays &beads, MagneticStats &stats)
+{
+  const auto &pairs = list_.pairs();
+  const std::size_t np = pairs.size();
+  pair_force_.resize(3 * np);
+  const bool corrected = settings_.model == DipoleModel::corrected;
+  const TwoSphereTable *single_table = tables_.size() == 1 ? tables_.begin()->second.get() : nullptr;
+  const double s0 = settings_.switch_begin, s1 = settings_.switch_end;
+  std::size_t corrected_pairs = 0;
+#pragma omp parallel for schedule(static) reduction(+ : corrected_pairs) if (np >= parallel_threshold)
+  for (long k = 0; k < static_cast<long>(np); ++k)
+  {
+    double *F = &pair_force_[3 * k];
+    if (!active_[k])
+    {
+      F[0] = F[1] = F[2] = 0.0;
+      continue;
+    }
+    const std::uint32_t i = pairs[k].i, j = pairs[k].j;
+    const double *r = &r_[3 * k];
+    dipole_pair_force(r, &p_[3 * j], &p_[3 * i], F);
+    if (!corrected)
+      continue;
+
+    // Exact two-sphere correction, Δf = f_exact − f_mutual, in the field the pair sits in:
+    // the local field at each bead minus the partner's own contribution, averaged.
+    const double a = 0.5 * (beads.radius[i] + beads.radius[j]);
+    const double dist = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+    const double D = dist / a;
+    if (D >= s1)
+      continue;
+    const TwoSphereTable *table = single_table;
+    if (!table)
+      table = tables_.at(0.5 * (beta_[i] + beta_[j])).get();
+    double Bi[3] = {B_local_[3 * i], B_local_[3 * i + 1], B_local_[3 * i + 2]};
+    double Bj[3] = {B_local_[3 * j], B_local_[3 * j + 1], B_local_[3 * j + 2]};
+    const DipoleTensor minus = {-tensor_[k].xx, -tensor_[k].yy, -tensor_[k].zz,
+                                -tensor_[k].xy, -tensor_[k].xz, -tensor_[k].yz};
+    minus.add_field(&p_[3 * j], Bi);
+    minus.add_field(&p_[3 * i], Bj);
+    double H[3], e[3];
+    for (int d = 0; d < 3; ++d)
+    {
+      H[d] = 0.5 * (Bi[d] + Bj[d]) / mu0;
+      e[d] = r[d] / dist;
+    }
+    const double Hr = H[0] * e[0] + H[1] * e[1] + H[2] * e[2];
+    const double Ht[3] = {H[0] - Hr * e[0], H[1] - Hr * e[1], H[2] - Hr * e[2]};
+    const double Ht2 = Ht[0] * Ht[0] + Ht[1] * Ht[1] + Ht[2] * Ht[2];
+    const TwoSphereForce c = table->correction(D);
+    // Smooth switch-off (C¹ smoothstep) between switch_begin and switch_end.
+    double w = 1.0;
+    if (D > s0)
+    {
+      const double t = (D - s0) / (s1 - s0);
+      w = 1.0 - t * t * (3.0 - 2.0 * t);
+    }
+    const double scale = w * mu0 * a * a;
+    const double radial = c.parallel * Hr * Hr + c.perpendicular * Ht2;
+    // F·t̂ = f_t sinψ cosψ H² along t̂ (the direction that turns r̂ away from the field),
+    // i.e. −f_t H_r H_t as a vector.
+    for (int d = 0; d < 3; ++d)
+      F[d] += scale * (radial * e[d] - c.transverse * Hr * Ht[d]);
+    ++corrected_pairs;
+  }
+  stats.corrected_pairs = corrected_pairs;
+}
+
+void InducedDipoles::gather_forces(const ForceArrays &out)
+{
+  const std::size_t n = beta_.size();
+  force_.resize(3 * n);
+  torque_.resize(3 * n);
+  const auto &begin = list_.incident_begin();
+  const auto &pair_of = list_.incident_pair();
+  const auto &first = list_.incident_first();
+  const bool paper_torque = settings_.torque == TorqueModel::paper;
+#pragma omp parallel for schedule(static) if (n >= parallel_threshold)
+  for (long b = 0; b < static_cast<long>(n); ++b)
+  {
+    const double *p = &p_[3 * b];
+    const double *g = &gradB0_[9 * b];
+    // (p·∇)B_applied: F_a = Σ_c p_c ∂B_a/∂x_c.
+    double F[3];
+    for (int a = 0; a < 3; ++a)
+      F[a] = p[0] * g[3 * a] + p[1] * g[3 * a + 1] + p[2] * g[3 * a + 2];
+    // Pair forces are stored as the force on the pair's j bead; its i bead gets the negative.
+    for (std::size_t q = begin[b]; q < begin[b + 1]; ++q)
+    {
+      const double *Fp = &pair_force_[3 * pair_of[q]];
+      const double sign = first[q] ? -1.0 : 1.0;
+      for (int a = 0; a < 3; ++a)
+        F[a] += sign * Fp[a];
+    }
+    double *T = &torque_[3 * b];
+    if (paper_torque)
+    {
+      const double *B = &B_local_[3 * b];
+      T[0] = p[1] * B[2] - p[2] * B[1];
+      T[1] = p[2] * B[0] - p[0] * B[2];
+      T[2] = p[0] * B[1] - p[1] * B[0];
+    }
+    else
+      T[0] = T[1] = T[2] = 0.0;
+    for (int a = 0; a < 3; ++a)
+      force_[3 * b + a] = F[a];
+  }
+  add_held_forces(out);
+}
+
+void InducedDipoles::add_held_forces(const ForceArrays &out) const
+{
+  const std::size_t n = force_.size() / 3;
+  const bool torques = settings_.torque == TorqueModel::paper && out.tx && out.ty && out.tz;
+#pragma omp parallel for schedule(static) if (n >= parallel_threshold)
+  for (long b = 0; b < static_cast<long>(n); ++b)
+  {
+    out.fx[b] += force_[3 * b];
+    out.fy[b] += force_[3 * b + 1];
+    out.fz[b] += force_[3 * b + 2];
+    if (torques)
+    {
+      out.tx[b] += torque_[3 * b];
+      out.ty[b] += torque_[3 * b + 1];
+      out.tz[b] += torque_[3 * b + 2];
+    }
+  }
+}
+
+bool InducedDipoles::needs_refresh(const BeadArrays &beads, double time) const
+{
+  if (!computed_ || x_last_.size() != 3 * beads.n)
+    return true;
+  if (settings_.refresh_interval <= 0.0 ||
+      time - t_last_ >= settings_.refresh_interval * (1.0 - 1e-9))
+    return true;
+  bool moved = false;
+#pragma omp parallel for schedule(static) reduction(|| : moved) if (beads.n >= parallel_threshold)
+  for (long b = 0; b < static_cast<long>(beads.n); ++b)
+  {
+    const double dx = beads.x[b] - x_last_[3 * b], dy = beads.y[b] - x_last_[3 * b + 1],
+                 dz = beads.z[b] - x_last_[3 * b + 2];
+    const double limit = settings_.staleness_fraction * beads.radius[b];
+    if (dx * dx + dy * dy + dz * dz > limit * limit)
+      moved = true;
+  }
+  return moved;
+}
+
+} // namespace magbrush::magnetics

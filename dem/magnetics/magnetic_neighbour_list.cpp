@@ -1,0 +1,243 @@
+#include "magnetic_neighbour_list.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace magbrush::magnetics {
+
+namespace {
+
+// The cell grid along one axis. Periodic axes: nc cells of width L/nc ≥ list radius (one
+// cell when the box is narrower than the radius); a bead looks `reach` cells either way,
+// wrapping with an image shift. Open axes: cells of width ≥ list radius over the bounding
+// box, reach 1, no wrap.
+struct Axis
+{
+  bool periodic = false;
+  double length = 0.0; // periodic length
+  double origin = 0.0; // open axes: lower bound of the bounding box
+  double width = 1.0;  // cell width
+  long cells = 1;
+  long reach = 1;
+
+  long cell_of(double wrapped) const
+  {
+    long c = static_cast<long>(std::floor((wrapped - origin) / width));
+    return std::clamp(c, 0L, cells - 1);
+  }
+};
+
+// Wraps a coordinate into [0, L) on a periodic axis.
+double wrap(double v, const Axis &a)
+{
+  if (!a.periodic)
+    return v;
+  double w = v - a.length * std::floor(v / a.length);
+  if (w >= a.length) // round-off at the upper edge
+    w -= a.length;
+  return w;
+}
+
+} // namespace
+
+void MagneticNeighbourList::build(std::size_t n, const double *x, const double *y,
+                                  const double *z, const std::array<double, 3> &box,
+                                  double list_radius)
+{
+  if (!(list_radius > 0.0))
+    throw std::invalid_argument("magnetic neighbour list: expected a positive list radius, "
+                                "found " + std::to_string(list_radius) + " m.");
+  if (n >= std::numeric_limits<std::uint32_t>::max())
+    throw std::invalid_argument("magnetic neighbour list: too many beads for 32-bit indices.");
+  list_radius_ = list_radius;
+  box_ = box;
+  const double *coord[3] = {x, y, z};
+
+  // Grid: cap the number of cells so a sparse open box cannot blow the memory up.
+  Axis axis[3];
+  const long max_cells_per_axis = 1024;
+  for (int d = 0; d < 3; ++d)
+  {
+    Axis &a = axis[d];
+    a.periodic = box[d] > 0.0;
+    if (a.periodic)
+    {
+      a.length = box[d];
+      a.origin = 0.0;
+      a.cells = std::clamp(static_cast<long>(std::floor(a.length / list_radius)), 1L,
+                           max_cells_per_axis);
+      a.width = a.length / a.cells;
+      a.reach = static_cast<long>(std::ceil(list_radius / a.width - 1e-12));
+    }
+    else
+    {
+      double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+      for (std::size_t b = 0; b < n; ++b)
+      {
+        lo = std::min(lo, coord[d][b]);
+        hi = std::max(hi, coord[d][b]);
+      }
+      if (n == 0)
+        lo = hi = 0.0;
+      a.origin = lo;
+      a.width = std::max(list_radius, (hi - lo) / max_cells_per_axis);
+      a.cells = static_cast<long>(std::floor((hi - lo) / a.width)) + 1;
+      a.reach = 1;
+    }
+  }
+
+  // Wrapped positions and cell of every bead; counting sort keeps index order in a cell.
+  std::vector<double> xw(3 * n);
+  std::vector<long> cell(n);
+  const long ncell = axis[0].cells * axis[1].cells * axis[2].cells;
+  std::vector<std::size_t> cell_begin(ncell + 1, 0);
+  for (std::size_t b = 0; b < n; ++b)
+  {
+    long c[3];
+    for (int d = 0; d < 3; ++d)
+    {
+      xw[3 * b + d] = wrap(coord[d][b], axis[d]);
+      c[d] = axis[d].cell_of(xw[3 * b + d]);
+    }
+    cell[b] = (c[2] * axis[1].cells + c[1]) * axis[0].cells + c[0];
+    ++cell_begin[cell[b] + 1];
+  }
+  for (long c = 0; c < ncell; ++c)
+    cell_begin[c + 1] += cell_begin[c];
+  std::vector<std::uint32_t> cell_beads(n);
+  {
+    std::vector<std::size_t> fill(cell_begin.begin(), cell_begin.end() - 1);
+    for (std::size_t b = 0; b < n; ++b)
+      cell_beads[fill[cell[b]]++] = static_cast<std::uint32_t>(b);
+  }
+
+  const double r2max = list_radius * list_radius;
+  // Visits every (neighbour j ≥ i, image) of bead i within the list radius, in a fixed
+  // order; `emit(j, shift)` receives the shift in wrapped coordinates.
+  auto for_each_neighbour = [&](std::size_t i, auto &&emit) {
+    long ci[3];
+    for (int d = 0; d < 3; ++d)
+      ci[d] = axis[d].cell_of(xw[3 * i + d]);
+    for (long oz = -axis[2].reach; oz <= axis[2].reach; ++oz)
+      for (long oy = -axis[1].reach; oy <= axis[1].reach; ++oy)
+        for (long ox = -axis[0].reach; ox <= axis[0].reach; ++ox)
+        {
+          const long o[3] = {ox, oy, oz};
+          long cj[3];
+          double shift[3];
+          bool inside = true;
+          for (int d = 0; d < 3 && inside; ++d)
+          {
+            const long c = ci[d] + o[d];
+            if (axis[d].periodic)
+            {
+              const long q = (c >= 0) ? c / axis[d].cells : -((-c - 1) / axis[d].cells) - 1;
+              cj[d] = c - q * axis[d].cells;
+              shift[d] = q * axis[d].length;
+            }
+            else
+            {
+              inside = (c >= 0 && c < axis[d].cells);
+              cj[d] = c;
+              shift[d] = 0.0;
+            }
+          }
+          if (!inside)
+            continue;
+          const long c = (cj[2] * axis[1].cells + cj[1]) * axis[0].cells + cj[0];
+          const bool zero_shift = shift[0] == 0.0 && shift[1] == 0.0 && shift[2] == 0.0;
+          // A bead's own image counts once per ± pair: keep the lexicographically positive.
+          const bool positive_shift =
+            shift[0] > 0.0 || (shift[0] == 0.0 && (shift[1] > 0.0 || (shift[1] == 0.0 && shift[2] > 0.0)));
+          for (std::size_t k = cell_begin[c]; k < cell_begin[c + 1]; ++k)
+          {
+            const std::uint32_t j = cell_beads[k];
+            if (j < i || (j == i && (zero_shift || !positive_shift)))
+              continue;
+            double r2 = 0.0;
+            for (int d = 0; d < 3; ++d)
+            {
+              const double r = xw[3 * j + d] + shift[d] - xw[3 * i + d];
+              r2 += r * r;
+            }
+            if (r2 < r2max)
+              emit(j, shift);
+          }
+        }
+  };
+
+  // Pass 1: count; pass 2: fill at the prefix offsets. Both parallel over beads.
+  std::vector<std::size_t> begin(n + 1, 0);
+#pragma omp parallel for schedule(dynamic, 64) if (n >= 512)
+  for (long i = 0; i < static_cast<long>(n); ++i)
+  {
+    std::size_t count = 0;
+    for_each_neighbour(i, [&](std::uint32_t, const double *) { ++count; });
+    begin[i + 1] = count;
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    begin[i + 1] += begin[i];
+  pairs_.resize(begin[n]);
+#pragma omp parallel for schedule(dynamic, 64) if (n >= 512)
+  for (long i = 0; i < static_cast<long>(n); ++i)
+  {
+    std::size_t k = begin[i];
+    for_each_neighbour(i, [&](std::uint32_t j, const double *shift) {
+      Pair &p = pairs_[k++];
+      p.i = static_cast<std::uint32_t>(i);
+      p.j = j;
+      for (int d = 0; d < 3; ++d) // raw-coordinate shift: r = x_j − x_i + S
+        p.shift[d] = shift[d] + (xw[3 * j + d] - coord[d][j]) - (xw[3 * i + d] - coord[d][i]);
+    });
+  }
+
+  // Incidence (CSR), in increasing pair order for every bead.
+  incident_begin_.assign(n + 1, 0);
+  for (const Pair &p : pairs_)
+  {
+    ++incident_begin_[p.i + 1];
+    ++incident_begin_[p.j + 1];
+  }
+  for (std::size_t b = 0; b < n; ++b)
+    incident_begin_[b + 1] += incident_begin_[b];
+  incident_pair_.resize(2 * pairs_.size());
+  incident_first_.resize(2 * pairs_.size());
+  {
+    std::vector<std::size_t> fill(incident_begin_.begin(), incident_begin_.end() - 1);
+    for (std::size_t k = 0; k < pairs_.size(); ++k)
+    {
+      const Pair &p = pairs_[k];
+      incident_pair_[fill[p.i]] = static_cast<std::uint32_t>(k);
+      incident_first_[fill[p.i]++] = 1;
+      incident_pair_[fill[p.j]] = static_cast<std::uint32_t>(k);
+      incident_first_[fill[p.j]++] = 0;
+    }
+  }
+
+  x_ref_.resize(3 * n);
+  for (std::size_t b = 0; b < n; ++b)
+    for (int d = 0; d < 3; ++d)
+      x_ref_[3 * b + d] = coord[d][b];
+  built_ = true;
+}
+
+double MagneticNeighbourList::max_displacement(std::size_t n, const double *x,
+                                               const double *y, const double *z) const
+{
+  if (!built_ || n != particle_count())
+    return std::numeric_limits<double>::infinity();
+  double max2 = 0.0;
+#pragma omp parallel for reduction(max : max2) if (n >= 512)
+  for (long b = 0; b < static_cast<long>(n); ++b)
+  {
+    const double dx = x[b] - x_ref_[3 * b], dy = y[b] - x_ref_[3 * b + 1],
+                 dz = z[b] - x_ref_[3 * b + 2];
+    max2 = std::max(max2, dx * dx + dy * dy + dz * dz);
+  }
+  return std::sqrt(max2);
+}
+
+} // namespace magbrush::magnetics

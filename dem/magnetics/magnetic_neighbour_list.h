@@ -1,0 +1,71 @@
+// The magnetic neighbour list: every unordered pair of beads (and every periodic image of a
+// pair) closer than the list radius (cutoff + skin), each exactly once. It is separate from
+// the contact list because its radius is many diameters, not one.
+//
+// Periodic boxes: a box length of 0 means "not periodic" along that axis. The cutoff may
+// exceed half the box (even the whole box): a bead then meets several images of the same
+// neighbour, and its own images, each as its own pair. This is what an infinite periodic
+// chain needs (the dipole sums converge like 1/n³, so the cutoff may span many boxes).
+//
+// A pair stores its two indices and the image shift S such that the pair vector is
+//   r = x_j − x_i + S      (raw, unwrapped positions as given at build time).
+// A bead wrapped by the DEM between two builds jumps by a box length, which the displacement
+// check sees as a large move: the list is then rebuilt and S recomputed.
+//
+// Construction: a cell list (cells at least the list radius wide), built deterministically
+// in two parallel passes (count, then fill); the pair order depends on the positions only,
+// never on the number of threads.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace magbrush::magnetics {
+
+class MagneticNeighbourList
+{
+public:
+  struct Pair
+  {
+    std::uint32_t i, j; // i < j, or i == j for a bead and one of its own images
+    double shift[3];    // r = x_j − x_i + shift
+  };
+
+  // Builds the list of pairs closer than list_radius; box[d] = periodic length (0 = open).
+  void build(std::size_t n, const double *x, const double *y, const double *z,
+             const std::array<double, 3> &box, double list_radius);
+
+  // Largest displacement of any bead since the last build (no minimum image: a wrap counts
+  // as a large move).
+  double max_displacement(std::size_t n, const double *x, const double *y,
+                          const double *z) const;
+
+  bool built() const { return built_; }
+  std::size_t size() const { return pairs_.size(); }
+  std::size_t particle_count() const { return x_ref_.size() / 3; }
+  double list_radius() const { return list_radius_; }
+  const std::array<double, 3> &box() const { return box_; }
+  const std::vector<Pair> &pairs() const { return pairs_; }
+
+  // Incidence of the pairs on the beads (CSR): the pairs touching bead b are
+  //   incident_pair[incident_begin[b] .. incident_begin[b+1]), in increasing pair order,
+  // with incident_first[k] = 1 when b is the pair's i (0 when its j). A self-image pair
+  // appears twice, once as i and once as j.
+  const std::vector<std::size_t> &incident_begin() const { return incident_begin_; }
+  const std::vector<std::uint32_t> &incident_pair() const { return incident_pair_; }
+  const std::vector<std::uint8_t> &incident_first() const { return incident_first_; }
+
+private:
+  bool built_ = false;
+  double list_radius_ = 0.0;
+  std::array<double, 3> box_{0.0, 0.0, 0.0};
+  std::vector<double> x_ref_; // positions at build time (x, y, z interleaved)
+  std::vector<Pair> pairs_;
+  std::vector<std::size_t> incident_begin_;
+  std::vector<std::uint32_t> incident_pair_;
+  std::vector<std::uint8_t> incident_first_;
+};
+
+} // namespace magbrush::magnetics

@@ -1,0 +1,44 @@
+#include "magnetic_settings.h"
+
+#include "case_model.h"
+
+#include <stdexcept>
+
+namespace magbrush::magnetics {
+
+DipoleModel parse_dipole_model(const std::string &name)
+{
+  if (name == "point_dipole")
+    return DipoleModel::point_dipole;
+  if (name == "mutual_dipole")
+    return DipoleModel::mutual_dipole;
+  if (name == "corrected")
+    return DipoleModel::corrected;
+  throw std::invalid_argument("magnetic model: expected one of point_dipole, mutual_dipole, "
+                              "corrected; found '" + name +
+                              "'. Set dem.magnetic_model to one of these.");
+}
+
+std::string to_string(DipoleModel model)
+{
+  switch (model)
+  {
+    case DipoleModel::point_dipole: return "point_dipole";
+    case DipoleModel::mutual_dipole: return "mutual_dipole";
+    case DipoleModel::corrected: return "corrected";
+  }
+  return "?";
+}
+
+MagneticSettings MagneticSettings::from_case(const DemSettings &dem)
+{
+  MagneticSettings s;
+  s.model = parse_dipole_model(dem.magnetic_model);
+  s.cutoff_diameters = dem.magnetic_cutoff;
+  s.tolerance = dem.magnetic_tolerance;
+  s.refresh_interval = dem.magnetic_refresh;
+  s.skin_fraction = dem.verlet_skin;
+  return s;
+}
+
+} // namespace magbrush::magnetics

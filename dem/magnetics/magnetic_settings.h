@@ -1,0 +1,72 @@
+// Settings of the DEM magnetics (the accuracy knobs of DESIGN.md "Magnetic").
+#pragma once
+
+#include <string>
+
+namespace magbrush {
+struct DemSettings;
+}
+
+namespace magbrush::magnetics {
+
+// Which interaction model the carriers obey.
+//  * point_dipole:  each bead is a dipole induced by the APPLIED field alone,
+//                   p_j = α_j B_applied(x_j); the beads then attract/repel as point dipoles.
+//                   No mutual induction. (Cheapest; underestimates chains.)
+//  * mutual_dipole: the model of the papers (Kawamoto A8–A11, Kweon eq. 2–5): p_j = α_j B_j
+//                   with B_j the applied field PLUS the dipole fields of all other beads within
+//                   the cutoff, solved self-consistently.
+//  * corrected:     mutual_dipole plus, for close pairs, the difference between the exact
+//                   two-sphere force (multipole series) and the isolated-pair mutual-dipole
+//                   force, both evaluated in the local field the pair sits in.
+enum class DipoleModel { point_dipole, mutual_dipole, corrected };
+
+DipoleModel parse_dipole_model(const std::string &name); // throws std::invalid_argument
+std::string to_string(DipoleModel model);
+
+// What the torque outputs receive. A homogeneous isotropic sphere feels no magnetic torque:
+// its induced magnetisation is not fixed to the body, so rotating it changes nothing. With
+// converged mutual induction the papers' p × B (A8) is zero up to the solver tolerance; in
+// the point_dipole model it is an artefact (p follows the applied field only).
+enum class TorqueModel
+{
+  none,  // add nothing (physically exact for isotropic beads): the default
+  paper  // add p_j × B_j (Kawamoto A8), B_j the local field at the bead
+};
+
+struct MagneticSettings
+{
+  DipoleModel model = DipoleModel::corrected;
+  TorqueModel torque = TorqueModel::none;
+
+  // Interaction cutoff: a pair interacts when its centre distance is below the cutoff.
+  // cutoff_length > 0 gives it in metres; otherwise cutoff_diameters × the mean diameter
+  // of the beads (Kawamoto: 8 diameters).
+  double cutoff_diameters = 8.0;
+  double cutoff_length = 0.0;
+
+  // Verlet skin of the magnetic neighbour list, as a fraction of the mean diameter: the list
+  // holds pairs within cutoff + skin and is rebuilt when a bead moved more than skin/2.
+  double skin_fraction = 0.3;
+
+  // Mutual induction: Jacobi sweeps until max_j |Δp_j| ≤ tolerance × max_j |p_j|.
+  double tolerance = 1e-6;
+  int max_sweeps = 200;
+
+  // Refresh bookkeeping for a DEM that holds the magnetic forces between evaluations:
+  // refresh after refresh_interval [s] (0 = every step), or earlier as soon as some bead
+  // moved more than staleness_fraction × its radius since the last evaluation.
+  double refresh_interval = 0.0;
+  double staleness_fraction = 0.05;
+
+  // `corrected`: the exact-minus-dipole pair correction is applied fully for centre
+  // distances below switch_begin (in mean pair radii, 2 = touching) and blended smoothly to
+  // zero at switch_end (C¹ smoothstep). Tables extend to switch_end.
+  double switch_begin = 4.0;
+  double switch_end = 5.0;
+
+  // The settings a case asks for (model, cutoff, tolerance, refresh, skin).
+  static MagneticSettings from_case(const DemSettings &dem);
+};
+
+} // namespace magbrush::magnetics

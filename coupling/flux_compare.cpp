@@ -1,6 +1,8 @@
 // Profile comparison: errors, per-pole peaks, residual file (see flux_compare.h).
 #include "flux_compare.h"
 
+#include <Eigen/Dense>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -78,29 +80,43 @@ std::vector<PeakMatch> find_pole_peaks(const std::vector<Pole> &poles,
         best = static_cast<long>(k);
     if (best < 0 || sign * B[best] <= 0.0)
       continue;
+    // A resolved peak has samples on both sides that are lower (not the end of a partial scan).
     long prev = best - 1, next = best + 1;
     if (full_turn)
     {
       prev = (prev + long(m)) % long(m);
       next = next % long(m);
     }
-    if (prev < 0 || next >= long(m))
-      continue; // the extremum sits on the end of a partial scan: not a resolved peak
-    const double h1 = wrap_pm_pi(angle[prev] - angle[best]);
-    const double h2 = wrap_pm_pi(angle[next] - angle[best]);
-    // A peak inside the window, not on its edge.
-    if (sign * B[prev] > sign * B[best] || sign * B[next] > sign * B[best])
+    if (prev < 0 || next >= long(m) || sign * B[prev] > sign * B[best] ||
+        sign * B[next] > sign * B[best])
       continue;
-    // Parabola y = a + b x + c x² through (h1, y1), (0, y0), (h2, y2).
-    const double y0 = B[best], y1 = B[prev], y2 = B[next];
-    const double d1 = (y1 - y0) / h1, d2 = (y2 - y0) / h2;
-    const double c = (d2 - d1) / (h2 - h1);
-    const double b = d1 - c * h1;
-    double x = 0.0, value = y0;
-    if (c != 0.0)
+    // Refine by a least-squares parabola through the top of the peak: the contiguous samples
+    // within 5 % of the largest one (at least its two neighbours). On a noisy scan a
+    // three-point parabola would follow the noise; the top of a smooth pole peak is very
+    // nearly quadratic, and a flat peak gets a wider window than a sharp one.
+    const double level = 0.95 * sign * B[best];
+    Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+    double lo = 0.0, hi = 0.0;
+    for (size_t k = 0; k < m; ++k)
     {
-      x = std::clamp(-b / (2.0 * c), std::min(h1, h2), std::max(h1, h2));
-      value = y0 + b * x + c * x * x;
+      const double x = wrap_pm_pi(angle[k] - angle[best]);
+      if ((sign * B[k] < level || std::abs(x) > half_window) && long(k) != prev && long(k) != next)
+        continue;
+      if (!full_turn && ((x < 0) != (long(k) < best)) && x != 0.0)
+        continue; // a partial scan does not wrap
+      const Eigen::Vector3d phi(1.0, x, x * x);
+      normal += phi * phi.transpose();
+      rhs += phi * B[k];
+      lo = std::min(lo, x);
+      hi = std::max(hi, x);
+    }
+    const Eigen::Vector3d q = normal.ldlt().solve(rhs);
+    double x = 0.0, value = B[best];
+    if (q(2) * sign < 0.0) // a maximum of sign·B
+    {
+      x = std::clamp(-q(1) / (2.0 * q(2)), lo, hi);
+      value = q(0) + q(1) * x + q(2) * x * x;
     }
     if (std::abs(wrap_pm_pi(angle[best] + x - target)) > half_window)
       continue;

@@ -4,7 +4,7 @@
 // Both profiles are sampled at the scan's angles (the computed one is evaluated or
 // interpolated there by the caller). A pole's peak is the extremum of Bn with the pole's sign
 // nearest the pole's angle, within half the angular distance to its neighbours, refined by a
-// parabola through the three samples around it.
+// least-squares parabola through the samples within ±3° of the largest one (robust to noise).
 #pragma once
 
 #include "case_model.h"

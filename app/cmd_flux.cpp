@@ -1,0 +1,670 @@
+// `magbrush flux CASE [--measured SCAN.csv] [--fit] ...`: the sleeve flux profile of a case
+// against a gaussmeter scan, and calibration of the pole model to the scan.
+//
+// The steps, as run() reads:
+//   1. load the case and decide the probe radius (field.probe_radius, 0 = sleeve radius);
+//   2. the computed profile: the FEM's when magbrush-field has written one for this radius,
+//      otherwise the exact multipole ring (which one is always said);
+//   3. read the scan, compare (RMS/max errors, per-pole peaks), write the residuals and plot;
+//   4. --fit: Levenberg–Marquardt on the exact ring, parameters with uncertainties, the
+//      fitted case file, and "the FEM as the final check" when magbrush-field is available.
+#include "subcommand.h"
+
+#include "case_parser.h"
+#include "flux_compare.h"
+#include "flux_scan.h"
+#include "multipole_ring.h"
+#include "pole_fit.h"
+#include "units.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <sys/wait.h>
+#include <vector>
+
+namespace magbrush {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double to_deg = 180.0 / M_PI;
+
+const char *flux_help =
+    R"(Usage: magbrush flux CASE [--measured SCAN.csv] [-o DIR] [--set key=value ...] [options]
+
+Compares the sleeve flux profile of a case with a gaussmeter scan, and with --fit calibrates
+the Gaussian pole model (strengths, angles, shape factors, encoder offset) to it.
+
+The computed profile is taken at field.probe_radius (0 = the sleeve radius): from the finite-
+element field (<field.output_dir>/<case>_profile_probe.csv, written by `magbrush field`) when
+it exists for that radius, otherwise from the exact multipole-ring solution of the pole model.
+
+Scan (CSV): columns angle, Bn[, Bt] in any order (names like angle_deg/theta, Bn/B_n/Br,
+Bt/B_t/Btheta), units in the header (angle_deg, Bn_mT, "Bn [G]") or given below, '#' comments.
+Without --measured the case's measured_flux_file is used; without either only the computed
+profile is written.
+
+Options:
+  --measured FILE        the gaussmeter scan
+  -o, --output DIR       output directory (default: <output.directory>/<case name>/flux)
+  --set key=value        override a case value (repeatable), e.g. --set field.probe_radius=10mm
+  --angle-unit deg|rad   unit of the scan's angle column (overrides the header)
+  --field-unit T|mT|G|kG unit of the scan's Bn/Bt columns (overrides the header)
+  --angle-offset ANGLE   roller angle = scan angle + ANGLE (e.g. 2.5deg)
+  --clockwise            the scan's angle runs clockwise (Bt is then negated too)
+  --source auto|ring|fem computed profile from the FEM if present (auto), the exact ring, or
+                         the FEM only (error if missing)
+  --fit                  fit the pole model to the scan; writes <case>_fitted.yaml in DIR
+  --fit-shape shared|per-pole|fixed   shape factors α: one for all (default), one per pole,
+                         or held at the case's values
+  --no-offset            do not fit an encoder offset (every pole angle free)
+  --bn-only              fit Bn only (ignore Bt)
+  --no-fem-check         skip running magbrush-field on the fitted case
+  --no-plot              do not call tools/plot_flux.py
+  --harmonics N          number of Fourier harmonics (default: from the decay of the series)
+
+Outputs in DIR: flux_profile.csv (computed, 0.25 deg), flux_residuals.csv, flux_overlay.png,
+and with --fit: flux_fit_residuals.csv, <case>_fitted.yaml, flux_fit.txt.
+Exit status: 0 done, 1 bad input (message says what and how to fix), 2 bad usage.
+)";
+
+struct FluxOptions
+{
+  std::string case_path, measured, output_dir;
+  std::vector<std::string> overrides;
+  ScanReadOptions scan;
+  std::string source = "auto";
+  bool fit = false, no_fem_check = false, no_plot = false;
+  PoleFitOptions fit_options;
+  int harmonics = 0;
+};
+
+struct UsageError : std::invalid_argument
+{
+  using std::invalid_argument::invalid_argument;
+};
+
+FluxOptions parse_arguments(const std::vector<std::string> &args)
+{
+  FluxOptions o;
+  auto value = [&](size_t &i) -> std::string {
+    if (i + 1 >= args.size())
+      throw UsageError(args[i] + " needs a value (see magbrush flux --help)");
+    return args[++i];
+  };
+  for (size_t i = 1; i < args.size(); ++i)
+  {
+    const std::string &a = args[i];
+    if (a == "--measured")
+      o.measured = value(i);
+    else if (a == "-o" || a == "--output")
+      o.output_dir = value(i);
+    else if (a == "--set")
+      o.overrides.push_back(value(i));
+    else if (a.rfind("--set=", 0) == 0)
+      o.overrides.push_back(a.substr(6));
+    else if (a == "--angle-unit")
+      o.scan.angle_unit = value(i);
+    else if (a == "--field-unit")
+      o.scan.field_unit = value(i);
+    else if (a == "--angle-offset")
+      o.scan.angle_offset = parse_quantity(value(i), Dimension::angle);
+    else if (a == "--clockwise")
+      o.scan.clockwise = true;
+    else if (a == "--source")
+    {
+      o.source = value(i);
+      if (o.source != "auto" && o.source != "ring" && o.source != "fem")
+        throw UsageError("--source expects auto, ring or fem, found '" + o.source + "'");
+    }
+    else if (a == "--fit")
+      o.fit = true;
+    else if (a == "--fit-shape")
+    {
+      const std::string s = value(i);
+      if (s == "shared")
+        o.fit_options.shape = PoleFitOptions::Shape::shared;
+      else if (s == "per-pole" || s == "per_pole")
+        o.fit_options.shape = PoleFitOptions::Shape::per_pole;
+      else if (s == "fixed")
+        o.fit_options.shape = PoleFitOptions::Shape::fixed;
+      else
+        throw UsageError("--fit-shape expects shared, per-pole or fixed, found '" + s + "'");
+    }
+    else if (a == "--no-offset")
+      o.fit_options.fit_offset = false;
+    else if (a == "--bn-only")
+      o.fit_options.use_tangential = false;
+    else if (a == "--no-fem-check")
+      o.no_fem_check = true;
+    else if (a == "--no-plot")
+      o.no_plot = true;
+    else if (a == "--harmonics")
+    {
+      const std::string s = value(i);
+      try
+      {
+        o.harmonics = std::stoi(s);
+      }
+      catch (const std::exception &)
+      {
+        o.harmonics = -1;
+      }
+      if (o.harmonics < 1 || o.harmonics > 4096)
+        throw UsageError("--harmonics expects a whole number in 1..4096, found '" + s + "'");
+      o.fit_options.harmonics = o.harmonics;
+    }
+    else if (!a.empty() && a[0] == '-')
+      throw UsageError("unknown option '" + a + "' (see magbrush flux --help)");
+    else if (o.case_path.empty())
+      o.case_path = a;
+    else
+      throw UsageError("more than one case given ('" + o.case_path + "' and '" + a + "')");
+  }
+  if (o.case_path.empty())
+    throw UsageError("no case file given (usage: magbrush flux CASE --measured SCAN.csv)");
+  return o;
+}
+
+// ---------------------------------------------------------------------------------------
+
+std::string fixed(double v, int digits)
+{
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
+  return buf;
+}
+
+std::string scientific(double v)
+{
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.1e", v);
+  return buf;
+}
+
+double probe_radius_of(const Case &c)
+{
+  if (!c.roller)
+    throw std::invalid_argument("the case has no roller; magbrush flux needs roller.poles");
+  double r = c.field.probe_radius;
+  if (r == 0.0)
+  {
+    if (!c.sleeve)
+      throw std::invalid_argument("field.probe_radius is 0 (= the sleeve radius) but the case has "
+                                  "no sleeve; set field.probe_radius");
+    r = c.sleeve->radius;
+  }
+  if (r < c.roller->magnet_radius)
+    throw std::invalid_argument("the probe radius " + fixed(r * 1e3, 3) +
+                                " mm lies inside the magnet (outer radius " +
+                                fixed(c.roller->magnet_radius * 1e3, 3) +
+                                " mm); a gaussmeter scans outside it: set field.probe_radius to a "
+                                "radius ≥ the magnet radius (0 = the sleeve radius)");
+  return r;
+}
+
+// The FEM profile at this radius, if magbrush-field wrote one: "# ... radius R mm." line.
+std::string fem_profile_path(const Case &c, double probe_radius, std::string &why_not)
+{
+  const std::string path = c.field.output_dir + "/" + c.name + "_profile_probe.csv";
+  std::ifstream in(path);
+  if (!in)
+  {
+    why_not = "no finite-element profile " + path + " (run `magbrush field` first to compare the FEM)";
+    return "";
+  }
+  std::string line;
+  while (std::getline(in, line) && !line.empty() && line[0] == '#')
+  {
+    const auto at = line.find("radius ");
+    if (at == std::string::npos)
+      continue;
+    const double r = std::atof(line.c_str() + at + 7) * 1e-3;
+    if (std::abs(r - probe_radius) > 1e-9)
+    {
+      why_not = path + " is at radius " + fixed(r * 1e3, 3) + " mm, not the probe radius " +
+                fixed(probe_radius * 1e3, 3) + " mm";
+      return "";
+    }
+    return path;
+  }
+  return path;
+}
+
+struct ComputedProfile
+{
+  std::string source; // words
+  std::vector<double> Bn, Bt;
+};
+
+ComputedProfile computed_at(const std::vector<double> &angles, const MultipoleRing &ring,
+                            double probe_radius, const std::string &fem_path)
+{
+  ComputedProfile p;
+  if (!fem_path.empty())
+  {
+    ScanReadOptions o;
+    o.min_points = 16;
+    const FluxScan fem = read_flux_scan(fem_path, o);
+    p.Bn = interpolate_periodic(fem.angle, fem.Bn, angles);
+    p.Bt = fem.has_tangential() ? interpolate_periodic(fem.angle, fem.Bt, angles)
+                                : std::vector<double>(angles.size(), 0.0);
+    p.source = "finite-element field (" + fem_path + ")";
+    return p;
+  }
+  ring.profile(probe_radius, angles, p.Bn, p.Bt);
+  p.source = "exact multipole ring (" + std::to_string(ring.harmonic_count()) + " harmonics)";
+  return p;
+}
+
+void write_profile_csv(const std::string &path, const Case &c, double r,
+                       const ComputedProfile &p, const std::vector<double> &angles)
+{
+  std::ostringstream out;
+  out << "# Computed sleeve flux profile of case '" << c.name << "' at radius " << r * 1e3
+      << " mm, from the " << p.source << ".\n"
+      << "# angle counter-clockwise from +x; Bn positive outward, Bt positive counter-clockwise.\n"
+      << "angle_deg,Bn_mT,Bt_mT\n";
+  char buf[128];
+  for (size_t k = 0; k < angles.size(); ++k)
+  {
+    std::snprintf(buf, sizeof buf, "%.4f,%.6f,%.6f\n", angles[k] * to_deg, p.Bn[k] * 1e3,
+                  p.Bt[k] * 1e3);
+    out << buf;
+  }
+  write_file_atomically(path, out.str());
+}
+
+// Candidate locations of tools/plot_flux.py: next to this source file's repository, or
+// relative to the executable (build/bin → ../../tools).
+std::string find_plot_script()
+{
+  std::vector<fs::path> candidates;
+  if (const char *env = std::getenv("MAGBRUSH_TOOLS"))
+    candidates.push_back(fs::path(env) / "plot_flux.py");
+  candidates.push_back(fs::path(__FILE__).parent_path().parent_path() / "tools" / "plot_flux.py");
+  const fs::path exe = executable_dir();
+  candidates.push_back(exe / ".." / ".." / "tools" / "plot_flux.py");
+  candidates.push_back(exe / ".." / "tools" / "plot_flux.py");
+  candidates.push_back(exe / ".." / "share" / "magbrush" / "tools" / "plot_flux.py");
+  for (const auto &c : candidates)
+  {
+    std::error_code ec;
+    if (fs::is_regular_file(c, ec))
+      return fs::weakly_canonical(c, ec).string();
+  }
+  return "";
+}
+
+std::string quoted(const std::string &s)
+{
+  std::string q = "'";
+  for (char ch : s)
+    q += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
+  return q + "'";
+}
+
+int exit_status(int raw)
+{
+  if (raw == -1)
+    return -1;
+  return WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+}
+
+void plot(const std::string &residuals, const std::string &fitted, const std::string &png,
+          const std::string &title, const std::string &label)
+{
+  const std::string script = find_plot_script();
+  if (script.empty())
+  {
+    std::cout << "warning: tools/plot_flux.py not found (set MAGBRUSH_TOOLS to the tools "
+                 "directory); no plot written\n";
+    return;
+  }
+  const std::string arguments = " " + quoted(script) + " --residuals " + quoted(residuals) +
+                              (fitted.empty() ? "" : " --fitted " + quoted(fitted)) + " --title " +
+                              quoted(title) + " --label " + quoted(label) + " -o " + quoted(png);
+  // The first interpreter that has matplotlib: $MAGBRUSH_PYTHON, python3 on the PATH, then the
+  // system's (a pyenv or venv python3 on the PATH often lacks the Debian matplotlib).
+  std::vector<std::string> interpreters;
+  if (const char *env = std::getenv("MAGBRUSH_PYTHON"))
+    interpreters.push_back(env);
+  interpreters.push_back("python3");
+  if (fs::exists("/usr/bin/python3"))
+    interpreters.push_back("/usr/bin/python3");
+  int status = 127;
+  std::cout << std::flush;
+  for (const auto &python : interpreters)
+  {
+    const std::string cmd = quoted(python) + arguments + " 2>/dev/null";
+    status = exit_status(std::system(cmd.c_str()));
+    if (status != 3 && status != 127)
+      break;
+  }
+  if (status == 0)
+    std::cout << "  plot        " << png << "\n";
+  else if (status == 127)
+    std::cout << "warning: python3 not found; no plot written (install python3 and "
+                 "python3-matplotlib)\n";
+  else if (status == 3)
+    std::cout << "warning: matplotlib is missing; no plot written (install python3-matplotlib)\n";
+  else
+    std::cout << "warning: the plot script failed (status " << status << "); no plot written\n";
+}
+
+void print_comparison(const FluxComparison &c, const std::string &title)
+{
+  std::cout << title << "\n" << format_errors(c) << "\n" << format_peaks(c) << "\n";
+}
+
+// ---------------------------------------------------------------------------------------
+// The fitted case file: the user's YAML with roller.poles replaced (comments are lost).
+
+// Apply "a.b.c=value" overrides to the YAML tree (lists addressed by element name or [index]),
+// so that the fitted file describes the case that was actually fitted.
+void apply_override(YAML::Node root, const std::string &override_text)
+{
+  const auto eq = override_text.find('=');
+  if (eq == std::string::npos)
+    return;
+  std::vector<std::string> keys;
+  std::stringstream ks(override_text.substr(0, eq));
+  for (std::string k; std::getline(ks, k, '.');)
+    keys.push_back(k);
+  YAML::Node node = root;
+  for (size_t i = 0; i < keys.size(); ++i)
+  {
+    std::string key = keys[i];
+    const bool last = i + 1 == keys.size();
+    if (node.IsSequence())
+    {
+      YAML::Node next;
+      if (key.size() > 2 && key.front() == '[' && key.back() == ']')
+      {
+        const size_t index = std::stoul(key.substr(1, key.size() - 2));
+        if (index < node.size())
+          next.reset(node[index]);
+      }
+      else
+        for (const auto &element : node)
+          if (element.IsMap() && element["name"] && element["name"].as<std::string>() == key)
+            next.reset(element);
+      // Not addressable, or a whole list element: leave the file's text (the loaded case
+      // itself had the override applied by the parser).
+      if (!next.IsDefined() || next.IsNull() || last)
+        return;
+      node.reset(next);
+      continue;
+    }
+    if (last)
+    {
+      node[key] = override_text.substr(eq + 1);
+      return;
+    }
+    if (!node[key])
+      node[key] = YAML::Node(YAML::NodeType::Map);
+    YAML::Node next = node[key];
+    node.reset(next);
+  }
+}
+
+std::string fitted_case_text(const Case &c, const FluxOptions &o, const PoleFitResult &fit,
+                             const std::string &scan_path, const std::string &fitted_name)
+{
+  YAML::Node root = YAML::LoadFile(c.source_file);
+  for (const auto &ov : o.overrides)
+    apply_override(root, ov);
+  root["name"] = fitted_name;
+  root["measured_flux_file"] = fs::absolute(scan_path).lexically_normal().string();
+  YAML::Node poles(YAML::NodeType::Sequence);
+  for (const auto &p : fit.poles)
+  {
+    YAML::Node n(YAML::NodeType::Map);
+    n.SetStyle(YAML::EmitterStyle::Flow);
+    n["name"] = p.pole.name;
+    n["angle"] = fixed(p.pole.angle * to_deg, 4) + " deg";
+    n["strength"] = fixed(p.pole.strength * 1e-3, 3) + " kA/m";
+    n["shape_factor"] = fixed(p.pole.shape_factor, 4) + " rad^-2";
+    poles.push_back(n);
+  }
+  root["roller"]["poles"] = poles;
+  if (o.fit_options.shape == PoleFitOptions::Shape::shared)
+    root["roller"]["shape_factor"] = fixed(fit.poles[0].pole.shape_factor, 4) + " rad^-2";
+
+  std::ostringstream out;
+  std::time_t now = std::time(nullptr);
+  char stamp[64];
+  std::strftime(stamp, sizeof stamp, "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
+  out << "# " << fitted_name << ": case '" << c.name << "' (" << c.source_file
+      << ") with the poles fitted by\n#   magbrush flux --fit to the scan " << scan_path << " ("
+      << stamp << ").\n"
+      << "# Residual RMS " << fixed(fit.rms * 1e3, 3) << " mT over " << fit.samples
+      << " values; encoder offset " << fixed(fit.offset * to_deg, 4) << " ± "
+      << fixed(fit.offset_sigma * to_deg, 4) << " deg (roller angle = scan angle + offset).\n"
+      << "# Comments of the original file are not carried over.\n";
+  YAML::Emitter emitter;
+  emitter << root;
+  out << emitter.c_str() << "\n";
+  return out.str();
+}
+
+std::string fit_report(const PoleFitResult &fit, const FluxOptions &o)
+{
+  std::ostringstream out;
+  char buf[256];
+  out << "Pole fit (Levenberg–Marquardt on the exact ring, " << fit.harmonics << " harmonics): "
+      << fit.status << "\n"
+      << "  " << fit.samples << " residuals, " << fit.parameters << " parameters, "
+      << fit.iterations << " iterations, " << fit.evaluations << " evaluations\n"
+      << "  residual RMS " << fixed(fit.rms * 1e3, 4) << " mT (Bn " << fixed(fit.rms_Bn * 1e3, 4)
+      << ", Bt " << fixed(fit.rms_Bt * 1e3, 4) << "), initial guess " << fixed(fit.initial_rms * 1e3, 3)
+      << " mT\n";
+  if (o.fit_options.fit_offset)
+    out << "  encoder offset " << fixed(fit.offset * to_deg, 4) << " ± "
+        << fixed(fit.offset_sigma * to_deg, 4)
+        << " deg (roller angle = scan angle + offset; defined so that the pole angles deviate "
+           "from the case's by zero on average)\n";
+  out << "\n  pole   angle [deg]            strength [kA/m]        shape α [1/rad²]     "
+         "(initial: angle, strength)\n";
+  for (const auto &p : fit.poles)
+  {
+    std::snprintf(buf, sizeof buf,
+                  "  %-5s  %8.3f ± %-8.3f   %9.2f ± %-8.2f   %7.3f ± %-7.3f    (%.2f, %.1f)\n",
+                  p.pole.name.c_str(), p.pole.angle * to_deg, p.angle_sigma * to_deg,
+                  p.pole.strength * 1e-3, p.strength_sigma * 1e-3, p.pole.shape_factor,
+                  p.shape_sigma, p.initial.angle * to_deg, p.initial.strength * 1e-3);
+    out << buf;
+  }
+  out << "  (± one standard error from the Jacobian at the optimum, s² = RSS/(m − p))\n";
+  for (const auto &n : fit.notes)
+    out << "  note: " << n << "\n";
+  return out.str();
+}
+
+// "The FEM as the final check": magbrush-field on the fitted case, its probe profile against
+// the scan. Returns false (with the reason printed) when it cannot be done.
+void fem_check(const std::string &fitted_case, const FluxScan &scan, const std::string &dir)
+{
+  const fs::path field_exe = fs::path(executable_dir()) / "magbrush-field";
+  if (!fs::exists(field_exe))
+  {
+    std::cout << "FEM check skipped: " << field_exe.string()
+              << " is not built (build the magbrush-field target to check the fit by FEM)\n";
+    return;
+  }
+  std::cout << "FEM check: running magbrush-field on " << fitted_case << " ...\n" << std::flush;
+  const std::string log = dir + "/flux_fem_check.log";
+  const std::string cmd = quoted(field_exe.string()) + " " + quoted(fitted_case) +
+                          " --only magnetic --no-vtu > " + quoted(log) + " 2>&1";
+  const int status = exit_status(std::system(cmd.c_str()));
+  if (status != 0)
+  {
+    std::cout << "FEM check failed: magbrush-field exited with status " << status << " (see "
+              << log << ")\n";
+    return;
+  }
+  const Case fitted = load_case(fitted_case);
+  const double r = probe_radius_of(fitted);
+  std::string why;
+  const std::string path = fem_profile_path(fitted, r, why);
+  if (path.empty())
+  {
+    std::cout << "FEM check: no profile to compare: " << why << "\n";
+    return;
+  }
+  const MultipoleRing ring(*fitted.roller);
+  const ComputedProfile fem = computed_at(scan.angle, ring, r, path);
+  const FluxComparison c = compare_flux(scan, fem.Bn, fem.Bt, fitted.roller->poles);
+  print_comparison(c, "FEM of the fitted case against the scan (" + fem.source + "):");
+  write_residuals_csv(dir + "/flux_fem_check_residuals.csv", c);
+}
+
+// ---------------------------------------------------------------------------------------
+
+int run_flux(const std::vector<std::string> &args)
+{
+  for (const auto &a : args)
+    if (a == "--help" || a == "-h")
+    {
+      std::cout << flux_help;
+      return 0;
+    }
+  FluxOptions o;
+  try
+  {
+    o = parse_arguments(args);
+  }
+  catch (const UsageError &e)
+  {
+    std::cerr << "magbrush flux: " << e.what() << "\n";
+    return 2;
+  }
+
+  // 1. The case and the probe radius.
+  const Case c = load_case(o.case_path, o.overrides);
+  const double r = probe_radius_of(c);
+  MultipoleRing::Options ring_options;
+  ring_options.harmonics = o.harmonics;
+  const MultipoleRing ring(*c.roller, ring_options);
+  const std::string dir =
+      o.output_dir.empty() ? c.output.directory + "/" + c.name + "/flux" : o.output_dir;
+  fs::create_directories(dir);
+  std::cout << "magbrush flux: case '" << c.name << "', probe radius " << fixed(r * 1e3, 3)
+            << " mm (magnet " << fixed(c.roller->magnet_radius * 1e3, 3) << " mm), "
+            << c.roller->poles.size() << " poles\n"
+            << "  exact ring: " << ring.harmonic_count() << " harmonics"
+            << (o.harmonics ? " (as asked)"
+                            : " (chosen from the decay: every coefficient beyond is below " +
+                                  scientific(std::max(ring.harmonic_choice().tail, 1e-16)) +
+                                  " of the largest)")
+            << "\n";
+
+  // 2. Where the computed profile comes from.
+  std::string why_not_fem = "--source ring";
+  const std::string fem_path = o.source == "ring" ? "" : fem_profile_path(c, r, why_not_fem);
+  if (o.source == "fem" && fem_path.empty())
+    throw std::invalid_argument("--source fem: " + why_not_fem);
+  std::vector<double> grid;
+  for (int k = 0; k < 1440; ++k)
+    grid.push_back(k * 0.25 / to_deg);
+  const ComputedProfile on_grid = computed_at(grid, ring, r, fem_path);
+  std::cout << "  computed profile: " << on_grid.source << "\n";
+  if (fem_path.empty())
+    std::cout << "  (" << why_not_fem << ")\n";
+  write_profile_csv(dir + "/flux_profile.csv", c, r, on_grid, grid);
+  std::cout << "  profile     " << dir << "/flux_profile.csv\n";
+
+  // 3. The scan and the comparison.
+  const std::string scan_path = o.measured.empty() ? c.measured_flux_file : o.measured;
+  if (scan_path.empty())
+  {
+    if (o.fit)
+      throw std::invalid_argument("--fit needs a scan: give --measured FILE.csv (or set "
+                                  "measured_flux_file in the case)");
+    const auto peaks = find_pole_peaks(c.roller->poles, grid, on_grid.Bn);
+    std::cout << "\nNo scan given (--measured or measured_flux_file): computed peaks only.\n"
+              << "  pole   angle [deg]   Bn peak [mT]\n";
+    for (size_t i = 0; i < peaks.size(); ++i)
+      std::cout << "  " << c.roller->poles[i].name << "    "
+                << (peaks[i].found ? fixed(peaks[i].angle * to_deg, 2) + "      " +
+                                         fixed(peaks[i].value * 1e3, 2)
+                                   : std::string("(no peak)"))
+                << "\n";
+    return 0;
+  }
+  const FluxScan scan = read_flux_scan(scan_path, o.scan);
+  std::cout << "  scan: " << scan_path << ": " << scan.size() << " points, angle in "
+            << scan.angle_unit << ", field in " << scan.field_unit
+            << (scan.has_tangential() ? ", Bn and Bt" : ", Bn only") << "\n";
+  for (const auto &n : scan.notes)
+    std::cout << "  note: " << n << "\n";
+  const ComputedProfile computed = computed_at(scan.angle, ring, r, fem_path);
+  const FluxComparison comparison = compare_flux(scan, computed.Bn, computed.Bt, c.roller->poles);
+  std::cout << "\n";
+  print_comparison(comparison, "Scan against the " + computed.source + ":");
+  const std::string residuals = dir + "/flux_residuals.csv";
+  write_residuals_csv(residuals, comparison);
+  std::cout << "  residuals   " << residuals << "\n";
+  const std::string label = fem_path.empty() ? "exact ring" : "FEM";
+
+  if (!o.fit)
+  {
+    if (!o.no_plot)
+      plot(residuals, "", dir + "/flux_overlay.png", "Case '" + c.name + "' against " + scan_path,
+           label);
+    return 0;
+  }
+
+  // 4. The fit.
+  const PoleFitResult fit = fit_poles(*c.roller, scan, r, o.fit_options);
+  const std::string report = fit_report(fit, o);
+  std::cout << "\n" << report << "\n";
+  if (!fit.converged)
+    std::cout << "warning: the fit did not converge; the parameters above are the last iterate\n";
+  const MultipoleRing fitted_ring(fit.roller, ring_options);
+  ComputedProfile fitted;
+  fitted_ring.profile(r, scan.angle, fitted.Bn, fitted.Bt);
+  const FluxComparison fc = compare_flux(scan, fitted.Bn, fitted.Bt, fit.roller.poles);
+  print_comparison(fc, "Scan against the fitted pole model (exact ring):");
+  const std::string fit_residuals = dir + "/flux_fit_residuals.csv";
+  write_residuals_csv(fit_residuals, fc);
+
+  const std::string stem = fs::path(c.source_file).stem().string();
+  const std::string fitted_path = dir + "/" + stem + "_fitted.yaml";
+  write_file_atomically(fitted_path, fitted_case_text(c, o, fit, scan_path, c.name + "_fitted"));
+  write_file_atomically(dir + "/flux_fit.txt", report);
+  try
+  {
+    load_case(fitted_path); // the file we wrote must be a valid case
+  }
+  catch (const std::exception &e)
+  {
+    throw std::runtime_error("internal error: the fitted case " + fitted_path +
+                             " does not load: " + e.what());
+  }
+  std::cout << "  residuals   " << fit_residuals << "\n  fitted case " << fitted_path
+            << "\n  fit report  " << dir << "/flux_fit.txt\n";
+  if (!o.no_plot)
+    plot(residuals, fit_residuals, dir + "/flux_overlay.png",
+         "Case '" + c.name + "' and its fitted poles against " + scan_path, label);
+  if (o.no_fem_check)
+    std::cout << "FEM check skipped (--no-fem-check)\n";
+  else
+    fem_check(fitted_path, scan, dir);
+  return 0;
+}
+
+const bool registered = register_subcommand(
+    {"flux", "compare the sleeve flux with a gaussmeter scan; --fit calibrates the poles",
+     run_flux, 50});
+
+} // namespace
+} // namespace magbrush

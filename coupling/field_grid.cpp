@@ -2,6 +2,9 @@
 // The file layout is documented in docs/field_grid_format.md; keep the two in step.
 #include "field_grid.h"
 
+#include "cartesian_field_interpolator.h"
+#include "polar_field_interpolator.h"
+
 #include <hdf5.h>
 
 #include <cerrno>
@@ -257,6 +260,18 @@ std::vector<double> bicubic_hermite_data(const std::vector<double> &f, int n1, i
 
 } // namespace spline
 
+GridProvenance case_provenance(const Case &c, FieldKind kind)
+{
+  GridProvenance p;
+  p.case_hash = field_hash(c, kind);
+  p.case_inputs = field_inputs(c, kind);
+  p.mesh_sizes = {{"far", c.field.mesh_size_far},
+                  {"sleeve", c.field.mesh_size_sleeve},
+                  {"gap", c.field.mesh_size_gap}};
+  p.element_degree = c.field.element_degree;
+  return p;
+}
+
 // ---------------------------------------------------------------------------------------
 // HDF5 plumbing: handles closed by RAII, the library's own error printing silenced (we
 // throw messages of our own).
@@ -477,8 +492,23 @@ void write_magnetic_grid(const std::string &path, const PolarGrid &grid,
               {static_cast<hsize_t>(grid.n_r)}, "m");
     w.dataset(group, "theta", linspace(0.0, two_pi, grid.n_theta, false),
               {static_cast<hsize_t>(grid.n_theta)}, "rad");
-    w.dataset(group, "A_z", grid.A_z,
-              {static_cast<hsize_t>(grid.n_r), static_cast<hsize_t>(grid.n_theta)}, "T*m");
+    const std::vector<hsize_t> shape = {static_cast<hsize_t>(grid.n_r),
+                                        static_cast<hsize_t>(grid.n_theta)};
+    w.dataset(group, "A_z", grid.A_z, shape, "T*m");
+    // For inspection only (h5py, ParaView); the reader ignores them: B at the nodes, from the
+    // same spline the DEM uses, in polar components.
+    const PolarFieldInterpolator interp(grid);
+    std::vector<double> B_r(grid.A_z.size()), B_theta(grid.A_z.size());
+    for (int i = 0; i < grid.n_r; ++i)
+      for (int j = 0; j < grid.n_theta; ++j)
+      {
+        const double c = std::cos(grid.theta(j)), s = std::sin(grid.theta(j));
+        const Vec3 B = interp.field({grid.r(i) * c, grid.r(i) * s, 0.0});
+        B_r[static_cast<size_t>(i) * grid.n_theta + j] = B[0] * c + B[1] * s;
+        B_theta[static_cast<size_t>(i) * grid.n_theta + j] = -B[0] * s + B[1] * c;
+      }
+    w.dataset(group, "B_r", B_r, shape, "T");
+    w.dataset(group, "B_theta", B_theta, shape, "T");
   });
 }
 
@@ -501,8 +531,21 @@ void write_electric_grid(const std::string &path, const CartesianGrid &grid,
               {static_cast<hsize_t>(grid.n_x)}, "m");
     w.dataset(group, "y", linspace(grid.y_min, grid.y_max, grid.n_y, true),
               {static_cast<hsize_t>(grid.n_y)}, "m");
-    w.dataset(group, "phi", grid.phi,
-              {static_cast<hsize_t>(grid.n_x), static_cast<hsize_t>(grid.n_y)}, "V");
+    const std::vector<hsize_t> shape = {static_cast<hsize_t>(grid.n_x),
+                                        static_cast<hsize_t>(grid.n_y)};
+    w.dataset(group, "phi", grid.phi, shape, "V");
+    // For inspection only; the reader ignores them: E = −∇Φ at the nodes.
+    const CartesianFieldInterpolator interp(grid);
+    std::vector<double> E_x(grid.phi.size()), E_y(grid.phi.size());
+    for (int i = 0; i < grid.n_x; ++i)
+      for (int j = 0; j < grid.n_y; ++j)
+      {
+        const Vec3 E = interp.field({grid.x(i), grid.y(j), 0.0});
+        E_x[static_cast<size_t>(i) * grid.n_y + j] = E[0];
+        E_y[static_cast<size_t>(i) * grid.n_y + j] = E[1];
+      }
+    w.dataset(group, "E_x", E_x, shape, "V/m");
+    w.dataset(group, "E_y", E_y, shape, "V/m");
   });
 }
 

@@ -18,6 +18,7 @@
 // its finite-element solution at the nodes (sample_polar_grid), the DEM reads it back.
 #pragma once
 
+#include "case_hash.h"
 #include "case_model.h"
 
 #include <functional>
@@ -191,6 +192,12 @@ struct GridProvenance
   // The solver's estimate of the field error (relative, on B or E); NaN = unknown.
   double error_estimate = std::numeric_limits<double>::quiet_NaN();
 };
+
+// The provenance a case implies for one of its fields: hash and canonical inputs
+// (case_hash.h field_hash/field_inputs), mesh sizes {"far", "sleeve", "gap"} and element
+// degree from FieldSettings. The field solver adds its error estimate before writing; the
+// DEM compares a stored file with check_provenance(info, case_provenance(c, kind).case_inputs).
+GridProvenance case_provenance(const Case &c, FieldKind kind);
 
 // What a reader learns about a file besides the grid.
 struct GridFileInfo

@@ -1,5 +1,6 @@
 // The HDF5 field-grid format: bit-exact round trip, the reader's checks (each with the
 // message a user will see), provenance comparison and the atomic write.
+#include "exact_multipole.h"
 #include "field_grid.h"
 
 #include <gtest/gtest.h>
@@ -444,4 +445,112 @@ TEST(FieldGridLayout, PolarGridFromTheCaseSettings)
   EXPECT_EQ(l.n_theta, 1440);
   c.field.grid_outer_radius = 12.0e-3;
   EXPECT_THROW(polar_grid_layout(c), FieldGridError);
+}
+
+namespace {
+std::vector<double> read_dataset(const fs::path &path, const char *name, std::string &units)
+{
+  H5File f(path);
+  hid_t set = H5Dopen2(f.id, name, H5P_DEFAULT);
+  EXPECT_GE(set, 0) << name;
+  hid_t space = H5Dget_space(set);
+  std::vector<double> v(static_cast<size_t>(H5Sget_simple_extent_npoints(space)));
+  H5Dread(set, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data());
+  hid_t attr = H5Aopen(set, "units", H5P_DEFAULT);
+  hid_t type = H5Aget_type(attr);
+  units.assign(H5Tget_size(type), '\0');
+  H5Aread(attr, type, units.data());
+  units = units.substr(0, units.find('\0'));
+  H5Tclose(type);
+  H5Aclose(attr);
+  H5Sclose(space);
+  H5Dclose(set);
+  return v;
+}
+} // namespace
+
+// B_r, B_θ (and E_x, E_y) at the nodes, stored for inspection: the field at the nodes.
+TEST(FieldGridFile, InspectionDatasetsHoldTheFieldAtTheNodes)
+{
+  const fs::path dir = scratch_dir();
+  const magbrush::testing::MultipoleField f(4e-3, 11.5e-3, {{3, 150e3, 0.2}, {5, -90e3, 1.0}});
+  const PolarGrid g = sample_polar_grid(12.5e-3, 16e-3, 36, 360,
+                                        [&](double x, double y) { return f.A(x, y); });
+  write_magnetic_grid(dir / "m.h5", g, {});
+  std::string units_r, units_t;
+  const auto B_r = read_dataset(dir / "m.h5", "/polar/B_r", units_r);
+  const auto B_t = read_dataset(dir / "m.h5", "/polar/B_theta", units_t);
+  EXPECT_EQ(units_r, "T");
+  EXPECT_EQ(units_t, "T");
+  double err = 0, scale = 0;
+  for (int i = 0; i < g.n_r; ++i)
+    for (int j = 0; j < g.n_theta; ++j)
+    {
+      const double c = std::cos(g.theta(j)), s = std::sin(g.theta(j));
+      const auto e = f.B(g.r(i) * c, g.r(i) * s);
+      const double er = e.B[0] * c + e.B[1] * s, et = -e.B[0] * s + e.B[1] * c;
+      const size_t k = static_cast<size_t>(i) * g.n_theta + j;
+      err = std::max({err, std::abs(B_r[k] - er), std::abs(B_t[k] - et)});
+      scale = std::max(scale, std::hypot(er, et));
+    }
+  EXPECT_LT(err, 1e-4 * scale);
+  EXPECT_NO_THROW(read_magnetic_grid(dir / "m.h5"));
+
+  // Φ = x y + x²: a quadratic, reproduced exactly by the not-a-knot spline; E = −(y + 2x, x).
+  const CartesianGrid c = sample_cartesian_grid(-1e-3, 1e-3, 9, 0.0, 5e-4, 6,
+                                                [](double x, double y) { return 1e6 * (x * y + x * x); });
+  write_electric_grid(dir / "e.h5", c, {});
+  std::string ux, uy;
+  const auto E_x = read_dataset(dir / "e.h5", "/cartesian/E_x", ux);
+  const auto E_y = read_dataset(dir / "e.h5", "/cartesian/E_y", uy);
+  EXPECT_EQ(ux, "V/m");
+  EXPECT_EQ(uy, "V/m");
+  for (int i = 0; i < c.n_x; ++i)
+    for (int j = 0; j < c.n_y; ++j)
+    {
+      const size_t k = static_cast<size_t>(i) * c.n_y + j;
+      EXPECT_NEAR(E_x[k], -1e6 * (c.y(j) + 2 * c.x(i)), 1e-6);
+      EXPECT_NEAR(E_y[k], -1e6 * c.x(i), 1e-6);
+    }
+}
+
+// The provenance of a case: its hash and inputs (case_hash.h), mesh sizes, degree; moving a
+// pole makes the stored magnetic field stale and the mismatch names the pole's key.
+TEST(FieldGridFile, CaseProvenanceDetectsAMovedPole)
+{
+  Case c;
+  c.name = "t";
+  c.source_file = "t.yaml";
+  c.sleeve = Sleeve{};
+  c.sleeve->radius = 12.5e-3;
+  c.sleeve->thickness = 0.5e-3;
+  c.roller = Roller{};
+  c.roller->shaft_radius = 3e-3;
+  c.roller->magnet_radius = 11e-3;
+  c.roller->poles = {{"N1", 0.5, 150e3, 10.0}, {"S1", 2.0, -150e3, 10.0}};
+  const GridProvenance p = case_provenance(c, FieldKind::magnetic);
+  EXPECT_EQ(p.case_hash, field_hash(c, FieldKind::magnetic));
+  EXPECT_EQ(p.case_inputs, field_inputs(c, FieldKind::magnetic));
+  ASSERT_FALSE(p.case_inputs.empty());
+  EXPECT_EQ(p.element_degree, c.field.element_degree);
+  ASSERT_EQ(p.mesh_sizes.size(), 3u);
+  EXPECT_EQ(p.mesh_sizes[1].second, c.field.mesh_size_sleeve);
+
+  const fs::path path = scratch_dir() / "t_magnetic.h5";
+  write_magnetic_grid(path, some_polar_grid(), p);
+  const GridFileInfo info = read_grid_info(path);
+  EXPECT_NO_THROW(check_provenance(info, case_provenance(c, FieldKind::magnetic).case_inputs));
+  c.dem.time_step = 1e-8; // not a field input
+  EXPECT_NO_THROW(check_provenance(info, case_provenance(c, FieldKind::magnetic).case_inputs));
+  c.roller->poles[0].angle = 0.6;
+  try
+  {
+    check_provenance(info, case_provenance(c, FieldKind::magnetic).case_inputs);
+    FAIL() << "expected ProvenanceMismatch";
+  }
+  catch (const ProvenanceMismatch &e)
+  {
+    EXPECT_TRUE(contains(e.differing_key, "N1")) << e.differing_key;
+    EXPECT_TRUE(contains(e.differing_key, "angle")) << e.differing_key;
+  }
 }

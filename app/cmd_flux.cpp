@@ -68,7 +68,8 @@ Options:
   --no-offset            do not fit an encoder offset (every pole angle free)
   --bn-only              fit Bn only (ignore Bt)
   --no-fem-check         skip running magbrush-field on the fitted case
-  --no-plot              do not call tools/plot_flux.py
+  --no-plot              do not call tools/plot_flux.py (the plot needs python3 with
+                         matplotlib; $MAGBRUSH_PYTHON picks the interpreter)
   --harmonics N          number of Fourier harmonics (default: from the decay of the series)
 
 Outputs in DIR: flux_profile.csv (computed, 0.25 deg), flux_residuals.csv, flux_overlay.png,
@@ -334,12 +335,16 @@ void plot(const std::string &residuals, const std::string &fitted, const std::st
                               quoted(title) + " --label " + quoted(label) + " -o " + quoted(png);
   // The first interpreter that has matplotlib: $MAGBRUSH_PYTHON, python3 on the PATH, then the
   // system's (a pyenv or venv python3 on the PATH often lacks the Debian matplotlib).
+  // $MAGBRUSH_PYTHON, when set, is the only one tried.
   std::vector<std::string> interpreters;
   if (const char *env = std::getenv("MAGBRUSH_PYTHON"))
     interpreters.push_back(env);
-  interpreters.push_back("python3");
-  if (fs::exists("/usr/bin/python3"))
-    interpreters.push_back("/usr/bin/python3");
+  else
+  {
+    interpreters.push_back("python3");
+    if (fs::exists("/usr/bin/python3"))
+      interpreters.push_back("/usr/bin/python3");
+  }
   int status = 127;
   std::cout << std::flush;
   for (const auto &python : interpreters)

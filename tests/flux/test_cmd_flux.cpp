@@ -1,0 +1,280 @@
+// End-to-end tests of `magbrush flux` (app/cmd_flux.cpp), run as a user would:
+//  * --fit on the example scan recovers its header's poles in the written case file;
+//  * --fit on a synthetic scan written here (gauss, radians, other column names, an encoder
+//    offset, noise) recovers the generating poles and offset;
+//  * a finite-element profile in field.output_dir is used when present;
+//  * bad input: unreadable scan, bad cell, probe radius inside the magnet, --fit without a
+//    scan, unknown option — exit status and message; a missing python only warns.
+#include "case_parser.h"
+#include "multipole_ring.h"
+#include "test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sys/wait.h>
+#include <unistd.h>
+
+using namespace magbrush;
+using namespace magbrush::flux_test;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct CommandResult
+{
+  int status = -1;
+  std::string output; // stdout and stderr
+};
+
+CommandResult run_magbrush(const std::string &arguments, const std::string &environment = "")
+{
+  const std::string cmd = environment + " " + std::string(MAGBRUSH_BINARY_DIR) +
+                          "/bin/magbrush flux " + arguments + " 2>&1";
+  CommandResult r;
+  FILE *pipe = popen(cmd.c_str(), "r");
+  if (!pipe)
+    return r;
+  std::array<char, 4096> buffer;
+  size_t n;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
+    r.output.append(buffer.data(), n);
+  const int raw = pclose(pipe);
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  return r;
+}
+
+bool contains(const std::string &s, const std::string &part) { return s.find(part) != std::string::npos; }
+
+// A scratch directory per test, under the build tree.
+fs::path scratch(const std::string &name)
+{
+  const fs::path dir = fs::path(MAGBRUSH_BINARY_DIR) / "tests" / "flux_scratch" / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+// The case of the example roller with a design layout to start the fit from (the header's
+// angles deviate from these by zero on average, so the fitted encoder offset is zero).
+fs::path write_case(const fs::path &dir)
+{
+  const fs::path path = dir / "example_roller.yaml";
+  std::ofstream(path) << R"(# The roller of cases/data/sleeve_profile_example.csv, design values.
+name: example_roller
+scene: roller
+roller:
+  shaft_radius: 3 mm
+  shaft_mu_r: 1e12             # ideal iron
+  magnet_radius: 9.3 mm
+  magnet_mu_r: 1
+  shape_factor: 10
+  poles:
+    - {name: S1, angle: 0 deg, strength: -300 kA/m}
+    - {name: N1, angle: 70 deg, strength: 150 kA/m}
+    - {name: S2, angle: 145 deg, strength: -150 kA/m}
+    - {name: S3, angle: 215 deg, strength: -150 kA/m}
+    - {name: N2, angle: 290 deg, strength: 150 kA/m}
+sleeve:
+  radius: 10 mm
+  thickness: 0.3 mm
+)";
+  return path;
+}
+
+double wrap_pm_pi(double a)
+{
+  a = std::remainder(a, 2 * M_PI);
+  return a <= -M_PI ? a + 2 * M_PI : a;
+}
+
+void expect_poles_near(const Roller &fitted, const Roller &truth, double angle_tol,
+                       double strength_tol, double shape_tol)
+{
+  ASSERT_EQ(fitted.poles.size(), truth.poles.size());
+  for (size_t i = 0; i < truth.poles.size(); ++i)
+  {
+    const Pole &f = fitted.poles[i], &t = truth.poles[i];
+    EXPECT_EQ(f.name, t.name);
+    EXPECT_LT(std::abs(wrap_pm_pi(f.angle - t.angle)), angle_tol) << t.name;
+    EXPECT_NEAR(f.strength / t.strength, 1.0, strength_tol) << t.name;
+    EXPECT_NEAR(f.shape_factor / t.shape_factor, 1.0, shape_tol) << t.name;
+  }
+}
+
+} // namespace
+
+TEST(CmdFlux, HelpAndUsage)
+{
+  const CommandResult help = run_magbrush("--help");
+  EXPECT_EQ(help.status, 0);
+  EXPECT_TRUE(contains(help.output, "Usage: magbrush flux CASE"));
+  const CommandResult unknown = run_magbrush("case.yaml --frobnicate");
+  EXPECT_EQ(unknown.status, 2);
+  EXPECT_TRUE(contains(unknown.output, "unknown option '--frobnicate'")) << unknown.output;
+  const CommandResult none = run_magbrush("");
+  EXPECT_EQ(none.status, 2);
+}
+
+TEST(CmdFlux, FitOnTheExampleScanRecoversItsHeaderPoles)
+{
+  const fs::path dir = scratch("example");
+  const fs::path case_file = write_case(dir);
+  const CommandResult r = run_magbrush(case_file.string() + " --measured " + example_scan_path() + " -o " +
+                             (dir / "out").string() + " --fit --no-fem-check --no-plot");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "exact multipole ring")) << r.output;
+  EXPECT_TRUE(contains(r.output, "FEM check skipped")) << r.output;
+  for (const char *f : {"flux_profile.csv", "flux_residuals.csv", "flux_fit_residuals.csv",
+                        "flux_fit.txt", "example_roller_fitted.yaml"})
+    EXPECT_TRUE(fs::exists(dir / "out" / f)) << f;
+  const Case fitted = load_case((dir / "out" / "example_roller_fitted.yaml").string());
+  EXPECT_EQ(fitted.name, "example_roller_fitted");
+  expect_poles_near(*fitted.roller, example_roller(), 0.1 * deg, 0.01, 0.01);
+  // Before the fit the design poles are ~10 % off; the comparison shows it.
+  EXPECT_TRUE(contains(r.output, "Scan against the fitted pole model")) << r.output;
+}
+
+TEST(CmdFlux, FitRecoversASyntheticScanWithOffsetInOtherUnits)
+{
+  // Truth: the design layout with zero-mean deviations, other strengths, α = 12; the scan is
+  // read by an encoder 2.5° behind (scan angle = roller angle − 2.5°), written in radians and
+  // gauss, noise 0.4 mT.
+  Roller truth = example_roller();
+  const double angles[] = {1.0, 71.0, 143.0, 216.0, 289.0}; // mean = 144 = the design's mean
+  for (size_t i = 0; i < truth.poles.size(); ++i)
+  {
+    truth.poles[i].angle = angles[i] * deg;
+    truth.poles[i].shape_factor = 12.0;
+  }
+  const double offset = 2.5 * deg;
+  std::vector<double> scan_angle, roller_angle, Bn, Bt;
+  for (int k = 0; k < 240; ++k)
+  {
+    scan_angle.push_back(k * 1.5 * deg);
+    roller_angle.push_back(k * 1.5 * deg + offset);
+  }
+  MultipoleRing(truth).profile(10e-3, roller_angle, Bn, Bt);
+  std::mt19937 rng(11);
+  std::normal_distribution<double> noise(0.0, 0.4e-3);
+  const fs::path dir = scratch("synthetic");
+  const fs::path case_file = write_case(dir);
+  const fs::path scan = dir / "scan.txt";
+  {
+    std::ofstream out(scan);
+    out << "# synthetic scan, gauss, radians\ntheta [rad]; B_theta (G); B_r (G)\n";
+    out.precision(10);
+    for (size_t k = 0; k < scan_angle.size(); ++k)
+      out << scan_angle[k] << "; " << (Bt[k] + noise(rng)) * 1e4 << "; " << (Bn[k] + noise(rng)) * 1e4
+          << "\n";
+  }
+  const CommandResult r = run_magbrush(case_file.string() + " --measured " + scan.string() + " -o " +
+                             (dir / "out").string() + " --fit --no-fem-check --no-plot");
+  ASSERT_EQ(r.status, 0) << r.output;
+  const Case fitted = load_case((dir / "out" / "example_roller_fitted.yaml").string());
+  expect_poles_near(*fitted.roller, truth, 0.1 * deg, 0.01, 0.01);
+  // The encoder offset is in the report: "encoder offset 2.5xxx ± ..."
+  const auto at = r.output.find("encoder offset ");
+  ASSERT_NE(at, std::string::npos) << r.output;
+  const double reported = std::atof(r.output.c_str() + at + 15);
+  std::printf("synthetic scan: encoder offset %.4f deg (true 2.5)\n", reported);
+  EXPECT_NEAR(reported, 2.5, 0.05);
+}
+
+TEST(CmdFlux, UsesTheFiniteElementProfileWhenPresent)
+{
+  // A stand-in for magbrush-field's output: the exact profile in its file format.
+  const fs::path dir = scratch("fem");
+  const fs::path case_file = write_case(dir);
+  const fs::path fields = dir / "fields";
+  fs::create_directories(fields);
+  Roller design = example_roller();
+  design.poles = {{"S1", 0, -300e3, 10}, {"N1", 70 * deg, 150e3, 10}, {"S2", 145 * deg, -150e3, 10},
+                  {"S3", 215 * deg, -150e3, 10}, {"N2", 290 * deg, 150e3, 10}};
+  std::vector<double> a, Bn, Bt;
+  for (int k = 0; k < 720; ++k)
+    a.push_back(k * 0.5 * deg);
+  MultipoleRing(design).profile(10e-3, a, Bn, Bt);
+  {
+    std::ofstream out(fields / "example_roller_profile_probe.csv");
+    out << "# Computed sleeve flux profile of case 'example_roller' (magbrush-field, FE_Q(2)), "
+           "radius 10 mm.\n# angle counter-clockwise from +x; Bn positive outward, Bt positive "
+           "counter-clockwise.\nangle_deg,Bn_T,Bt_T\n";
+    out.precision(12);
+    for (size_t k = 0; k < a.size(); ++k)
+      out << a[k] / deg << "," << Bn[k] << "," << Bt[k] << "\n";
+  }
+  const std::string common = case_file.string() + " --set field.output_dir=" + fields.string() +
+                             " --measured " + example_scan_path() + " --no-plot -o " +
+                             (dir / "out").string();
+  const CommandResult fem = run_magbrush(common);
+  ASSERT_EQ(fem.status, 0) << fem.output;
+  EXPECT_TRUE(contains(fem.output, "finite-element field")) << fem.output;
+  const CommandResult ring = run_magbrush(common + " --source ring");
+  ASSERT_EQ(ring.status, 0) << ring.output;
+  EXPECT_TRUE(contains(ring.output, "exact multipole ring")) << ring.output;
+  // Same profile, so the same error table (to the interpolation error, < 0.01 mT).
+  auto rms_bn = [](const std::string &out) {
+    const auto at = out.find("  Bn ");
+    return std::atof(out.c_str() + at + 5);
+  };
+  EXPECT_NEAR(rms_bn(fem.output), rms_bn(ring.output), 0.01);
+  // A profile at another radius is not used.
+  const CommandResult other = run_magbrush(common + " --set field.probe_radius=11mm");
+  ASSERT_EQ(other.status, 0) << other.output;
+  EXPECT_TRUE(contains(other.output, "not the probe radius")) << other.output;
+  const CommandResult must = run_magbrush(common + " --set field.probe_radius=11mm --source fem");
+  EXPECT_EQ(must.status, 1) << must.output;
+}
+
+TEST(CmdFlux, BadInputGivesClearErrors)
+{
+  const fs::path dir = scratch("bad");
+  const fs::path case_file = write_case(dir);
+  const std::string out = " -o " + (dir / "out").string() + " --no-plot";
+
+  const CommandResult missing = run_magbrush(case_file.string() + " --measured /nonexistent/scan.csv" + out);
+  EXPECT_EQ(missing.status, 1);
+  EXPECT_TRUE(contains(missing.output, "/nonexistent/scan.csv: cannot open")) << missing.output;
+
+  const fs::path bad = dir / "bad.csv";
+  std::ofstream(bad) << "angle_deg,Bn_mT,Bt_mT\n0,1,2\n1,1,2\n2,x,2\n";
+  const CommandResult cell = run_magbrush(case_file.string() + " --measured " + bad.string() + out);
+  EXPECT_EQ(cell.status, 1);
+  EXPECT_TRUE(contains(cell.output, "bad.csv:4:") && contains(cell.output, "'x'")) << cell.output;
+
+  const CommandResult inside = run_magbrush(case_file.string() + " --set field.probe_radius=8mm --measured " +
+                                  example_scan_path() + out);
+  EXPECT_EQ(inside.status, 1);
+  EXPECT_TRUE(contains(inside.output, "inside the magnet")) << inside.output;
+
+  const CommandResult no_scan = run_magbrush(case_file.string() + " --fit" + out);
+  EXPECT_EQ(no_scan.status, 1);
+  EXPECT_TRUE(contains(no_scan.output, "--fit needs a scan")) << no_scan.output;
+
+  const CommandResult no_case = run_magbrush("/nonexistent/case.yaml" + out);
+  EXPECT_EQ(no_case.status, 1);
+
+  // Without a scan: the computed profile and its peaks only.
+  const CommandResult profile_only = run_magbrush(case_file.string() + out);
+  EXPECT_EQ(profile_only.status, 0) << profile_only.output;
+  EXPECT_TRUE(contains(profile_only.output, "computed peaks only")) << profile_only.output;
+}
+
+TEST(CmdFlux, MissingPythonOnlyWarns)
+{
+  const fs::path dir = scratch("nopython");
+  const fs::path case_file = write_case(dir);
+  const CommandResult r = run_magbrush(case_file.string() + " --measured " + example_scan_path() + " -o " +
+                                 (dir / "out").string(),
+                             "MAGBRUSH_PYTHON=/nonexistent/python3");
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "warning: python3 not found")) << r.output;
+  EXPECT_TRUE(fs::exists(dir / "out" / "flux_residuals.csv"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "flux_overlay.png"));
+}

@@ -31,7 +31,9 @@ private:
 };
 } // namespace
 
-DemSystem::DemSystem(const Case &c) : case_(c), walls_(build_wall_primitives(c))
+DemSystem::DemSystem(const Case &c) : DemSystem(c, build_wall_primitives(c)) {}
+
+DemSystem::DemSystem(const Case &c, const WallSet &walls) : case_(c), walls_(walls)
 {
   box_.length = {c.dem.periodic_length_x, c.dem.periodic_length_y, c.dem.periodic_length};
 }

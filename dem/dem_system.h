@@ -54,6 +54,9 @@ public:
   // Walls, periodic box and materials come from the case; particles are added separately
   // (insert_particles, or directly through particles() in tests, then initialize()).
   explicit DemSystem(const Case &c);
+  // The same with an explicit wall set instead of build_wall_primitives(c) (tests, scenes
+  // whose walls are assembled by hand, e.g. a drum with the particles inside).
+  DemSystem(const Case &c, const WallSet &walls);
 
   void insert_particles();                 // the case's populations
   ParticleState &particles() { return particles_; }

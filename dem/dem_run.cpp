@@ -1,0 +1,194 @@
+// A whole DEM run with its outputs (see dem_run.h).
+#include "dem_run.h"
+
+#include <omp.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <ostream>
+
+namespace magbrush::dem {
+
+namespace fs = std::filesystem;
+
+DemRun::DemRun(const Case &c, const RunOptions &options, std::ostream &log)
+    : case_(c), options_(options), log_(log)
+{
+  const int threads = options_.threads > 0 ? options_.threads : case_.dem.threads;
+  if (threads > 0)
+    omp_set_num_threads(threads);
+  out_dir_ = options_.output_dir.empty() ? (fs::path(case_.output.directory) / "dem").string() : options_.output_dir;
+  fs::create_directories(out_dir_);
+  system_ = std::make_unique<DemSystem>(case_);
+  add_scene_force_terms();
+}
+
+std::string DemRun::checkpoint_path() const { return (fs::path(out_dir_) / "checkpoint.bin").string(); }
+
+void DemRun::add_scene_force_terms()
+{
+  // Each term only when the scene needs it.
+  const auto &g = case_.dem.gravity;
+  if (g[0] != 0.0 || g[1] != 0.0 || g[2] != 0.0)
+    system_->add_force_term(std::make_unique<Gravity>(g));
+  if (case_.dem.air_viscosity > 0.0)
+    system_->add_force_term(std::make_unique<StokesDrag>(case_.dem.air_viscosity));
+}
+
+void DemRun::log_setup() const
+{
+  const DemSystem &s = *system_;
+  char line[512];
+  log_ << "magbrush-dem: case '" << case_.name << "', " << s.particles().size() << " particles, "
+       << s.walls().size() << " walls, " << omp_get_max_threads() << " OpenMP threads\n";
+  for (std::size_t w = 0; w < s.walls().size(); ++w)
+    log_ << "  wall " << w << ": " << s.walls().name(w) << " (material " << s.walls().material(w) << ")\n";
+  const auto &b = s.box().length;
+  std::snprintf(line, sizeof line, "  periodic lengths x/y/z: %g / %g / %g m (0 = walls or open)\n", b[0], b[1], b[2]);
+  log_ << line;
+  log_ << "  contact law: Hertz + Voigt damping, Mindlin tangential + Coulomb, rolling friction (Kawamoto A2-A7)\n"
+       << s.contact_table().describe();
+  const auto &st = s.stable_time_step_info();
+  std::snprintf(line, sizeof line,
+                "  time step %.4g s (%s; stable limit %.4g s set by the %s; Rayleigh %.4g s, Hertz t_c/10 %.4g s)\n",
+                s.time_step(), case_.dem.time_step > 0 ? "user" : "automatic", st.limit, st.limiting.c_str(),
+                st.rayleigh, st.hertz);
+  log_ << line;
+  std::snprintf(line, sizeof line, "  Verlet skin %.3g m; force terms on: contacts", s.skin());
+  log_ << line;
+  for (const auto &t : s.force_terms())
+    log_ << ", " << t->name();
+  log_ << "\n";
+  if (case_.applied_field.kind != AppliedField::Kind::none)
+    log_ << "  note: the case has an applied magnetic field; the induced-dipole term (dem/magnetics) is "
+            "plugged in by the scene set-up and is NOT part of this run unless added\n";
+  if (case_.electric.enabled)
+    log_ << "  note: electrostatic terms (Coulomb, qE) are not part of this engine build yet\n";
+  log_.flush();
+}
+
+void DemRun::log_timings(double wall) const
+{
+  const DemSystem &s = *system_;
+  const PhaseTimes &t = s.phase_times();
+  auto row = [&](const char *name, double v) {
+    char line[160];
+    std::snprintf(line, sizeof line, "  %-22s %10.3f s  %5.1f %%\n", name, v, wall > 0 ? 100.0 * v / wall : 0.0);
+    log_ << line;
+  };
+  log_ << "time per phase (wall clock):\n";
+  row("neighbour list", t.neighbor);
+  row("particle contacts", t.particle_contacts);
+  row("wall contacts", t.wall_contacts);
+  for (std::size_t k = 0; k < s.force_terms().size(); ++k)
+    row(s.force_terms()[k]->name(), t.terms[k]);
+  row("integration", t.integrate);
+  row("guards", t.guards);
+  double rest = wall - t.neighbor - t.particle_contacts - t.wall_contacts - t.integrate - t.guards;
+  for (double v : t.terms)
+    rest -= v;
+  row("output and other", rest);
+  row("total", wall);
+}
+
+void DemRun::run()
+{
+  DemSystem &s = *system_;
+  SnapshotWriter snapshots(out_dir_);
+  const std::string csv = (fs::path(out_dir_) / "time_series.csv").string();
+  const bool restart = !options_.restart_file.empty();
+  if (restart)
+  {
+    s.read_checkpoint(options_.restart_file);
+    log_ << "restarted from '" << options_.restart_file << "' at step " << s.step_count() << ", t = " << s.time()
+         << " s\n";
+  }
+  else
+  {
+    s.insert_particles();
+    s.initialize();
+  }
+  TimeSeriesWriter series(csv, s);
+  log_setup();
+  const double t_wall0 = omp_get_wtime();
+  if (restart)
+  {
+    snapshots.resume(s.time());
+    series.resume(s.step_count());
+  }
+  else if (case_.dem.settle_time > 0.0)
+  {
+    log_ << "settling for " << case_.dem.settle_time << " s with the walls at rest ...\n";
+    s.settle(case_.dem.settle_time);
+  }
+
+  const double dt = s.time_step();
+  auto every = [dt](double interval) { return interval > 0.0 ? std::max(1L, std::lround(interval / dt)) : 0L; };
+  const long end_step = std::lround(case_.dem.duration / dt);
+  const long out_every = every(case_.dem.output_interval);
+  const long ckpt_every = every(case_.dem.checkpoint_interval);
+  const long series_every = out_every > 0 ? std::max(1L, out_every / 10) : std::max(1L, end_step / 1000);
+  if (!restart)
+  {
+    series.record(s);
+    snapshots.write(s);
+  }
+  const long start_step = s.step_count();
+  double last_progress = omp_get_wtime();
+  try
+  {
+    while (s.step_count() < end_step)
+    {
+      s.step();
+      const long k = s.step_count();
+      if (k % series_every == 0)
+        series.record(s);
+      if (out_every > 0 && k % out_every == 0)
+        snapshots.write(s);
+      if (ckpt_every > 0 && k % ckpt_every == 0)
+        s.write_checkpoint(checkpoint_path());
+      const double now = omp_get_wtime();
+      if (now - last_progress >= options_.progress_interval)
+      {
+        last_progress = now;
+        const double done = static_cast<double>(k - start_step), left = static_cast<double>(end_step - k);
+        const double rate = done / (now - t_wall0);
+        char line[256];
+        std::snprintf(line, sizeof line,
+                      "  t = %.5g / %.5g s (%5.1f %%), step %ld, %.3g particle-steps/s, ETA %.0f s, %ld contacts\n",
+                      s.time(), case_.dem.duration, 100.0 * k / std::max(1L, end_step), k,
+                      rate * static_cast<double>(s.particles().size()), left / std::max(rate, 1e-30),
+                      s.particle_contacts());
+        log_ << line;
+        log_.flush();
+      }
+    }
+  }
+  catch (const StabilityError &e)
+  {
+    log_ << e.what() << "\n";
+    if (fs::exists(checkpoint_path()))
+      log_ << "the last good checkpoint is kept: " << checkpoint_path() << " (restart from it with --restart)\n";
+    else
+      log_ << "no checkpoint was written before the failure (set dem.checkpoint_interval to keep one)\n";
+    log_timings(omp_get_wtime() - t_wall0);
+    throw;
+  }
+  if (out_every == 0 || s.step_count() % out_every != 0)
+    snapshots.write(s);
+  if (s.step_count() % series_every != 0)
+    series.record(s);
+  s.write_checkpoint(checkpoint_path());
+  const double wall = omp_get_wtime() - t_wall0;
+  char line[256];
+  std::snprintf(line, sizeof line, "done: %ld steps to t = %.6g s in %.2f s wall (%.3g particle-steps/s), %ld list rebuilds\n",
+                s.step_count() - start_step, s.time(), wall,
+                static_cast<double>(s.step_count() - start_step) * static_cast<double>(s.particles().size()) / std::max(wall, 1e-9),
+                s.neighbor_rebuilds());
+  log_ << line;
+  log_ << "outputs: " << out_dir_ << "/{particles.xdmf, snapshots/, time_series.csv, checkpoint.bin}\n";
+  log_timings(wall);
+}
+
+} // namespace magbrush::dem

@@ -1,0 +1,57 @@
+// One DEM run of a case, as `magbrush dem` does it:
+//
+//   insert the populations → settle → loop { step; time series; snapshots; checkpoints;
+//   progress line } → final checkpoint → log of the time spent per phase and force term
+//
+// or, with a checkpoint, restart at its step and continue bit-identically. The run owns the
+// outputs: <output.directory>/dem/{particles.xdmf, snapshots/, time_series.csv,
+// checkpoint.bin}.
+#pragma once
+
+#include "dem_system.h"
+#include "snapshot_writer.h"
+
+#include "case_model.h"
+
+#include <iosfwd>
+#include <memory>
+#include <string>
+
+namespace magbrush::dem {
+
+struct RunOptions
+{
+  std::string restart_file;  // continue from this checkpoint ("" = fresh run)
+  std::string output_dir;    // "" = <case.output.directory>/dem
+  int threads = 0;           // 0 = case.dem.threads, then the OpenMP default
+  double progress_interval = 5.0; // seconds of wall time between progress lines
+};
+
+class DemRun
+{
+public:
+  DemRun(const Case &c, const RunOptions &options, std::ostream &log);
+
+  // The engine, e.g. to plug in further force terms (magnetics) before run().
+  DemSystem &system() { return *system_; }
+
+  // Inserts (or restarts), settles and runs to case.dem.duration. Throws StabilityError
+  // after keeping the last good checkpoint.
+  void run();
+
+  const std::string &output_dir() const { return out_dir_; }
+  std::string checkpoint_path() const;
+
+private:
+  Case case_;
+  RunOptions options_;
+  std::ostream &log_;
+  std::string out_dir_;
+  std::unique_ptr<DemSystem> system_;
+
+  void add_scene_force_terms();
+  void log_setup() const;
+  void log_timings(double wall) const;
+};
+
+} // namespace magbrush::dem

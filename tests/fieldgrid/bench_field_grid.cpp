@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <random>
 #include <memory>
 #include <string>
 
@@ -239,6 +240,42 @@ int main(int argc, char **argv)
     const PolarFieldInterpolator interp(make_grid(sharp, s));
     const Accuracy a = measure(interp, sharp, points);
     std::printf("%9.1f %9.3f %12.3e %12.3e\n", s.dr * 1e6, s.dtheta / deg, a.B, a.gradB2);
+  }
+
+  // The nip grid (FieldSettings::grid_electric_spacing, default 10 µm): a harmonic potential
+  // like the nip's — bias across a 400 µm gap over a latent image of 300 µm period —
+  // Φ = V y/g + φ1 cos(kx) sinh(k(g − y))/sinh(kg) on the window |x| ≤ 1.5 mm, 0 ≤ y ≤ g.
+  const double gap = 400e-6, V = -600.0, phi1 = 150.0, k = 2 * M_PI / 300e-6;
+  const auto phi = [&](double x, double y) {
+    return V * y / gap + phi1 * std::cos(k * x) * std::sinh(k * (gap - y)) / std::sinh(k * gap);
+  };
+  const auto E_exact = [&](double x, double y) -> std::array<double, 2> {
+    const double sh = std::sinh(k * gap);
+    return {phi1 * k * std::sin(k * x) * std::sinh(k * (gap - y)) / sh,
+            -V / gap + phi1 * k * std::cos(k * x) * std::cosh(k * (gap - y)) / sh};
+  };
+  std::printf("\nElectric nip grid: |x| <= 1.5 mm, 0 <= y <= 400 um; errors relative to max|E|\n");
+  std::printf("%9s %8s %10s %12s %8s\n", "h[um]", "nodes", "memory", "err E", "order");
+  double previous = 0.0;
+  for (double h : {40e-6, 20e-6, 10e-6, 5e-6})
+  {
+    const int nx = 1 + static_cast<int>(std::lround(3e-3 / h)), ny = 1 + static_cast<int>(std::lround(gap / h));
+    const CartesianFieldInterpolator interp(sample_cartesian_grid(-1.5e-3, 1.5e-3, nx, 0.0, gap, ny, phi));
+    double err = 0, scale = 0;
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> ux(-1.5e-3, 1.5e-3), uy(0.0, gap);
+    for (int n = 0; n < 40000; ++n)
+    {
+      const double x = ux(rng), y = uy(rng);
+      const auto e = E_exact(x, y);
+      const Vec3 E = interp.field({x, y, 0});
+      err = std::max(err, std::hypot(E[0] - e[0], E[1] - e[1]));
+      scale = std::max(scale, std::hypot(e[0], e[1]));
+    }
+    err /= scale;
+    std::printf("%9.1f %8d %8.2fMB %12.3e %8.2f\n", h * 1e6, nx * ny, interp.memory_bytes() / 1048576.0,
+                err, previous > 0 ? std::log2(previous / err) : NAN);
+    previous = err;
   }
   benchmark::Shutdown();
   return 0;

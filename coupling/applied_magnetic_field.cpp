@@ -1,6 +1,9 @@
 // Construction of the applied magnetic field from the case (see applied_magnetic_field.h).
 #include "applied_magnetic_field.h"
 
+#include "case_hash.h"
+#include "field_grid.h"
+
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -66,6 +69,15 @@ AppliedMagneticField AppliedMagneticField::from_settings(
     return roller(std::move(grid), settings.ramp_time);
   }
   throw std::invalid_argument("applied magnetic field: unknown kind");
+}
+
+AppliedMagneticField AppliedMagneticField::for_case(const Case &c, const std::string &grid_path)
+{
+  if (c.applied_field.kind != AppliedField::Kind::roller)
+    return from_settings(c.applied_field);
+  const MagneticGridFile file = read_magnetic_grid(grid_path);
+  check_provenance(file.info, field_inputs(c, FieldKind::magnetic));
+  return roller(std::make_shared<const PolarFieldInterpolator>(file.grid), c.applied_field.ramp_time);
 }
 
 const char *AppliedMagneticField::kind_name() const

@@ -38,6 +38,12 @@ public:
   static AppliedMagneticField from_settings(const AppliedField &settings,
                                             std::shared_ptr<const PolarFieldInterpolator> grid = {});
 
+  // What `magbrush dem` does: the case's applied field; for a roller, read the magnetic grid
+  // at `grid_path` (field_solver/field_files.h magnetic_grid_path), check that it was computed
+  // for this case (throws ProvenanceMismatch naming the key otherwise) and interpolate it.
+  // FieldGridError when the file is missing or malformed.
+  static AppliedMagneticField for_case(const Case &c, const std::string &grid_path);
+
   Kind kind() const { return kind_; }
   const char *kind_name() const;
   bool has_gradient() const { return kind_ == Kind::roller; }

@@ -2,6 +2,10 @@
 // the roller kind is the grid interpolator, scaled by the same ramp.
 #include "applied_magnetic_field.h"
 #include "exact_multipole.h"
+#include "field_grid.h"
+
+#include <filesystem>
+#include <unistd.h>
 
 #include <gtest/gtest.h>
 
@@ -88,4 +92,41 @@ TEST(AppliedMagneticField, RollerKindIsTheGridInterpolatorTimesTheRamp)
       EXPECT_EQ(ga[i][j], g0[i][j]);
   }
   EXPECT_THROW(f.field({0, 1e-3, 0}, 1.0), FieldLookupError);
+}
+
+// The DEM's entry point: a roller case reads its grid and checks its provenance; a case whose
+// roller changed since the field was computed is refused with the key.
+TEST(AppliedMagneticField, ForCaseReadsTheGridAndChecksProvenance)
+{
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("magbrush_applied_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  Case c;
+  c.name = "t";
+  c.sleeve = Sleeve{};
+  c.sleeve->radius = 12.5e-3;
+  c.roller = Roller{};
+  c.roller->magnet_radius = 11e-3;
+  c.roller->poles = {{"N1", 0.5, 150e3, 10.0}};
+  c.applied_field.kind = AppliedField::Kind::roller;
+  const auto exact = magbrush::testing::roller_like_field();
+  const PolarGrid grid = sample_polar_grid(12.5e-3, 16e-3, 36, 720,
+                                           [&](double x, double y) { return exact.A(x, y); });
+  const std::string path = (dir / "t_magnetic.h5").string();
+  write_magnetic_grid(path, grid, case_provenance(c, FieldKind::magnetic));
+
+  const auto f = AppliedMagneticField::for_case(c, path);
+  EXPECT_EQ(f.kind(), AppliedMagneticField::Kind::roller);
+  const Vec3 B = f.field({0, 13e-3, 0}, 0.0);
+  const auto e = exact.B(0, 13e-3);
+  EXPECT_NEAR(B[0], e.B[0], 1e-4 * std::hypot(e.B[0], e.B[1]));
+  EXPECT_NEAR(B[1], e.B[1], 1e-4 * std::hypot(e.B[0], e.B[1]));
+
+  c.roller->poles[0].strength = 160e3;
+  EXPECT_THROW(AppliedMagneticField::for_case(c, path), ProvenanceMismatch);
+  EXPECT_THROW(AppliedMagneticField::for_case(c, (dir / "missing.h5").string()), FieldGridError);
+  c.applied_field.kind = AppliedField::Kind::uniform; // no grid needed
+  c.applied_field.uniform_magnitude = 0.1;
+  EXPECT_EQ(AppliedMagneticField::for_case(c, "unused").kind(), AppliedMagneticField::Kind::uniform);
+  fs::remove_all(dir);
 }

@@ -323,6 +323,9 @@ MultipoleRing::MultipoleRing(const RingGeometry &geometry,
 
 void MultipoleRing::build_responses()
 {
+  consecutive_ = true;
+  for (size_t i = 0; i < harmonics_.size(); ++i)
+    consecutive_ = consecutive_ && harmonics_[i].n == static_cast<int>(i) + 1;
   responses_.clear();
   responses_.reserve(harmonics_.size());
   for (const auto &h : harmonics_)
@@ -337,12 +340,15 @@ RingField MultipoleRing::field(double x, double y) const
 RingField MultipoleRing::field_polar(double r, double theta) const
 {
   RingField f;
+  const std::complex<double> step = std::polar(1.0, theta);
+  std::complex<double> z(1.0, 0.0); // e^{inθ} by recurrence when the orders are 1, 2, 3, ...
   for (size_t i = 0; i < harmonics_.size(); ++i)
   {
     const auto &h = harmonics_[i];
     double br, bt;
     responses_[i].radial_factors(r, br, bt);
-    const double c = std::cos(h.n * theta), s = std::sin(h.n * theta);
+    z = consecutive_ ? z * step : std::polar(1.0, h.n * theta);
+    const double c = z.real(), s = z.imag();
     f.Br += br * (h.a * c + h.b * s);
     f.Btheta += bt * (h.a * s - h.b * c);
     f.Az += (r * br / h.n) * (h.a * s - h.b * c);
@@ -368,10 +374,13 @@ void MultipoleRing::profile(double r, const std::vector<double> &angles, std::ve
   for (size_t k = 0; k < angles.size(); ++k)
   {
     double bn = 0.0, bt = 0.0;
+    const std::complex<double> step = std::polar(1.0, angles[k]);
+    std::complex<double> z(1.0, 0.0);
     for (size_t i = 0; i < N; ++i)
     {
       const auto &h = harmonics_[i];
-      const double c = std::cos(h.n * angles[k]), s = std::sin(h.n * angles[k]);
+      z = consecutive_ ? z * step : std::polar(1.0, h.n * angles[k]);
+      const double c = z.real(), s = z.imag();
       bn += fr[i] * (h.a * c + h.b * s);
       bt += ft[i] * (h.a * s - h.b * c);
     }

@@ -172,6 +172,7 @@ private:
   std::vector<HarmonicResponse> responses_;
   double mean_magnetisation_ = 0.0; // m_0 (no field, kept for magnetisation())
   HarmonicChoice choice_;
+  bool consecutive_ = false; // orders are 1, 2, ..., N: powers of e^{iθ} by recurrence
   void build_responses();
 };
 

@@ -282,15 +282,19 @@ private:
         }
         if (current.IsSequence())
         {
-          YAML::Node element = find_element(current, part);
-          if (!element)
+          YAML::Node element;
+          if (!find_element(current, part, element))
           {
             error(where, display, "no element '" + part + "' in this list (elements: " +
                                       join(element_names(current), ", ") + ")");
             ok = false;
             break;
           }
-          display += is_index(part) ? part : "." + part;
+          // The same naming as the schema walk: named elements by name, others by [index].
+          if (element.IsMap() && element["name"] && element["name"].IsScalar())
+            display += "." + element["name"].Scalar();
+          else
+            display += part;
           if (last)
           {
             error(where, display, "an override replaces a value, not a whole list element");
@@ -309,6 +313,12 @@ private:
         display += (display.empty() ? "" : ".") + part;
         if (last)
         {
+          // Setting one of a pair of alternatives replaces the other one given in the file
+          // (--set sleeve.radius=... on a file that gives the diameter).
+          for (const auto &[a, b] : alternatives)
+            for (const auto &[key, other] : {std::pair{a, b}, std::pair{b, a}})
+              if (part == key && current.IsMap() && current[other])
+                current.remove(other);
           current[part] = value;
           override_origin[display] = where;
         }
@@ -323,24 +333,34 @@ private:
     }
   }
 
+  // Keys that stand for each other: an override of one replaces the other.
+  static constexpr std::pair<const char *, const char *> alternatives[] = {{"radius", "diameter"}};
+
   static bool is_index(const std::string &part)
   {
     return part.size() >= 3 && part.front() == '[' && part.back() == ']' &&
            part.find_first_not_of("0123456789", 1) == part.size() - 1;
   }
 
-  static YAML::Node find_element(const YAML::Node &list, const std::string &part)
+  // The list element addressed by `part` (its name, or [index]); false if there is none.
+  static bool find_element(const YAML::Node &list, const std::string &part, YAML::Node &found)
   {
     if (is_index(part))
     {
-      const size_t index = std::stoul(part.substr(1, part.size() - 2));
-      return index < list.size() ? list[index] : YAML::Node();
+      const size_t index = part.size() > 12 ? list.size() : std::stoul(part.substr(1, part.size() - 2));
+      if (index >= list.size())
+        return false;
+      found.reset(list[index]);
+      return true;
     }
     for (const auto &element : list)
       if (element.IsMap() && element["name"] && element["name"].IsScalar() &&
           element["name"].Scalar() == part)
-        return element;
-    return YAML::Node();
+      {
+        found.reset(element);
+        return true;
+      }
+    return false;
   }
 
   static std::vector<std::string> element_names(const YAML::Node &list)
@@ -617,8 +637,9 @@ private:
                           (spec.type == KeyType::integer ? std::string("an integer")
                                                          : dimension_description(spec.dimension)) +
                           " " + spec.range_description() + ", found '" + written + "'";
-    if (spec.dimension != Dimension::dimensionless && spec.type == KeyType::quantity)
-      message += " (= " + format_quantity(v, spec.dimension) + ")";
+    const std::string pretty = format_quantity(v, spec.dimension);
+    if (spec.dimension != Dimension::dimensionless && spec.type == KeyType::quantity && pretty != written)
+      message += " (= " + pretty + ")";
     if (spec.dimension == Dimension::angle && written.find_first_not_of("0123456789.+-eE ") == std::string::npos)
       message += "; a bare number is in radians: write e.g. '90 deg'";
     throw UnitError(message);

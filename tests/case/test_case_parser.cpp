@@ -1,0 +1,333 @@
+// The case parser: the paper scenes load with the values the papers give, defaults match
+// the contract struct, overrides behave like file values, errors carry file:line:column,
+// the schema and the printed case agree, and printing then re-reading gives the same case.
+#include "case_format.h"
+#include "case_parser.h"
+#include "case_schema.h"
+#include "case_validation.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <set>
+#include <sstream>
+
+using namespace magbrush;
+namespace fs = std::filesystem;
+
+namespace {
+constexpr double pi = 3.14159265358979323846;
+const std::string source_dir = MAGBRUSH_SOURCE_DIR;
+
+std::string read_file(const std::string &path)
+{
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string error_of(const std::string &text, const std::vector<std::string> &overrides = {})
+{
+  try
+  {
+    parse_case_text(text, "t.yaml", overrides);
+  }
+  catch (const CaseError &e)
+  {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+const std::string minimal = source_dir + "/tests/case/valid/minimal_roller.yaml";
+
+double nip_relative_speed(const Case &c)
+{
+  return std::abs(c.sleeve->omega() * c.sleeve->radius + c.drum.omega() * c.drum.radius);
+}
+} // namespace
+
+TEST(CaseFiles, EveryCaseInCasesLoads)
+{
+  int n = 0;
+  for (const auto &entry : fs::directory_iterator(source_dir + "/cases"))
+    if (entry.path().extension() == ".yaml")
+    {
+      SCOPED_TRACE(entry.path().string());
+      EXPECT_NO_THROW(load_case(entry.path().string()));
+      ++n;
+    }
+  EXPECT_GE(n, 3);
+  for (const auto &entry : fs::directory_iterator(source_dir + "/tests/case/valid"))
+  {
+    SCOPED_TRACE(entry.path().string());
+    EXPECT_NO_THROW(load_case(entry.path().string()));
+  }
+}
+
+TEST(CaseFiles, KawamotoNipHasThePaperValues)
+{
+  const Case c = load_case(source_dir + "/cases/kawamoto_nip.yaml");
+  EXPECT_EQ(c.name, "kawamoto_nip");
+  ASSERT_TRUE(c.sleeve && c.roller && c.drum.present);
+  EXPECT_DOUBLE_EQ(c.sleeve->radius, 0.0125);
+  EXPECT_NEAR(c.sleeve->rpm, 219.0, 1e-12);
+  EXPECT_DOUBLE_EQ(c.drum.radius, 0.05);
+  EXPECT_NEAR(c.drum.rpm, -29.0, 1e-12);
+  EXPECT_NEAR(c.drum.gap, 400e-6, 1e-18);
+  // The paper's relative speed 0.135 m/s: pi (25 mm x 219 - 100 mm x 29) / 60 = 0.13483 m/s.
+  EXPECT_NEAR(c.sleeve->surface_speed(), pi * 0.025 * 219 / 60, 1e-12);
+  EXPECT_NEAR(nip_relative_speed(c), pi * (0.025 * 219 - 0.1 * 29) / 60, 1e-12);
+  EXPECT_NEAR(nip_relative_speed(c), 0.135, 0.0005);
+  ASSERT_EQ(c.populations.size(), 1u);
+  EXPECT_EQ(c.populations[0].count, 12300);
+  EXPECT_NEAR(c.populations[0].diameter_mean, 60e-6, 1e-18);
+  const Material &carrier = c.material("carrier");
+  EXPECT_DOUBLE_EQ(carrier.youngs_modulus, 1e9);
+  EXPECT_DOUBLE_EQ(carrier.poisson_ratio, 0.35);
+  EXPECT_DOUBLE_EQ(carrier.friction, 0.45);
+  EXPECT_DOUBLE_EQ(carrier.damping, 0.6);
+  EXPECT_EQ(carrier.polygon_angles, 12);
+  EXPECT_DOUBLE_EQ(carrier.mu_r, 3.9);
+  EXPECT_DOUBLE_EQ(c.material("wall").youngs_modulus, 5e10);
+  EXPECT_DOUBLE_EQ(c.material("wall").friction, 0.35);
+  EXPECT_DOUBLE_EQ(c.dem.time_step, 2e-8);
+  EXPECT_DOUBLE_EQ(c.dem.magnetic_refresh, 5e-6);
+  EXPECT_DOUBLE_EQ(c.dem.periodic_length, 1e-3);
+  EXPECT_EQ(c.applied_field.kind, AppliedField::Kind::roller);
+  EXPECT_FALSE(c.electric.enabled);
+  ASSERT_EQ(c.roller->poles.size(), 5u);
+  EXPECT_EQ(c.roller->poles[0].name, "S1");
+  EXPECT_LT(c.roller->poles[0].strength, 0.0);
+  EXPECT_NEAR(c.roller->poles[0].angle, c.drum.angle, 1e-12); // development pole faces the drum
+}
+
+TEST(CaseFiles, BrushCompressionAndItsCarrierVariants)
+{
+  const std::string path = source_dir + "/cases/kawamoto_brush_compression.yaml";
+  const Case c = load_case(path);
+  EXPECT_EQ(c.scene, "box");
+  EXPECT_EQ(c.applied_field.kind, AppliedField::Kind::uniform);
+  EXPECT_DOUBLE_EQ(c.applied_field.uniform_magnitude, 0.13);
+  EXPECT_DOUBLE_EQ(c.dem.periodic_length_x, 2e-3);
+  EXPECT_DOUBLE_EQ(c.dem.gravity[2], -9.81);
+  ASSERT_EQ(c.planes.size(), 2u);
+  EXPECT_EQ(c.planes[1].path.back().second[0], 1.5e-3); // slides 1.5 mm sideways
+  EXPECT_EQ(c.populations[0].count, 4420);
+  const Case c42 = load_case(path, {"populations.carrier.diameter=42um", "populations.carrier.diameter_std=4.2um",
+                                    "populations.carrier.count=13700"});
+  EXPECT_EQ(c42.populations[0].count, 13700);
+  EXPECT_NEAR(c42.populations[0].diameter_mean, 42e-6, 1e-18);
+}
+
+TEST(CaseFiles, KweonFullRoller)
+{
+  const Case c = load_case(source_dir + "/cases/kweon_full_roller.yaml");
+  EXPECT_TRUE(c.electric.enabled);
+  EXPECT_GE(std::abs(c.electric.bias), 500.0);
+  EXPECT_LE(std::abs(c.electric.bias), 800.0);
+  ASSERT_EQ(c.blades.size(), 2u);
+  EXPECT_TRUE(c.blades[0].is_doctor_blade);
+  EXPECT_NEAR(c.blades[0].gap, 0.5e-3, 1e-15);
+  // The generated blade's polygon really is `gap` from the sleeve.
+  EXPECT_NEAR(polygon_distance_to_point(c.blades[0].polygon, {0, 0}) - c.sleeve->radius, 0.5e-3, 1e-12);
+  EXPECT_GT(polygon_signed_area(c.blades[1].polygon), 0.0);
+  ASSERT_EQ(c.populations.size(), 2u);
+  EXPECT_EQ(c.populations[1].kind, ParticleKind::toner);
+  EXPECT_NEAR(c.populations[1].charge_to_mass, -30e-3, 1e-15);
+  EXPECT_TRUE(fs::exists(c.measured_flux_file)) << c.measured_flux_file;
+  // polarity + unsigned strength = signed strength
+  EXPECT_LT(c.roller->poles[0].strength, 0.0);
+  EXPECT_GT(c.roller->poles[1].strength, 0.0);
+}
+
+TEST(CaseParser, DefaultsAgreeWithTheContractStruct)
+{
+  const Case c = load_case(minimal);
+  const FieldSettings f;
+  EXPECT_DOUBLE_EQ(c.field.mesh_size_far, f.mesh_size_far);
+  EXPECT_DOUBLE_EQ(c.field.mesh_size_sleeve, f.mesh_size_sleeve);
+  EXPECT_DOUBLE_EQ(c.field.mesh_size_gap, f.mesh_size_gap);
+  EXPECT_EQ(c.field.element_degree, f.element_degree);
+  EXPECT_DOUBLE_EQ(c.field.outer_radius_factor, f.outer_radius_factor);
+  EXPECT_DOUBLE_EQ(c.field.grid_radial_spacing, f.grid_radial_spacing);
+  EXPECT_NEAR(c.field.grid_angular_spacing, f.grid_angular_spacing, 1e-15);
+  EXPECT_DOUBLE_EQ(c.field.grid_electric_spacing, f.grid_electric_spacing);
+  EXPECT_EQ(c.field.output_dir, f.output_dir);
+  const DemSettings d;
+  EXPECT_DOUBLE_EQ(c.dem.time_step_safety, d.time_step_safety);
+  EXPECT_EQ(c.dem.magnetic_model, d.magnetic_model);
+  EXPECT_DOUBLE_EQ(c.dem.magnetic_cutoff, d.magnetic_cutoff);
+  EXPECT_DOUBLE_EQ(c.dem.magnetic_tolerance, d.magnetic_tolerance);
+  EXPECT_DOUBLE_EQ(c.dem.verlet_skin, d.verlet_skin);
+  EXPECT_DOUBLE_EQ(c.dem.air_viscosity, d.air_viscosity);
+  EXPECT_EQ(c.dem.gravity, d.gravity);
+  EXPECT_EQ(c.dem.seed, d.seed);
+  EXPECT_DOUBLE_EQ(c.dem.max_overlap_fraction, d.max_overlap_fraction);
+  EXPECT_EQ(c.dem.restitution_model, d.restitution_model);
+  EXPECT_DOUBLE_EQ(c.dem.max_kinetic_energy_growth, d.max_kinetic_energy_growth);
+  const Material m;
+  EXPECT_DOUBLE_EQ(c.material("wall").poisson_ratio, m.poisson_ratio);
+  EXPECT_DOUBLE_EQ(c.material("wall").restitution, m.restitution);
+  const OutputSettings o;
+  EXPECT_EQ(c.output.directory, o.directory);
+  EXPECT_EQ(c.name, "minimal_roller"); // the file stem
+  EXPECT_EQ(c.roller->poles[0].shape_factor, 10.0);
+  EXPECT_EQ(c.drum.pc_eps_r, Drum{}.pc_eps_r);
+}
+
+TEST(CaseParser, OverridesUseTheSameConversionAndNames)
+{
+  const Case c = load_case(minimal, {"drum.gap=0.3mm", "roller.poles.S1.angle=95deg", "roller.poles.[0].strength=1.2e5",
+                                     "sleeve.rpm=-2 rad/s", "electric.bias=-500 V"});
+  EXPECT_NEAR(c.drum.gap, 0.3e-3, 1e-18);
+  EXPECT_NEAR(c.roller->poles[1].angle, 95 * pi / 180, 1e-15);
+  EXPECT_DOUBLE_EQ(c.roller->poles[0].strength, 1.2e5);
+  EXPECT_NEAR(c.sleeve->rpm, -2 * 60 / (2 * pi), 1e-12);
+  EXPECT_TRUE(c.electric.enabled); // the override created the section
+  EXPECT_DOUBLE_EQ(c.electric.bias, -500.0);
+  // A later override wins.
+  EXPECT_NEAR(load_case(minimal, {"drum.gap=1mm", "drum.gap=2mm"}).drum.gap, 2e-3, 1e-18);
+  // Errors name the override, not the file.
+  const std::string e = error_of(read_file(minimal), {"roller.poles.S1.angle=-5deg"});
+  EXPECT_NE(e.find("--set 'roller.poles.S1.angle=-5deg': roller.poles.S1.angle: expected an angle in [0 deg, 360 deg)"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(error_of(read_file(minimal), {"sleeve.radius"}).find("expected key.path=value"), std::string::npos);
+  EXPECT_NE(error_of(read_file(minimal), {"dem.seeed=3"}).find("did you mean 'seed'?"), std::string::npos);
+}
+
+TEST(CaseParser, ErrorsCarryFileLineColumnPathExpectedAndFound)
+{
+  const std::string text = "sleeve:\n  radius: 10 mm\n  rpm: 25 mm\n";
+  const std::string e = error_of(text);
+  EXPECT_NE(e.find("t.yaml:3:8: sleeve.rpm: expected an angular velocity (e.g. 219 rpm), found '25 mm': that is a length"),
+            std::string::npos)
+      << e;
+  // Several errors in one go, in file order.
+  const std::string many = error_of("sleeve:\n  radius: 10 rpm\n  rpn: 3 rpm\nrollr: {}\n");
+  EXPECT_NE(many.find("(3 errors)"), std::string::npos) << many;
+  EXPECT_LT(many.find("t.yaml:2:11"), many.find("t.yaml:3:3"));
+  EXPECT_NE(many.find("did you mean 'rpm'?"), std::string::npos);
+  EXPECT_NE(many.find("t.yaml:4:1: rollr: unknown key 'rollr' (did you mean 'roller'?)"), std::string::npos) << many;
+}
+
+TEST(CaseParser, DidYouMean)
+{
+  const std::vector<std::string> keys{"radius", "diameter", "thickness", "rpm"};
+  EXPECT_EQ(did_you_mean("diamter", keys), "diameter");   // deletion
+  EXPECT_EQ(did_you_mean("raidus", keys), "radius");      // transposition
+  EXPECT_EQ(did_you_mean("Thickness", keys), "thickness"); // case
+  EXPECT_EQ(did_you_mean("rpn", keys), "rpm");
+  EXPECT_EQ(did_you_mean("diam", keys), "diameter");      // prefix
+  EXPECT_EQ(did_you_mean("colour", keys), "");            // nothing close
+}
+
+TEST(CaseParser, GeometryNonsenseIsCaughtInProcess)
+{
+  const std::string base = read_file(minimal);
+  EXPECT_NE(error_of(base, {"drum.gap=-0.1mm"}).find("cut into the sleeve"), std::string::npos);
+  EXPECT_NE(error_of(base, {"roller.shaft_radius=9.5mm"}).find("must be smaller than the magnet"), std::string::npos);
+  EXPECT_NE(error_of(base, {"sleeve.thickness=1.5mm"}).find("must fit inside the sleeve"), std::string::npos);
+  EXPECT_NE(error_of(base, {"roller.poles.S1.angle=5deg"}).find("at least 10 deg apart"), std::string::npos);
+  EXPECT_NE(error_of(base, {"populations.carrier.diameter_std=20um"}).find("mean - 3 std"), std::string::npos);
+  EXPECT_NE(error_of(base, {"field.probe_radius=8mm"}).find("inside the magnet"), std::string::npos);
+  EXPECT_NE(error_of(base, {"dem.time_step=1us", "dem.duration=0.5us"}).find("shorter than one time step"),
+            std::string::npos);
+  // Geometry errors are collected too.
+  const std::string two = error_of(base, {"drum.gap=-1mm", "roller.shaft_radius=9.5mm"});
+  EXPECT_NE(two.find("(2 errors)"), std::string::npos) << two;
+}
+
+TEST(CaseParser, GeneratedBladePolygon)
+{
+  const auto p = generated_blade_polygon(0.01, pi / 2, 0.5e-3, 1e-3, 5e-3);
+  ASSERT_EQ(p.size(), 4u);
+  EXPECT_NEAR(polygon_distance_to_point(p, {0, 0}), 0.0105, 1e-15);
+  EXPECT_NEAR(polygon_signed_area(p), 5e-6, 1e-18); // counter-clockwise, thickness x length
+  EXPECT_TRUE(polygon_is_simple(p));
+  EXPECT_FALSE(polygon_is_simple({{0, 0}, {1, 1}, {1, 0}, {0, 1}}));
+}
+
+TEST(CaseSchema, PrintedEntriesAndSchemaAgree)
+{
+  // Every printed entry names a schema key, and a case using every key prints every leaf
+  // (apart from the alternatives folded into others).
+  const Case c = load_case(source_dir + "/tests/case/valid/full_roller.yaml");
+  std::set<std::string> printed;
+  for (const auto &e : resolved_entries(c))
+  {
+    EXPECT_NE(find_key_spec(e.pattern), nullptr) << e.pattern;
+    printed.insert(e.pattern);
+  }
+  const std::set<std::string> folded{"sleeve.diameter", "drum.diameter", "roller.shape_factor",
+                                     "roller.poles[].polarity", "blades[].angle", "blades[].thickness",
+                                     "blades[].length", "electric.image.dark_potential",
+                                     "electric.image.light_potential", "planes[].path[].time",
+                                     "planes[].path[].displacement", "planes[].name", "planes[].point",
+                                     "planes[].normal", "planes[].material"};
+  for (const auto &k : case_schema())
+    if (!k.is_container() && !folded.count(k.path))
+    {
+      EXPECT_TRUE(printed.count(k.path)) << k.path << " is in the schema but not printed";
+    }
+  // Schema sanity: children have parents; defaults of leaves parse.
+  for (const auto &k : case_schema())
+  {
+    const std::string parent = parent_pattern(k.path);
+    if (!parent.empty())
+    {
+      std::string container = parent;
+      if (container.size() > 2 && container.substr(container.size() - 2) == "[]")
+        container = container.substr(0, container.size() - 2);
+      if (container.size() > 2 && container.substr(container.size() - 2) == ".*")
+        container = container.substr(0, container.size() - 2);
+      EXPECT_NE(find_key_spec(container), nullptr) << k.path;
+    }
+    EXPECT_FALSE(k.doc.empty()) << k.path;
+  }
+}
+
+TEST(CaseFormat, PrintedCaseReadsBackToTheSameCase)
+{
+  // Every "path = value" line of the printed case, given back as an override, must leave the
+  // case unchanged to the printed precision (6 digits).
+  for (const char *file : {"/cases/kawamoto_nip.yaml", "/cases/kawamoto_brush_compression.yaml"})
+  {
+    SCOPED_TRACE(file);
+    const Case c = load_case(source_dir + file);
+    std::vector<std::string> overrides;
+    for (const auto &e : resolved_entries(c))
+      if (e.path != "measured_flux_file" && e.path.find(".path[") == std::string::npos)
+        overrides.push_back(e.path + "=" + e.pretty);
+    const Case again = load_case(source_dir + file, overrides);
+    const auto a = resolved_entries(c), b = resolved_entries(again);
+    ASSERT_EQ(a.size(), b.size());
+    const std::regex number(R"([-+]?[0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)");
+    for (size_t i = 0; i < a.size(); ++i)
+    {
+      EXPECT_EQ(a[i].path, b[i].path);
+      std::vector<double> x, y;
+      for (auto it = std::sregex_iterator(a[i].exact.begin(), a[i].exact.end(), number); it != std::sregex_iterator(); ++it)
+        x.push_back(std::stod(it->str()));
+      for (auto it = std::sregex_iterator(b[i].exact.begin(), b[i].exact.end(), number); it != std::sregex_iterator(); ++it)
+        y.push_back(std::stod(it->str()));
+      ASSERT_EQ(x.size(), y.size()) << a[i].path;
+      for (size_t k = 0; k < x.size(); ++k)
+        EXPECT_NEAR(x[k], y[k], 1e-5 * std::abs(x[k])) << a[i].path;
+    }
+  }
+}
+
+TEST(CaseFormat, SchemaReferenceIsUpToDate)
+{
+  // docs/case_reference.md is generated by `magbrush check --explain --markdown`.
+  const std::string doc = read_file(source_dir + "/docs/case_reference.md");
+  EXPECT_EQ(doc, format_schema(true)) << "regenerate: build/bin/magbrush check --explain --markdown > docs/case_reference.md";
+  for (const auto &k : case_schema())
+    EXPECT_NE(format_schema(false).find(last_component(k.path)), std::string::npos);
+}

@@ -184,6 +184,14 @@ TEST(CmdFlux, FitRecoversASyntheticScanWithOffsetInOtherUnits)
   const double reported = std::atof(r.output.c_str() + at + 15);
   std::printf("synthetic scan: encoder offset %.4f deg (true 2.5)\n", reported);
   EXPECT_NEAR(reported, 2.5, 0.05);
+
+  // The same with the offset given (--angle-offset) and every angle free (--no-offset).
+  const CommandResult given = run_magbrush(case_file.string() + " --measured " + scan.string() +
+                                           " --angle-offset 2.5deg --no-offset -o " +
+                                           (dir / "given").string() + " --fit --no-fem-check --no-plot");
+  ASSERT_EQ(given.status, 0) << given.output;
+  const Case fitted_given = load_case((dir / "given" / "example_roller_fitted.yaml").string());
+  expect_poles_near(*fitted_given.roller, truth, 0.1 * deg, 0.01, 0.01);
 }
 
 TEST(CmdFlux, UsesTheFiniteElementProfileWhenPresent)

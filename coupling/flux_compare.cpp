@@ -51,6 +51,37 @@ ComponentErrors errors_of(const std::vector<double> &angle, const std::vector<do
   return e;
 }
 
+// Extrema of B that stand out (|B| ≥ 20 % of the largest, the largest |B| of their sign within
+// ±10°) and lie more than 10° from every matched pole peak.
+std::vector<PeakMatch> unmatched_extrema(const std::vector<double> &angle, const std::vector<double> &B,
+                                         const std::vector<PeakMatch> &matched)
+{
+  const double radius = 10.0 * pi / 180.0;
+  double largest = 0.0;
+  for (double b : B)
+    largest = std::max(largest, std::abs(b));
+  std::vector<PeakMatch> out;
+  for (size_t k = 0; k < B.size(); ++k)
+  {
+    if (std::abs(B[k]) < 0.2 * largest)
+      continue;
+    bool extremum = true;
+    for (size_t j = 0; j < B.size() && extremum; ++j)
+      if (j != k && std::abs(wrap_pm_pi(angle[j] - angle[k])) <= radius &&
+          B[j] * B[k] > 0.0 && std::abs(B[j]) > std::abs(B[k]))
+        extremum = false;
+    if (!extremum)
+      continue;
+    bool explained = false;
+    for (const auto &m : matched)
+      explained = explained || (m.found && std::abs(wrap_pm_pi(m.angle - angle[k])) <= radius &&
+                                m.value * B[k] > 0.0);
+    if (!explained)
+      out.push_back({true, wrap_0_2pi(angle[k]), B[k]});
+  }
+  return out;
+}
+
 } // namespace
 
 std::vector<PeakMatch> find_pole_peaks(const std::vector<Pole> &poles,
@@ -148,6 +179,7 @@ FluxComparison compare_flux(const FluxScan &scan, const std::vector<double> &com
   const auto measured = find_pole_peaks(poles, scan.angle, scan.Bn);
   for (size_t i = 0; i < poles.size(); ++i)
     c.peaks.push_back({poles[i].name, computed[i], measured[i]});
+  c.unmatched = unmatched_extrema(scan.angle, scan.Bn, measured);
   return c;
 }
 
@@ -190,6 +222,14 @@ std::string format_peaks(const FluxComparison &c)
                     100.0 * (std::abs(p.measured.value) - std::abs(p.computed.value)) /
                         std::abs(p.computed.value));
     std::snprintf(buf, sizeof buf, "  %-5s  %s    %s   %s\n", p.pole.c_str(), a, b, d);
+    out << buf;
+  }
+  for (const auto &u : c.unmatched)
+  {
+    std::snprintf(buf, sizeof buf,
+                  "  note: the scan has a %s peak of %.2f mT at %.1f deg that no pole of the case "
+                  "accounts for (a pole missing from the case, or one with the wrong sign?)\n",
+                  u.value > 0 ? "north (Bn > 0)" : "south (Bn < 0)", u.value * 1e3, u.angle * to_deg);
     out << buf;
   }
   return out.str();

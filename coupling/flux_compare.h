@@ -48,6 +48,9 @@ struct FluxComparison
   ComponentErrors Bn, Bt;                  // Bt only when the scan has it
   bool has_tangential = false;
   std::vector<PolePeakComparison> peaks;
+  // Clear extrema of the measured Bn (above 20 % of its largest magnitude, the largest within
+  // ±10°) that no pole of the case accounts for: a pole missing from the case, or a wrong sign.
+  std::vector<PeakMatch> unmatched;
 };
 
 FluxComparison compare_flux(const FluxScan &scan, const std::vector<double> &computed_Bn,

@@ -342,3 +342,21 @@ TEST(PoleFit, BnOnlyScanOverPartOfTheTurn)
   EXPECT_LT(w.strength, 0.02);
   EXPECT_LT(w.pull, 5.0);
 }
+
+TEST(FluxCompare, FlagsAPeakNoPoleAccountsFor)
+{
+  // The case forgets N2: the scan's north peak near 288° is reported as unmatched.
+  const FluxScan scan = read_flux_scan(example_scan_path());
+  Roller incomplete = example_roller();
+  incomplete.poles.pop_back();
+  std::vector<double> Bn, Bt;
+  MultipoleRing(incomplete).profile(10e-3, scan.angle, Bn, Bt);
+  const FluxComparison c = compare_flux(scan, Bn, Bt, incomplete.poles);
+  ASSERT_EQ(c.unmatched.size(), 1u);
+  EXPECT_NEAR(c.unmatched[0].angle, 288 * deg, 1.5 * deg);
+  EXPECT_GT(c.unmatched[0].value, 0.05);
+  EXPECT_NE(format_peaks(c).find("no pole of the case"), std::string::npos);
+  // The complete case explains every peak.
+  MultipoleRing(example_roller()).profile(10e-3, scan.angle, Bn, Bt);
+  EXPECT_TRUE(compare_flux(scan, Bn, Bt, example_roller().poles).unmatched.empty());
+}

@@ -17,7 +17,26 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A scratch directory per test (ctest runs the tests of this file as parallel processes).
+// A scratch directory per test (ctest runs the tests of this file as parallel processes),
+// removed when the test program ends.
+std::vector<fs::path> &scratch_dirs()
+{
+  static std::vector<fs::path> dirs;
+  return dirs;
+}
+
+struct RemoveScratchDirs : ::testing::Environment
+{
+  void TearDown() override
+  {
+    std::error_code ignored;
+    for (const auto &d : scratch_dirs())
+      fs::remove_all(d, ignored);
+  }
+};
+[[maybe_unused]] ::testing::Environment *const remove_scratch_dirs =
+    ::testing::AddGlobalTestEnvironment(new RemoveScratchDirs);
+
 fs::path scratch_dir()
 {
   const auto *info = ::testing::UnitTest::GetInstance()->current_test_info();
@@ -25,6 +44,7 @@ fs::path scratch_dir()
                  ("magbrush_fieldgrid_" + std::to_string(::getpid()) + "_" + info->name());
   fs::remove_all(dir);
   fs::create_directories(dir);
+  scratch_dirs().push_back(dir);
   return dir;
 }
 
@@ -553,4 +573,34 @@ TEST(FieldGridFile, CaseProvenanceDetectsAMovedPole)
     EXPECT_TRUE(contains(e.differing_key, "N1")) << e.differing_key;
     EXPECT_TRUE(contains(e.differing_key, "angle")) << e.differing_key;
   }
+}
+
+// Files touched by Python tools carry variable-length strings (h5py's default): accepted.
+TEST(FieldGridFile, ReaderAcceptsVariableLengthStrings)
+{
+  const fs::path path = scratch_dir() / "f.h5";
+  write_magnetic_grid(path, some_polar_grid(), some_provenance());
+  {
+    H5File f(path);
+    const auto set_vl = [](hid_t obj, const char *name, const char *value) {
+      H5Adelete(obj, name);
+      hid_t type = H5Tcopy(H5T_C_S1);
+      H5Tset_size(type, H5T_VARIABLE);
+      H5Tset_cset(type, H5T_CSET_UTF8);
+      hid_t space = H5Screate(H5S_SCALAR);
+      hid_t attr = H5Acreate2(obj, name, type, space, H5P_DEFAULT, H5P_DEFAULT);
+      H5Awrite(attr, type, &value);
+      H5Aclose(attr);
+      H5Sclose(space);
+      H5Tclose(type);
+    };
+    set_vl(f.id, "kind", "magnetic");
+    set_vl(f.id, "case_hash", "from-python");
+    hid_t set = H5Dopen2(f.id, "/polar/A_z", H5P_DEFAULT);
+    set_vl(set, "units", "T*m");
+    H5Dclose(set);
+  }
+  const MagneticGridFile in = read_magnetic_grid(path);
+  EXPECT_EQ(in.info.provenance.case_hash, "from-python");
+  EXPECT_EQ(in.grid.A_z, some_polar_grid().A_z);
 }

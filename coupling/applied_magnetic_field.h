@@ -81,6 +81,24 @@ public:
     }
   }
 
+  // As evaluate(), but never throws: false (B = 0, ∇B = 0) inside the sleeve. For OpenMP
+  // loops, where an exception must not escape the parallel region: count the failures and
+  // stop the run after the loop with a message.
+  bool try_evaluate(const Vec3 &x, double t, Vec3 &B, std::array<Vec3, 3> &gradB) const noexcept
+  {
+    if (kind_ != Kind::roller)
+    {
+      evaluate(x, t, B, gradB);
+      return true;
+    }
+    if (!grid_->try_evaluate(x, B, gradB))
+      return false;
+    const double s = ramp(t);
+    if (s != 1.0)
+      scale(s, B, gradB);
+    return true;
+  }
+
   Vec3 field(const Vec3 &x, double t) const
   {
     Vec3 B;

@@ -92,6 +92,13 @@ TEST(AppliedMagneticField, RollerKindIsTheGridInterpolatorTimesTheRamp)
       EXPECT_EQ(ga[i][j], g0[i][j]);
   }
   EXPECT_THROW(f.field({0, 1e-3, 0}, 1.0), FieldLookupError);
+  Vec3 Bt;
+  std::array<Vec3, 3> gt;
+  EXPECT_FALSE(f.try_evaluate({0, 1e-3, 0}, 1.0, Bt, gt));
+  EXPECT_EQ(Bt, (Vec3{0, 0, 0}));
+  ASSERT_TRUE(f.try_evaluate(x, 0.4e-3, Bt, gt));
+  EXPECT_EQ(Bt, B);
+  EXPECT_EQ(gt, g);
 }
 
 // The DEM's entry point: a roller case reads its grid and checks its provenance; a case whose

@@ -2,6 +2,7 @@
 #include "case_format.h"
 
 #include "case_schema.h"
+#include "multipole_ring.h"
 #include "units.h"
 
 #include <algorithm>
@@ -263,44 +264,6 @@ std::string format_case(const Case &c)
 
 namespace {
 
-// Exterior radial field of the Gaussian pole model for mu_r = 1 and no iron shaft: each
-// Fourier harmonic n of M_r(theta) is a multipole ring (DESIGN.md, exact check), whose
-// radial field at radius r is mu0 n/(2(n+1)) (Ro/r)^(n+1) (1 - rho^(n+1)) times the harmonic.
-double estimate_radial_field(const Roller &r, double radius, double theta)
-{
-  const int samples = 1440, harmonics = 80;
-  std::vector<double> m(samples);
-  for (int k = 0; k < samples; ++k)
-  {
-    const double t = 2.0 * pi * k / samples;
-    double s = 0.0;
-    for (const auto &p : r.poles)
-    {
-      const double w = std::remainder(t - p.angle, 2.0 * pi);
-      s += p.strength * std::exp(-p.shape_factor * w * w);
-    }
-    m[k] = s;
-  }
-  const double rho = r.shaft_radius / r.magnet_radius;
-  double b = 0.0;
-  for (int n = 1; n <= harmonics; ++n)
-  {
-    double a = 0.0, s = 0.0;
-    for (int k = 0; k < samples; ++k)
-    {
-      const double t = 2.0 * pi * k / samples;
-      a += m[k] * std::cos(n * t);
-      s += m[k] * std::sin(n * t);
-    }
-    a *= 2.0 / samples;
-    s *= 2.0 / samples;
-    const double gain = mu0 * n / (2.0 * (n + 1)) * std::pow(r.magnet_radius / radius, n + 1) *
-                        (1.0 - std::pow(rho, n + 1));
-    b += gain * (a * std::cos(n * theta) + s * std::sin(n * theta));
-  }
-  return b;
-}
-
 std::string fmt(const char *format, double v)
 {
   char b[64];
@@ -335,23 +298,28 @@ std::string format_derived(const Case &c)
   }
   if (c.roller && c.sleeve && !c.roller->poles.empty())
   {
-    const Pole *peak = &c.roller->poles.front();
-    for (const auto &p : c.roller->poles)
-      if (std::abs(p.strength) > std::abs(peak->strength))
-        peak = &p;
-    out << "pole field on the sleeve (estimate: Fourier multipole rings, mu_r = 1 everywhere):\n";
-    for (const auto &p : c.roller->poles)
+    // The exact field of the pole model (multipole_ring.h), the same one the field solver is
+    // verified against: normal flux density on the sleeve surface at each pole and at the nip.
+    try
     {
-      const double b = estimate_radial_field(*c.roller, c.sleeve->radius, p.angle);
-      out << "  " << p.name << " at " << format_quantity(p.angle, Dimension::angle) << ": Bn = "
-          << format_quantity(b, Dimension::magnetic_flux_density) << ", B^2/2mu0 = "
-          << format_quantity(b * b / (2.0 * mu0), Dimension::pressure) << "\n";
+      const MultipoleRing ring(*c.roller);
+      const auto B = [&](double theta) { return ring.field_polar(c.sleeve->radius, theta).Br; };
+      out << "sleeve-surface field of the pole model (exact multipole ring, " << ring.harmonic_count()
+          << " harmonics):\n";
+      for (const auto &p : c.roller->poles)
+      {
+        const double b = B(p.angle);
+        out << "  " << p.name << " at " << format_quantity(p.angle, Dimension::angle) << ": Bn = "
+            << format_quantity(b, Dimension::magnetic_flux_density)
+            << ", magnetic pressure B^2/2mu0 = " << format_quantity(b * b / (2.0 * mu0), Dimension::pressure) << "\n";
+      }
+      if (c.drum.present)
+        out << "  at the nip (" << format_quantity(c.drum.angle, Dimension::angle)
+            << "): Bn = " << format_quantity(B(c.drum.angle), Dimension::magnetic_flux_density) << "\n";
     }
-    if (c.drum.present)
+    catch (const std::exception &e)
     {
-      const double b = estimate_radial_field(*c.roller, c.sleeve->radius, c.drum.angle);
-      out << "  at the nip (" << format_quantity(c.drum.angle, Dimension::angle)
-          << "): Bn = " << format_quantity(b, Dimension::magnetic_flux_density) << "\n";
+      out << "sleeve-surface field: not available (" << e.what() << ")\n";
     }
   }
   if (c.applied_field.kind == AppliedField::Kind::uniform)

@@ -5,10 +5,13 @@
 #include "case_parser.h"
 #include "case_schema.h"
 #include "case_validation.h"
+#include "multipole_ring.h"
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -330,4 +333,52 @@ TEST(CaseFormat, SchemaReferenceIsUpToDate)
   EXPECT_EQ(doc, format_schema(true)) << "regenerate: build/bin/magbrush check --explain --markdown > docs/case_reference.md";
   for (const auto &k : case_schema())
     EXPECT_NE(format_schema(false).find(last_component(k.path)), std::string::npos);
+}
+
+namespace {
+// The synthetic gaussmeter scan shipped with the cases: angle_deg, Bn_mT, Bt_mT.
+std::vector<std::array<double, 3>> read_scan()
+{
+  std::ifstream in(source_dir + "/cases/data/sleeve_profile_example.csv");
+  std::vector<std::array<double, 3>> rows;
+  for (std::string line; std::getline(in, line);)
+  {
+    std::array<double, 3> r;
+    if (line.empty() || line[0] == '#' || std::sscanf(line.c_str(), "%lf,%lf,%lf", &r[0], &r[1], &r[2]) != 3)
+      continue;
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+// Largest |Bn| difference between the case's roller (exact multipole ring at the sleeve
+// surface) and the scan, which was generated independently from the roller in its header.
+double max_scan_deviation(const Case &c)
+{
+  const MultipoleRing ring(*c.roller);
+  double worst = 0.0;
+  for (const auto &row : read_scan())
+    worst = std::max(worst, std::abs(ring.field_polar(c.sleeve->radius, row[0] * pi / 180).Br * 1e3 - row[1]));
+  return worst;
+}
+} // namespace
+
+TEST(CaseFiles, RollersReproduceTheExampleScan)
+{
+  ASSERT_EQ(read_scan().size(), 360u);
+  // Kweon: the scan's roller at its own scale (probe radius 10 mm = sleeve surface).
+  // The scan has 0.4 mT of noise per point: 360 points stay within about 4 sigma.
+  EXPECT_LT(max_scan_deviation(load_case(source_dir + "/cases/kweon_full_roller.yaml")), 1.6);
+  // Kawamoto: the same roller scaled by 1.25 onto the 12.5 mm sleeve; uniform scaling of a
+  // magnetised body leaves B unchanged at corresponding points.
+  EXPECT_LT(max_scan_deviation(load_case(source_dir + "/cases/kawamoto_nip.yaml")), 1.6);
+}
+
+TEST(CaseFiles, KawamotoDevelopmentPoleFieldAtTheNip)
+{
+  const Case c = load_case(source_dir + "/cases/kawamoto_nip.yaml");
+  const MultipoleRing ring(*c.roller);
+  const double b = std::abs(ring.field_polar(c.sleeve->radius, c.drum.angle).Br);
+  EXPECT_GT(b, 0.095);
+  EXPECT_LT(b, 0.130);
 }

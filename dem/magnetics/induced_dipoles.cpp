@@ -46,6 +46,21 @@ InducedDipoles::InducedDipoles(const MagneticSettings &settings, const std::arra
   for (double L : box_)
     if (L < 0.0)
       throw std::invalid_argument("magnetics: periodic box lengths must be ≥ 0 (0 = open).");
+  if (settings_.slab_tail_correction)
+  {
+    int open = 0;
+    for (int d = 0; d < 3; ++d)
+      if (box_[d] == 0.0)
+      {
+        normal_axis_ = d;
+        ++open;
+      }
+    if (open != 1)
+      throw std::invalid_argument(
+        "magnetics: the slab tail correction needs a slab periodic along exactly two axes and "
+        "open along the third; found " + std::to_string(3 - open) +
+        " periodic axes. Switch slab_tail_correction off for this box.");
+  }
 }
 
 double InducedDipoles::cutoff_length(const BeadArrays &beads) const
@@ -82,6 +97,8 @@ MagneticStats InducedDipoles::compute(const BeadArrays &beads, const AppliedFiel
   refresh_list_if_needed(beads, cutoff, stats);
   evaluate_applied_field(beads, field);
   evaluate_pair_tensors(beads, cutoff, stats);
+  if (settings_.slab_tail_correction)
+    prepare_tail(beads, cutoff);
   solve_dipoles(beads, stats);
   if (settings_.model == DipoleModel::corrected)
     prepare_correction_tables();
@@ -186,6 +203,9 @@ void InducedDipoles::gather_local_field(std::size_t b, const std::vector<double>
   B[0] = B0_[3 * b];
   B[1] = B0_[3 * b + 1];
   B[2] = B0_[3 * b + 2];
+  if (normal_axis_ >= 0)
+    for (int d = 0; d < 3; ++d)
+      B[d] += tail_B_[3 * b + d];
   const auto &begin = list_.incident_begin();
   const auto &pair_of = list_.incident_pair();
   const auto &first = list_.incident_first();
@@ -218,6 +238,8 @@ void InducedDipoles::solve_dipoles(const BeadArrays &beads, MagneticStats &stats
   {
     // Dipoles from the applied field only; the local field is needed only for the papers'
     // torque diagnostic.
+    if (normal_axis_ >= 0)
+      evaluate_tail(p_);
     if (settings_.torque == TorqueModel::paper)
     {
 #pragma omp parallel for schedule(static) if (n >= parallel_threshold)
@@ -237,6 +259,8 @@ void InducedDipoles::solve_dipoles(const BeadArrays &beads, MagneticStats &stats
   stats.converged = false;
   for (int sweep = 1; sweep <= settings_.max_sweeps; ++sweep)
   {
+    if (normal_axis_ >= 0)
+      evaluate_tail(p_);
     double max_change2 = 0.0, max_p2 = 0.0;
 #pragma omp parallel for schedule(static) reduction(max : max_change2, max_p2) if (n >= parallel_threshold)
     for (long b = 0; b < static_cast<long>(n); ++b)
@@ -262,6 +286,82 @@ void InducedDipoles::solve_dipoles(const BeadArrays &beads, MagneticStats &stats
     {
       stats.converged = true;
       break;
+    }
+  }
+  if (normal_axis_ >= 0)
+    evaluate_tail(p_); // the tail force uses the final dipoles
+}
+
+void InducedDipoles::prepare_tail(const BeadArrays &beads, double cutoff)
+{
+  const std::size_t n = beads.n;
+  const double *u = normal_axis_ == 0 ? beads.x : normal_axis_ == 1 ? beads.y : beads.z;
+  tail_area_ = 1.0;
+  for (int d = 0; d < 3; ++d)
+    if (d != normal_axis_)
+      tail_area_ *= box_[d];
+  tail_cutoff_ = cutoff;
+  // Sort along the open axis (ties by index: deterministic), centred to limit cancellation.
+  tail_order_.resize(n);
+  for (std::size_t b = 0; b < n; ++b)
+    tail_order_[b] = static_cast<std::uint32_t>(b);
+  std::sort(tail_order_.begin(), tail_order_.end(), [&](std::uint32_t i, std::uint32_t j) {
+    return u[i] < u[j] || (u[i] == u[j] && i < j);
+  });
+  const double centre = 0.5 * (u[tail_order_.front()] + u[tail_order_.back()]);
+  tail_u_.resize(n);
+  for (std::size_t k = 0; k < n; ++k)
+    tail_u_[k] = u[tail_order_[k]] - centre;
+  // Window of every bead (in sorted positions): the sheets with |h| < R_c.
+  tail_lo_.resize(n);
+  tail_hi_.resize(n);
+  for (std::size_t k = 0; k < n; ++k)
+  {
+    const double uk = tail_u_[k];
+    tail_lo_[k] = std::lower_bound(tail_u_.begin(), tail_u_.end(), uk - cutoff) - tail_u_.begin();
+    tail_hi_[k] = std::upper_bound(tail_u_.begin(), tail_u_.end(), uk + cutoff) - tail_u_.begin();
+  }
+  tail_S0_.resize(3 * (n + 1));
+  tail_S1_.resize(3 * (n + 1));
+  tail_S2_.resize(3 * (n + 1));
+  tail_B_.resize(3 * n);
+  tail_dB_.resize(3 * n);
+}
+
+void InducedDipoles::evaluate_tail(const std::vector<double> &p)
+{
+  const std::size_t n = tail_order_.size();
+  const int na = normal_axis_;
+  // Prefix sums over the sorted beads of the sheet moments q = 2 p_n n̂ − p_t and of q u, q u².
+  for (int d = 0; d < 3; ++d)
+    tail_S0_[d] = tail_S1_[d] = tail_S2_[d] = 0.0;
+  for (std::size_t k = 0; k < n; ++k)
+  {
+    const std::uint32_t b = tail_order_[k];
+    const double uk = tail_u_[k];
+    for (int d = 0; d < 3; ++d)
+    {
+      const double q = (d == na ? 2.0 : -1.0) * p[3 * b + d];
+      tail_S0_[3 * (k + 1) + d] = tail_S0_[3 * k + d] + q;
+      tail_S1_[3 * (k + 1) + d] = tail_S1_[3 * k + d] + q * uk;
+      tail_S2_[3 * (k + 1) + d] = tail_S2_[3 * k + d] + q * uk * uk;
+    }
+  }
+  const double Rc = tail_cutoff_, c = -mu0 / (4.0 * Rc * tail_area_);
+#pragma omp parallel for schedule(static) if (n >= parallel_threshold)
+  for (long k = 0; k < static_cast<long>(n); ++k)
+  {
+    const std::uint32_t b = tail_order_[k];
+    const double ui = tail_u_[k];
+    const std::size_t lo = tail_lo_[k], hi = tail_hi_[k];
+    for (int d = 0; d < 3; ++d)
+    {
+      const double S0 = tail_S0_[3 * hi + d] - tail_S0_[3 * lo + d];
+      const double S1 = tail_S1_[3 * hi + d] - tail_S1_[3 * lo + d];
+      const double S2 = tail_S2_[3 * hi + d] - tail_S2_[3 * lo + d];
+      // Σ_k (1 − (u_k − u_i)²/R_c²) q_k  and its derivative in u_i, Σ 2(u_k − u_i)/R_c² q_k.
+      tail_B_[3 * b + d] = c * (S0 - (S2 - 2.0 * ui * S1 + ui * ui * S0) / (Rc * Rc));
+      tail_dB_[3 * b + d] = c * 2.0 * (S1 - ui * S0) / (Rc * Rc);
     }
   }
 }
@@ -367,6 +467,12 @@ void InducedDipoles::gather_forces(const ForceArrays &out)
     double F[3];
     for (int a = 0; a < 3; ++a)
       F[a] = p[0] * g[3 * a] + p[1] * g[3 * a + 1] + p[2] * g[3 * a + 2];
+    // Slab tail: the sheets vary only along the open axis, F = n̂ (p·∂B_tail/∂u).
+    if (normal_axis_ >= 0)
+    {
+      const double *dB = &tail_dB_[3 * b];
+      F[normal_axis_] += p[0] * dB[0] + p[1] * dB[1] + p[2] * dB[2];
+    }
     // Pair forces are stored as the force on the pair's j bead; its i bead gets the negative.
     for (std::size_t q = begin[b]; q < begin[b + 1]; ++q)
     {

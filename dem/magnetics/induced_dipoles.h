@@ -120,6 +120,15 @@ private:
   std::vector<unsigned char> active_;
   std::vector<double> pair_force_;
 
+  // Slab tail correction (settings.slab_tail_correction): beads sorted along the open axis,
+  // their cutoff windows in that order, prefix sums of the sheet moments, and the tail
+  // field and its derivative along the open axis per bead.
+  int normal_axis_ = -1;
+  double tail_area_ = 0.0, tail_cutoff_ = 0.0;
+  std::vector<std::uint32_t> tail_order_;
+  std::vector<std::size_t> tail_lo_, tail_hi_;
+  std::vector<double> tail_u_, tail_S0_, tail_S1_, tail_S2_, tail_B_, tail_dB_;
+
   // `corrected`: one table per distinct pair β (mean of the two beads' β).
   std::map<double, std::shared_ptr<const TwoSphereTable>> tables_;
   std::vector<const TwoSphereTable *> pair_table_;
@@ -128,6 +137,8 @@ private:
   void refresh_list_if_needed(const BeadArrays &beads, double cutoff, MagneticStats &stats);
   void evaluate_applied_field(const BeadArrays &beads, const AppliedFieldFunction &field);
   void evaluate_pair_tensors(const BeadArrays &beads, double cutoff, MagneticStats &stats);
+  void prepare_tail(const BeadArrays &beads, double cutoff);
+  void evaluate_tail(const std::vector<double> &p);
   void gather_local_field(std::size_t b, const std::vector<double> &p, double B[3]) const;
   void solve_dipoles(const BeadArrays &beads, MagneticStats &stats);
   void prepare_correction_tables();

@@ -742,6 +742,9 @@ void DemSystem::read_checkpoint(const std::string &path)
   time_ = time;
   guard_energy_ = guard;
   dt_ = dt;
+  x0_ = particles_.x; // drift reference; the list is rebuilt at the next step anyway
+  y0_ = particles_.y;
+  z0_ = particles_.z;
   force_rebuild_ = true;
   initialized_ = true;
 }

@@ -69,6 +69,8 @@ public:
   const std::vector<std::unique_ptr<ForceTerm>> &force_terms() const { return terms_; }
 
   void step();
+  // Rebuild (and re-sort) the neighbour list at the next step even if no particle moved far.
+  void request_neighbor_rebuild() { force_rebuild_ = true; }
   // Runs with the walls at rest for `duration`, then resets the clock to t = 0.
   void settle(double duration);
 

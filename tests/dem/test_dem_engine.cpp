@@ -1,0 +1,455 @@
+// Engine guarantees: results independent of the thread count (bit for bit), restarts that
+// continue bit-identically, contact history that survives neighbour-list rebuilds and
+// re-sorting, stability guards that stop with a useful message, refusal of unstable user
+// time steps, insertion, and the contact-law building blocks.
+#include "dem_test_scenes.h"
+
+#include "insertion.h"
+#include "snapshot_writer.h"
+
+#include <gtest/gtest.h>
+#include <hdf5.h>
+#include <omp.h>
+
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+using namespace magbrush;
+using namespace magbrush::dem;
+using namespace magbrush::dem::testing;
+
+namespace {
+
+// ~1500 frictional, rolling-resistant, damped spheres (100 µm ± 10 %) in a periodic x–y box
+// on a stage, falling under gravity with random initial velocities: every code path
+// (contacts, walls, rebuilds, sorting) is exercised within a few hundred steps.
+Case packing_case()
+{
+  Material m = elastic_material("carrier", 1e8, 0.35, 2200);
+  m.friction = 0.45;
+  m.polygon_angles = 12;
+  m.damping = 0.6;
+  Case c = single_species_case(m);
+  c.populations[0].diameter_mean = 100e-6;
+  c.populations[0].diameter_std = 10e-6;
+  c.populations[0].count = 1500;
+  c.populations[0].insert_box = std::array<Vec3, 2>{Vec3{0, 0, 0}, Vec3{3e-3, 3e-3, 0.3e-3}};
+  c.dem.periodic_length_x = c.dem.periodic_length_y = 3e-3;
+  c.dem.gravity = {0, 0, -9.81};
+  c.dem.seed = 42;
+  add_rigid_plane(c, {0, 0, 0}, {0, 0, 1}, 0.3, 0.35);
+  c.materials.back().youngs_modulus = 5e10;
+  return c;
+}
+
+std::unique_ptr<DemSystem> make_packing(const Case &c)
+{
+  auto sys = std::make_unique<DemSystem>(c);
+  sys->add_force_term(std::make_unique<Gravity>(c.dem.gravity));
+  sys->insert_particles();
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  auto &p = sys->particles();
+  for (std::size_t i = 0; i < p.size(); ++i)
+  {
+    p.vx[i] = u(rng);
+    p.vy[i] = u(rng);
+    p.vz[i] = u(rng);
+  }
+  sys->initialize();
+  return sys;
+}
+
+// Every dynamic array, in id order, as raw bytes.
+std::vector<double> state_by_id(const DemSystem &s)
+{
+  const auto &p = s.particles();
+  const auto &f = s.forces();
+  std::vector<double> out(p.size() * 15);
+  for (std::size_t i = 0; i < p.size(); ++i)
+  {
+    double *o = &out[static_cast<std::size_t>(p.id[i]) * 15];
+    const double v[15] = {p.x[i], p.y[i], p.z[i], p.vx[i], p.vy[i], p.vz[i], p.wx[i], p.wy[i],
+                          p.wz[i], f.fx[i], f.fy[i], f.fz[i], f.tx[i], f.ty[i], f.tz[i]};
+    std::memcpy(o, v, sizeof v);
+  }
+  return out;
+}
+
+bool bit_identical(const std::vector<double> &a, const std::vector<double> &b)
+{
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
+}
+
+} // namespace
+
+TEST(DemEngine, OneAndTwoThreadsGiveIdenticalBits)
+{
+  const Case c = packing_case();
+  std::vector<double> result[2];
+  long contacts = 0, rebuilds = 0;
+  for (int threads : {1, 2})
+  {
+    omp_set_num_threads(threads);
+    auto sys = make_packing(c);
+    for (int k = 0; k < 1500; ++k)
+      sys->step();
+    result[threads - 1] = state_by_id(*sys);
+    contacts = sys->particle_contacts();
+    rebuilds = sys->neighbor_rebuilds();
+  }
+  omp_set_num_threads(2);
+  std::printf("1 vs 2 threads: 1500 particles, 1500 steps, %ld contacts at the end, %ld list rebuilds\n", contacts,
+              rebuilds);
+  EXPECT_GT(contacts, 50);
+  EXPECT_GT(rebuilds, 2);
+  EXPECT_TRUE(bit_identical(result[0], result[1]));
+}
+
+TEST(DemEngine, RestartContinuesBitIdentically)
+{
+  const Case c = packing_case();
+  const std::string path = (std::filesystem::temp_directory_path() / "magbrush_dem_restart_test.bin").string();
+  auto a = make_packing(c);
+  for (int k = 0; k < 600; ++k)
+    a->step();
+  a->write_checkpoint(path);
+  for (int k = 0; k < 600; ++k)
+    a->step();
+
+  DemSystem b(c);
+  b.add_force_term(std::make_unique<Gravity>(c.dem.gravity));
+  b.read_checkpoint(path);
+  EXPECT_EQ(b.step_count(), 600);
+  for (int k = 0; k < 600; ++k)
+    b.step();
+  EXPECT_EQ(a->step_count(), b.step_count());
+  EXPECT_EQ(a->time(), b.time());
+  EXPECT_GT(a->particle_contacts(), 50);
+  EXPECT_TRUE(bit_identical(state_by_id(*a), state_by_id(b)));
+  std::filesystem::remove(path);
+}
+
+TEST(DemEngine, CorruptCheckpointIsRefused)
+{
+  const std::string path = (std::filesystem::temp_directory_path() / "magbrush_dem_bad.bin").string();
+  std::ofstream(path) << "not a checkpoint";
+  DemSystem s(packing_case());
+  try
+  {
+    s.read_checkpoint(path);
+    FAIL() << "a corrupt checkpoint was accepted";
+  }
+  catch (const std::runtime_error &e)
+  {
+    EXPECT_NE(std::string(e.what()).find("not a magbrush DEM checkpoint"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove(path);
+}
+
+TEST(DemEngine, HistorySurvivesRebuildAndResorting)
+{
+  // Clumps of touching spheres; set an antisymmetric history on every touching pair; move
+  // everything by a fraction of the periodic box (the cell order, hence the particle order,
+  // changes); rebuild: every pair must find its history again, with the right sign.
+  ParticleState s;
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double L = 4e-3, r = 50e-6;
+  for (int clump = 0; clump < 60; ++clump)
+  {
+    const Vector3 c{L * u(rng), L * u(rng), L * u(rng)};
+    for (int k = 0; k < 4; ++k)
+      s.add({c.x + 1.8 * r * k, c.y + 0.3 * r * (k % 2), c.z}, r, 2000, 0, 0.0);
+  }
+  PeriodicBox box;
+  box.length = {L, L, L};
+  NeighborList list;
+  std::vector<double> scratch;
+  std::vector<std::int32_t> iscratch;
+  auto permute = [&](const std::vector<std::int32_t> &order) { s.permute(order, scratch, iscratch); };
+  list.rebuild(s, box, 20e-6, permute);
+  auto h = [](int a, int b) { return Vector3{double(a - b), double(a * a - b * b), std::pow(double(a - b), 3)}; };
+  auto touching = [&](std::size_t i, std::size_t p) {
+    const std::size_t j = static_cast<std::size_t>(list.partner[p]);
+    const Vector3 sh = list.shift(p);
+    const Vector3 d{s.x[j] - s.x[i] + sh.x, s.y[j] - s.y[i] + sh.y, s.z[j] - s.z[i] + sh.z};
+    return norm(d) < s.radius[i] + s.radius[j];
+  };
+  long set = 0;
+  for (std::size_t i = 0; i < s.size(); ++i)
+    for (std::int32_t p = list.row_start[i]; p < list.row_start[i + 1]; ++p)
+    {
+      const std::size_t q = static_cast<std::size_t>(p);
+      list.touching[q] = touching(i, q);
+      const Vector3 v = list.touching[q] ? h(s.id[i], s.id[static_cast<std::size_t>(list.partner[q])]) : Vector3{};
+      list.hist_x[q] = v.x;
+      list.hist_y[q] = v.y;
+      list.hist_z[q] = v.z;
+      set += list.touching[q];
+    }
+  ASSERT_GT(set, 100);
+  const std::vector<std::int32_t> ids_before = s.id;
+  for (std::size_t i = 0; i < s.size(); ++i)
+  {
+    s.x[i] += 0.37 * L; // wraps: the sorted order changes
+    s.y[i] += 0.61 * L;
+  }
+  list.rebuild(s, box, 20e-6, permute);
+  EXPECT_NE(ids_before, s.id) << "the test must re-sort the particles";
+  long found = 0;
+  for (std::size_t i = 0; i < s.size(); ++i)
+    for (std::int32_t p = list.row_start[i]; p < list.row_start[i + 1]; ++p)
+    {
+      const std::size_t q = static_cast<std::size_t>(p);
+      if (!touching(i, q))
+        continue;
+      const Vector3 want = h(s.id[i], s.id[static_cast<std::size_t>(list.partner[q])]);
+      EXPECT_EQ(list.hist_x[q], want.x);
+      EXPECT_EQ(list.hist_y[q], want.y);
+      EXPECT_EQ(list.hist_z[q], want.z);
+      ++found;
+    }
+  EXPECT_EQ(found, set);
+}
+
+TEST(DemEngine, ForcesAreContinuousAcrossForcedRebuilds)
+{
+  // The same run with and without extra rebuilds every 50 steps: the tangential springs
+  // carry over, so the trajectories agree to rounding (a lost history would show at O(1)).
+  const Case c = packing_case();
+  auto a = make_packing(c);
+  auto b = make_packing(c);
+  for (int k = 1; k <= 400; ++k)
+  {
+    if (k % 50 == 0)
+      b->request_neighbor_rebuild();
+    a->step();
+    b->step();
+  }
+  const auto sa = state_by_id(*a), sb = state_by_id(*b);
+  double worst = 0, scale = 0;
+  for (std::size_t i = 0; i < sa.size(); i += 15)
+    for (int k = 9; k < 12; ++k) // forces
+    {
+      worst = std::max(worst, std::abs(sa[i + k] - sb[i + k]));
+      scale = std::max(scale, std::abs(sa[i + k]));
+    }
+  std::printf("forced rebuilds: max force difference %.3g N of max force %.3g N (%ld vs %ld rebuilds)\n", worst,
+              scale, a->neighbor_rebuilds(), b->neighbor_rebuilds());
+  EXPECT_GT(b->neighbor_rebuilds(), a->neighbor_rebuilds());
+  EXPECT_LT(worst, 1e-6 * scale);
+}
+
+TEST(DemEngine, OverlapGuardStopsWithMessage)
+{
+  Material m = elastic_material("soft", 1e6, 0.3, 2000);
+  Case c = single_species_case(m);
+  DemSystem s(c);
+  s.particles().add({0, 0, 0}, 1e-3, 2000, 0, 0.0);
+  s.particles().add({1.4e-3, 0, 0}, 1e-3, 2000, 0, 0.0); // 60 % overlap
+  try
+  {
+    s.initialize();
+    FAIL() << "no guard";
+  }
+  catch (const StabilityError &e)
+  {
+    const std::string w = e.what();
+    EXPECT_NE(w.find("step 0"), std::string::npos) << w;
+    EXPECT_NE(w.find("particle id"), std::string::npos) << w;
+    EXPECT_NE(w.find("overlaps"), std::string::npos) << w;
+    EXPECT_NE(w.find("time step"), std::string::npos) << w;
+    std::printf("guard message: %s\n", w.c_str());
+  }
+}
+
+TEST(DemEngine, NaNGuardStopsWithMessage)
+{
+  Material m = elastic_material("m", 1e7, 0.3, 2000);
+  Case c = single_species_case(m);
+  DemSystem s(c);
+  s.particles().add({0, 0, 0}, 1e-3, 2000, 0, 0.0);
+  s.particles().add({5e-3, 0, 0}, 1e-3, 2000, 0, 0.0);
+  s.initialize();
+  s.step();
+  s.particles().vx[1] = std::nan("");
+  try
+  {
+    s.step();
+    FAIL() << "no guard";
+  }
+  catch (const StabilityError &e)
+  {
+    const std::string w = e.what();
+    EXPECT_NE(w.find("NaN"), std::string::npos) << w;
+    EXPECT_NE(w.find("step 2"), std::string::npos) << w;
+    EXPECT_NE(w.find("particle id"), std::string::npos) << w;
+  }
+}
+
+namespace {
+// A force term that pumps energy in (negative drag): the runaway guard must catch it.
+class EnergyPump : public ForceTerm
+{
+public:
+  const char *name() const override { return "energy pump"; }
+  void add_forces(const ParticleState &s, ForceBuffers &f, double) override
+  {
+    for (std::size_t i = 0; i < s.size(); ++i)
+    {
+      f.fx[i] += 2e4 * s.mass[i] * s.vx[i];
+      f.fy[i] += 2e4 * s.mass[i] * s.vy[i];
+      f.fz[i] += 2e4 * s.mass[i] * s.vz[i];
+    }
+  }
+};
+} // namespace
+
+TEST(DemEngine, KineticEnergyRunawayGuardStopsWithMessage)
+{
+  Material m = elastic_material("m", 1e7, 0.3, 2000);
+  Case c = single_species_case(m);
+  c.dem.max_kinetic_energy_growth = 10.0;
+  DemSystem s(c);
+  s.particles().add({0, 0, 0}, 1e-3, 2000, 0, 0.0);
+  s.particles().vx = {1.0};
+  s.add_force_term(std::make_unique<EnergyPump>());
+  s.initialize();
+  try
+  {
+    for (int k = 0; k < 100000; ++k)
+      s.step();
+    FAIL() << "no guard";
+  }
+  catch (const StabilityError &e)
+  {
+    const std::string w = e.what();
+    EXPECT_NE(w.find("kinetic energy grew"), std::string::npos) << w;
+    EXPECT_NE(w.find("particle id 0"), std::string::npos) << w;
+    EXPECT_NE(w.find("time_step"), std::string::npos) << w;
+  }
+}
+
+TEST(DemEngine, UserTimeStepAboveStableLimitIsRefused)
+{
+  Material m = elastic_material("carrier", 1e9, 0.35, 5000);
+  Case c = single_species_case(m);
+  DemSystem probe(c);
+  probe.particles().add({0, 0, 0}, 30e-6, m.density, 0, 0.0);
+  probe.initialize();
+  const double limit = probe.stable_time_step_info().limit;
+  // Rayleigh time of a 60 µm carrier: π r √(ρ/G) / (0.1631 ν + 0.8766).
+  const double G = 1e9 / 2.7;
+  EXPECT_NEAR(probe.stable_time_step_info().rayleigh,
+              M_PI * 30e-6 * std::sqrt(5000 / G) / (0.1631 * 0.35 + 0.8766), 1e-15);
+  EXPECT_NEAR(probe.time_step(), 0.2 * limit, 1e-18);
+
+  c.dem.time_step = 1.5 * limit;
+  DemSystem s(c);
+  s.particles().add({0, 0, 0}, 30e-6, m.density, 0, 0.0);
+  try
+  {
+    s.initialize();
+    FAIL() << "an unstable time step was accepted";
+  }
+  catch (const std::invalid_argument &e)
+  {
+    const std::string w = e.what();
+    char expected[32];
+    std::snprintf(expected, sizeof expected, "%.4g s", limit);
+    EXPECT_NE(w.find("above the stable limit"), std::string::npos) << w;
+    EXPECT_NE(w.find(expected), std::string::npos) << w;
+    std::printf("refusal: %s\n", w.c_str());
+  }
+  c.dem.time_step = 0.9 * limit; // below the limit: accepted as given
+  DemSystem ok(c);
+  ok.particles().add({0, 0, 0}, 30e-6, m.density, 0, 0.0);
+  ok.initialize();
+  EXPECT_EQ(ok.time_step(), 0.9 * limit);
+}
+
+TEST(DemEngine, InsertionByMassWithoutOverlap)
+{
+  Case c = packing_case();
+  c.populations[0].count = 0;
+  const double rho = 2200, target = 1500 * rho * M_PI / 6 * std::pow(100e-6, 3);
+  c.populations[0].mass = target;
+  DemSystem s(c);
+  s.insert_particles();
+  const auto &p = s.particles();
+  double mass = 0, mean = 0, m_max = 0;
+  for (std::size_t i = 0; i < p.size(); ++i)
+  {
+    mass += p.mass[i];
+    mean += 2 * p.radius[i];
+    m_max = std::max(m_max, p.mass[i]);
+    ASSERT_GT(p.radius[i], 0.0);
+    ASSERT_GE(p.z[i], p.radius[i]); // not through the stage
+  }
+  mean /= static_cast<double>(p.size());
+  EXPECT_GE(mass, target);
+  EXPECT_LT(mass, target + m_max);
+  EXPECT_NEAR(mean, 100e-6, 3 * 10e-6 / std::sqrt(double(p.size())));
+  for (std::size_t i = 0; i < p.size(); ++i)
+    for (std::size_t j = i + 1; j < p.size(); ++j)
+    {
+      double d[3] = {p.x[j] - p.x[i], p.y[j] - p.y[i], p.z[j] - p.z[i]};
+      for (int k = 0; k < 2; ++k)
+        d[k] -= 3e-3 * std::round(d[k] / 3e-3);
+      ASSERT_GE(std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]), p.radius[i] + p.radius[j]);
+    }
+}
+
+TEST(DemEngine, OverfullInsertionSaysWhatToDo)
+{
+  Case c = packing_case();
+  c.populations[0].count = 20000;
+  DemSystem s(c);
+  try
+  {
+    s.insert_particles();
+    FAIL() << "an impossible insertion succeeded";
+  }
+  catch (const std::runtime_error &e)
+  {
+    EXPECT_NE(std::string(e.what()).find("enlarge the insertion region"), std::string::npos) << e.what();
+  }
+}
+
+TEST(DemEngine, SnapshotIsReadableAndInIdOrder)
+{
+  const Case c = packing_case();
+  auto sys = make_packing(c);
+  for (int k = 0; k < 50; ++k)
+    sys->step();
+  const auto dir = std::filesystem::temp_directory_path() / "magbrush_dem_snapshot_test";
+  std::filesystem::remove_all(dir);
+  SnapshotWriter w(dir.string());
+  w.write(*sys);
+  ASSERT_EQ(w.snapshots().size(), 1u);
+  const std::string h5 = (dir / w.snapshots()[0].second).string();
+  const hid_t f = H5Fopen(h5.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(f, 0);
+  std::vector<double> pos(3 * sys->particles().size());
+  const hid_t d = H5Dopen2(f, "position", H5P_DEFAULT);
+  ASSERT_GE(H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, pos.data()), 0);
+  H5Dclose(d);
+  H5Fclose(f);
+  const auto &p = sys->particles();
+  for (std::size_t i = 0; i < p.size(); ++i)
+  {
+    const std::size_t k = static_cast<std::size_t>(p.id[i]);
+    ASSERT_EQ(pos[3 * k], p.x[i]);
+    ASSERT_EQ(pos[3 * k + 2], p.z[i]);
+  }
+  std::ifstream x(dir / "particles.xdmf");
+  const std::string text((std::istreambuf_iterator<char>(x)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("CollectionType=\"Temporal\""), std::string::npos);
+  EXPECT_NE(text.find(w.snapshots()[0].second + ":/position"), std::string::npos);
+  EXPECT_FALSE(std::filesystem::exists(dir / "particles.xdmf.tmp"));
+  std::filesystem::remove_all(dir);
+}

@@ -316,10 +316,7 @@ int harmonics_for_fit(const std::vector<Pole> &poles, const PoleFitOptions &opti
   return static_cast<int>(std::ceil(2.0 * std::sqrt(4.0 * alpha * std::log(1e12)))) + 4;
 }
 
-} // namespace
-
-PoleFitResult fit_poles(const Roller &nominal, const FluxScan &scan, double probe_radius,
-                        const PoleFitOptions &options)
+void check_starting_poles(const Roller &nominal, const PoleFitOptions &options)
 {
   if (nominal.poles.empty())
     throw std::invalid_argument("pole fit: the case has no poles to start from; add roller.poles "
@@ -334,14 +331,25 @@ PoleFitResult fit_poles(const Roller &nominal, const FluxScan &scan, double prob
       if (p.shape_factor != nominal.poles[0].shape_factor)
         throw std::invalid_argument("pole fit: a shared shape factor was asked for, but the case "
                                     "gives different α per pole; use per-pole shapes");
+}
 
-  PoleFitResult result;
-  const RingGeometry geometry = RingGeometry::from(nominal);
-  result.harmonics = harmonics_for_fit(nominal.poles, options);
-  const PoleProfileModel model(geometry, probe_radius, result.harmonics);
+// The starting point of the fit: angles from the scan's peaks, strengths by linear least squares.
+struct InitialGuess
+{
+  std::vector<Pole> poles;
+  std::vector<double> deviation; // φ_i − φ_i^nominal
+  double offset = 0.0;           // δ
+};
+
+// Each pole is moved by the shift between its measured and computed Bn peak (the peak of a
+// pole is not exactly at φ_i, its neighbours pull it, so the shift is taken between profiles,
+// not against φ_i). With the offset fitted, the common part of the shifts is δ:
+// p_i + δ = c_i + Δ_i with ΣΔ_i = 0.
+void place_poles_at_the_peaks(const PoleProfileModel &model, const Roller &nominal,
+                              const FluxScan &scan, const PoleFitOptions &options,
+                              InitialGuess &guess, std::vector<std::string> &notes)
+{
   const size_t P = nominal.poles.size();
-
-  // --- Initial guess from the scan's peaks --------------------------------------------
   std::vector<double> Bn0, Bt0;
   model.profile(nominal.poles, scan.angle, Bn0, Bt0);
   const auto measured = find_pole_peaks(nominal.poles, scan.angle, scan.Bn);
@@ -359,125 +367,88 @@ PoleFitResult fit_poles(const Roller &nominal, const FluxScan &scan, double prob
       ++n_matched;
     }
     else
-      result.notes.push_back("pole " + nominal.poles[i].name +
-                             ": no matching Bn peak in the scan; starting from its nominal angle");
+      notes.push_back("pole " + nominal.poles[i].name +
+                      ": no matching Bn peak in the scan; starting from its nominal angle");
   if (n_matched)
     mean_shift /= n_matched;
-  double delta0 = 0.0;
-  std::vector<double> deviation(P, 0.0);
+  guess.deviation.assign(P, 0.0);
+  guess.offset = 0.0;
   if (options.fit_offset)
   {
-    // p_i + δ = c_i + Δ_i with ΣΔ_i = 0.
-    delta0 = -mean_shift;
+    guess.offset = -mean_shift;
     for (size_t i = 0; i < P; ++i)
-      deviation[i] = matched[i] ? shift[i] + delta0 : 0.0;
+      guess.deviation[i] = matched[i] ? shift[i] + guess.offset : 0.0;
     double mean = 0.0;
-    for (double d : deviation)
+    for (double d : guess.deviation)
       mean += d / P;
-    for (double &d : deviation)
+    for (double &d : guess.deviation)
       d -= mean;
   }
   else
-    for (size_t i = 0; i < P; ++i)
-      deviation[i] = shift[i];
-  std::vector<Pole> start = nominal.poles;
+    guess.deviation = shift;
+  guess.poles = nominal.poles;
   for (size_t i = 0; i < P; ++i)
-    start[i].angle = nominal.poles[i].angle + deviation[i];
+    guess.poles[i].angle = nominal.poles[i].angle + guess.deviation[i];
+}
 
-  // With the angles and shapes fixed the model is linear in the strengths: solve for them.
-  const bool use_bt = options.use_tangential && scan.has_tangential();
-  const size_t m = scan.size();
+// With the angles and shapes fixed the model is linear in the strengths: the exact linear
+// least-squares solution for them.
+void solve_for_strengths(const PoleProfileModel &model, const FluxScan &scan, bool use_bt,
+                         InitialGuess &guess, const Roller &nominal, std::vector<std::string> &notes)
+{
+  const size_t P = guess.poles.size(), m = scan.size();
   std::vector<double> theta(m);
   for (size_t k = 0; k < m; ++k)
-    theta[k] = scan.angle[k] + delta0;
+    theta[k] = scan.angle[k] + guess.offset;
+  Eigen::MatrixXd A(use_bt ? 2 * m : m, P);
+  Eigen::VectorXd b(A.rows());
+  for (size_t i = 0; i < P; ++i)
   {
-    Eigen::MatrixXd A(use_bt ? 2 * m : m, P);
-    Eigen::VectorXd b(A.rows());
-    for (size_t i = 0; i < P; ++i)
-    {
-      const auto t = model.terms(start[i].shape_factor, start[i].angle, theta, false);
-      for (size_t k = 0; k < m; ++k)
-      {
-        A(k, i) = t.C[k];
-        if (use_bt)
-          A(m + k, i) = t.S[k];
-      }
-    }
+    const auto t = model.terms(guess.poles[i].shape_factor, guess.poles[i].angle, theta, false);
     for (size_t k = 0; k < m; ++k)
     {
-      b(k) = scan.Bn[k];
+      A(k, i) = t.C[k];
       if (use_bt)
-        b(m + k) = scan.Bt[k];
-    }
-    const Eigen::VectorXd M = A.colPivHouseholderQr().solve(b);
-    for (size_t i = 0; i < P; ++i)
-    {
-      if (M(i) * nominal.poles[i].strength <= 0.0)
-        result.notes.push_back("pole " + nominal.poles[i].name +
-                               ": the scan suggests the opposite sign; check the pole order");
-      start[i].strength = M(i);
+        A(m + k, i) = t.S[k];
     }
   }
-
-  // --- Levenberg–Marquardt ---------------------------------------------------------------
-  // Angles are parametrised relative to the nominal layout when the offset is fitted (the
-  // constraint), else relative to the start.
-  std::vector<Pole> base = nominal.poles;
-  std::vector<double> a0(P, 0.0);
-  if (options.fit_offset)
-    for (size_t i = 0; i + 1 < P; ++i)
-      a0[i] = deviation[i];
-  else
-    base = start;
-  for (size_t i = 0; i < P; ++i)
-    base[i].angle = options.fit_offset ? nominal.poles[i].angle : start[i].angle;
-  double scale = 0.0;
-  for (const Pole &p : start)
-    scale = std::max(scale, std::abs(p.strength));
-  FitProblem problem(model, scan, base, options, scale);
-  result.parameters = problem.inputs();
-  result.samples = problem.values();
-  if (result.samples <= result.parameters)
-    throw std::invalid_argument("pole fit: " + std::to_string(result.samples) +
-                                " residuals for " + std::to_string(result.parameters) +
-                                " parameters; the scan needs more points");
-  Eigen::VectorXd x = problem.pack(start, a0, delta0);
+  for (size_t k = 0; k < m; ++k)
   {
-    Eigen::VectorXd f(problem.values());
-    problem(x, f);
-    result.initial_rms = std::sqrt(f.squaredNorm() / f.size());
+    b(k) = scan.Bn[k];
+    if (use_bt)
+      b(m + k) = scan.Bt[k];
   }
-  Eigen::LevenbergMarquardt<FitProblem> lm(problem);
-  lm.parameters.maxfev = options.max_evaluations;
-  lm.parameters.xtol = 1e-12;
-  lm.parameters.ftol = 1e-14;
-  const auto status = lm.minimize(x);
-  result.status = status_in_words(status);
-  result.converged = converged(status);
-  result.evaluations = problem.evaluations;
-  result.iterations = static_cast<int>(lm.iter);
+  const Eigen::VectorXd M = A.colPivHouseholderQr().solve(b);
+  for (size_t i = 0; i < P; ++i)
+  {
+    if (M(i) * nominal.poles[i].strength <= 0.0)
+      notes.push_back("pole " + nominal.poles[i].name +
+                      ": the scan suggests the opposite sign; check the pole order");
+    guess.poles[i].strength = M(i);
+  }
+}
 
-  // --- Result and uncertainties ------------------------------------------------------------
+// Residual RMS per component and the standard errors from the Jacobian at the optimum:
+// Cov = s² (JᵀJ)⁻¹, s² = RSS/(m − p), mapped to the physical parameters.
+void summarise(const FitProblem &problem, const Eigen::VectorXd &x, double strength_scale,
+               const Roller &nominal, const InitialGuess &guess, PoleFitResult &result)
+{
+  const size_t P = nominal.poles.size();
+  const size_t m = problem.use_bt_ ? problem.m_ / 2 : problem.m_;
   Eigen::VectorXd f(problem.values());
   Eigen::MatrixXd J(problem.values(), problem.inputs());
   problem(x, f);
   problem.df(x, J);
-  double sn = 0, st = 0;
-  for (size_t k = 0; k < m; ++k)
-  {
-    sn += f(k) * f(k);
-    if (use_bt)
-      st += f(m + k) * f(m + k);
-  }
-  result.rms_Bn = std::sqrt(sn / m);
-  result.rms_Bt = use_bt ? std::sqrt(st / m) : 0.0;
+  result.rms_Bn = std::sqrt(f.head(m).squaredNorm() / m);
+  result.rms_Bt = problem.use_bt_ ? std::sqrt(f.tail(m).squaredNorm() / m) : 0.0;
   result.rms = std::sqrt(f.squaredNorm() / f.size());
   const double s2 = f.squaredNorm() / double(problem.values() - problem.inputs());
   const Eigen::MatrixXd JtJ = J.transpose() * J;
-  Eigen::MatrixXd cov = s2 * JtJ.ldlt().solve(Eigen::MatrixXd::Identity(JtJ.rows(), JtJ.cols()));
-  const auto poles = problem.poles(x);
+  const Eigen::MatrixXd cov =
+      s2 * JtJ.ldlt().solve(Eigen::MatrixXd::Identity(JtJ.rows(), JtJ.cols()));
   const Eigen::MatrixXd Caa = cov.block(P, P, problem.n_angle_, problem.n_angle_);
   const Eigen::MatrixXd Cphi = problem.T_ * Caa * problem.T_.transpose();
+  const auto poles = problem.poles(x);
   result.offset = problem.offset(x);
   result.offset_sigma = problem.n_offset_ ? std::sqrt(cov(x.size() - 1, x.size() - 1)) : 0.0;
   result.roller = nominal;
@@ -486,9 +457,9 @@ PoleFitResult fit_poles(const Roller &nominal, const FluxScan &scan, double prob
     FittedPole fp;
     fp.pole = poles[i];
     fp.pole.angle = wrap_0_2pi(poles[i].angle);
-    fp.initial = start[i];
-    fp.initial.angle = wrap_0_2pi(start[i].angle);
-    fp.strength_sigma = scale * std::sqrt(cov(i, i));
+    fp.initial = guess.poles[i];
+    fp.initial.angle = wrap_0_2pi(guess.poles[i].angle);
+    fp.strength_sigma = strength_scale * std::sqrt(cov(i, i));
     fp.angle_sigma = std::sqrt(std::max(0.0, Cphi(i, i)));
     if (problem.n_shape_)
     {
@@ -504,6 +475,59 @@ PoleFitResult fit_poles(const Roller &nominal, const FluxScan &scan, double prob
   if (2.0 * std::sqrt(alpha_max * std::log(1e12)) > result.harmonics)
     result.notes.push_back("the fitted shape factors are sharper than the series was sized for; "
                            "rerun with more harmonics");
+}
+
+} // namespace
+
+PoleFitResult fit_poles(const Roller &nominal, const FluxScan &scan, double probe_radius,
+                        const PoleFitOptions &options)
+{
+  check_starting_poles(nominal, options);
+  PoleFitResult result;
+  result.harmonics = harmonics_for_fit(nominal.poles, options);
+  const PoleProfileModel model(RingGeometry::from(nominal), probe_radius, result.harmonics);
+
+  InitialGuess guess;
+  place_poles_at_the_peaks(model, nominal, scan, options, guess, result.notes);
+  solve_for_strengths(model, scan, options.use_tangential && scan.has_tangential(), guess, nominal,
+                      result.notes);
+
+  // Angles are parametrised relative to the nominal layout when the offset is fitted (that is
+  // the constraint), else relative to the initial guess.
+  const size_t P = nominal.poles.size();
+  std::vector<Pole> base = options.fit_offset ? nominal.poles : guess.poles;
+  std::vector<double> a0(P, 0.0);
+  if (options.fit_offset)
+    for (size_t i = 0; i + 1 < P; ++i)
+      a0[i] = guess.deviation[i];
+  double scale = 0.0;
+  for (const Pole &p : guess.poles)
+    scale = std::max(scale, std::abs(p.strength));
+  FitProblem problem(model, scan, base, options, scale);
+  result.parameters = problem.inputs();
+  result.samples = problem.values();
+  if (result.samples <= result.parameters)
+    throw std::invalid_argument("pole fit: " + std::to_string(result.samples) +
+                                " residuals for " + std::to_string(result.parameters) +
+                                " parameters; the scan needs more points");
+  Eigen::VectorXd x = problem.pack(guess.poles, a0, guess.offset);
+  {
+    Eigen::VectorXd f(problem.values());
+    problem(x, f);
+    result.initial_rms = std::sqrt(f.squaredNorm() / f.size());
+  }
+
+  Eigen::LevenbergMarquardt<FitProblem> lm(problem);
+  lm.parameters.maxfev = options.max_evaluations;
+  lm.parameters.xtol = 1e-12;
+  lm.parameters.ftol = 1e-14;
+  const auto status = lm.minimize(x);
+  result.status = status_in_words(status);
+  result.converged = converged(status);
+  result.evaluations = problem.evaluations;
+  result.iterations = static_cast<int>(lm.iter);
+
+  summarise(problem, x, scale, nominal, guess, result);
   return result;
 }
 

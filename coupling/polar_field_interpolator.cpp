@@ -150,6 +150,12 @@ void PolarFieldInterpolator::throw_inside_sleeve(const Vec3 &x, double r) const
 {
   std::ostringstream m;
   m.precision(6);
+  if (!std::isfinite(r))
+  {
+    m << "magnetic field lookup at a non-finite position (" << x[0] << ", " << x[1] << ", "
+      << x[2] << "): the particle state has blown up (NaN/Inf) — reduce the time step";
+    throw FieldLookupError(m.str());
+  }
   m << "magnetic field lookup at (" << x[0] << ", " << x[1] << ", " << x[2]
     << ") m: radius " << r << " m lies inside the field grid's inner radius " << r_min_
     << " m (the sleeve surface); a particle there has penetrated the sleeve — reduce the time "

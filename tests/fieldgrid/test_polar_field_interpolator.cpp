@@ -269,6 +269,16 @@ TEST(PolarFieldInterpolator, InsideTheSleeveIsAnErrorBeyondHalfACell)
         << e.what();
   }
   EXPECT_FALSE(interp.try_evaluate({0.0, r_in, 0.0}, B, gB));
+  EXPECT_FALSE(interp.try_evaluate({std::nan(""), 0.0, 0.0}, B, gB));
+  try
+  {
+    interp.evaluate({std::nan(""), 0.0, 0.0}, B, gB);
+    FAIL() << "expected FieldLookupError";
+  }
+  catch (const FieldLookupError &e)
+  {
+    EXPECT_NE(std::string(e.what()).find("non-finite position"), std::string::npos) << e.what();
+  }
   EXPECT_EQ(B[0], 0.0);
   EXPECT_EQ(gB[1][0], 0.0);
   // Within the tolerance band: the boundary cell's cubic, still close to the exact field.

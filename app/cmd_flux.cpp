@@ -24,6 +24,7 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <iostream>
 #include <sstream>
 #include <stdexcept>
@@ -534,6 +535,184 @@ void fem_check(const std::string &fitted_case, const FluxScan &scan, const std::
 
 // ---------------------------------------------------------------------------------------
 
+// The command, step by step; run() reads like the procedure in the header comment.
+class FluxCommand
+{
+public:
+  explicit FluxCommand(const FluxOptions &options) : o_(options) {}
+
+  int run()
+  {
+    load_case_and_exact_ring();
+    write_computed_profile();
+    if (!read_scan())
+      return report_computed_peaks();
+    compare_with_scan();
+    if (o_.fit)
+    {
+      fit_poles_to_scan();
+      write_fitted_case();
+    }
+    plot_overlay();
+    if (o_.fit)
+      check_fit_by_fem();
+    return 0;
+  }
+
+private:
+  FluxOptions o_;
+  Case case_;
+  double probe_radius_ = 0.0;
+  MultipoleRing::Options ring_options_;
+  std::optional<MultipoleRing> ring_;
+  std::string dir_, fem_path_, why_not_fem_ = "--source ring";
+  std::vector<double> grid_;           // 0.25° profile grid [rad]
+  ComputedProfile on_grid_;
+  std::string scan_path_;
+  std::optional<FluxScan> scan_;
+  std::string residuals_, fit_residuals_, fitted_case_;
+  std::optional<PoleFitResult> fit_;
+
+  // 1. The case, the probe radius, the exact ring.
+  void load_case_and_exact_ring()
+  {
+    case_ = load_case(o_.case_path, o_.overrides);
+    probe_radius_ = probe_radius_of(case_);
+    ring_options_.harmonics = o_.harmonics;
+    ring_.emplace(*case_.roller, ring_options_);
+    dir_ = o_.output_dir.empty() ? case_.output.directory + "/" + case_.name + "/flux" : o_.output_dir;
+    fs::create_directories(dir_);
+    std::cout << "magbrush flux: case '" << case_.name << "', probe radius "
+              << fixed(probe_radius_ * 1e3, 3) << " mm (magnet "
+              << fixed(case_.roller->magnet_radius * 1e3, 3) << " mm), "
+              << case_.roller->poles.size() << " poles\n"
+              << "  exact ring: " << ring_->harmonic_count() << " harmonics"
+              << (o_.harmonics ? " (as asked)"
+                               : " (chosen from the decay: every coefficient beyond is below " +
+                                     scientific(std::max(ring_->harmonic_choice().tail, 1e-16)) +
+                                     " of the largest)")
+              << "\n";
+  }
+
+  // 2. The computed profile: the FEM's if there is one for this radius, else the exact ring.
+  void write_computed_profile()
+  {
+    fem_path_ = o_.source == "ring" ? "" : fem_profile_path(case_, probe_radius_, why_not_fem_);
+    if (o_.source == "fem" && fem_path_.empty())
+      throw std::invalid_argument("--source fem: " + why_not_fem_);
+    for (int k = 0; k < 1440; ++k)
+      grid_.push_back(k * 0.25 / to_deg);
+    on_grid_ = computed_at(grid_, *ring_, probe_radius_, fem_path_);
+    std::cout << "  computed profile: " << on_grid_.source << "\n";
+    if (fem_path_.empty())
+      std::cout << "  (" << why_not_fem_ << ")\n";
+    write_profile_csv(dir_ + "/flux_profile.csv", case_, probe_radius_, on_grid_, grid_);
+    std::cout << "  profile     " << dir_ << "/flux_profile.csv\n";
+  }
+
+  // 3. The scan (false when none is given).
+  bool read_scan()
+  {
+    scan_path_ = o_.measured.empty() ? case_.measured_flux_file : o_.measured;
+    if (scan_path_.empty())
+    {
+      if (o_.fit)
+        throw std::invalid_argument("--fit needs a scan: give --measured FILE.csv (or set "
+                                    "measured_flux_file in the case)");
+      return false;
+    }
+    scan_ = read_flux_scan(scan_path_, o_.scan);
+    std::cout << "  scan: " << scan_path_ << ": " << scan_->size() << " points, angle in "
+              << scan_->angle_unit << ", field in " << scan_->field_unit
+              << (scan_->has_tangential() ? ", Bn and Bt" : ", Bn only") << "\n";
+    for (const auto &n : scan_->notes)
+      std::cout << "  note: " << n << "\n";
+    return true;
+  }
+
+  int report_computed_peaks()
+  {
+    const auto peaks = find_pole_peaks(case_.roller->poles, grid_, on_grid_.Bn);
+    std::cout << "\nNo scan given (--measured or measured_flux_file): computed peaks only.\n"
+              << "  pole   angle [deg]   Bn peak [mT]\n";
+    for (size_t i = 0; i < peaks.size(); ++i)
+      std::cout << "  " << case_.roller->poles[i].name << "    "
+                << (peaks[i].found ? fixed(peaks[i].angle * to_deg, 2) + "      " +
+                                         fixed(peaks[i].value * 1e3, 2)
+                                   : std::string("(no peak)"))
+                << "\n";
+    return 0;
+  }
+
+  // 4. Errors and peaks side by side, residuals.
+  void compare_with_scan()
+  {
+    const ComputedProfile computed = computed_at(scan_->angle, *ring_, probe_radius_, fem_path_);
+    const FluxComparison c = compare_flux(*scan_, computed.Bn, computed.Bt, case_.roller->poles);
+    std::cout << "\n";
+    print_comparison(c, "Scan against the " + computed.source + ":");
+    residuals_ = dir_ + "/flux_residuals.csv";
+    write_residuals_csv(residuals_, c);
+    std::cout << "  residuals   " << residuals_ << "\n";
+  }
+
+  // 5. Levenberg–Marquardt on the exact ring, and the fitted model against the scan.
+  void fit_poles_to_scan()
+  {
+    fit_ = fit_poles(*case_.roller, *scan_, probe_radius_, o_.fit_options);
+    std::cout << "\n" << fit_report(*fit_, o_) << "\n";
+    if (!fit_->converged)
+      std::cout << "warning: the fit did not converge; the parameters above are the last iterate\n";
+    const MultipoleRing fitted_ring(fit_->roller, ring_options_);
+    ComputedProfile fitted;
+    fitted_ring.profile(probe_radius_, scan_->angle, fitted.Bn, fitted.Bt);
+    const FluxComparison c = compare_flux(*scan_, fitted.Bn, fitted.Bt, fit_->roller.poles);
+    print_comparison(c, "Scan against the fitted pole model (exact ring):");
+    fit_residuals_ = dir_ + "/flux_fit_residuals.csv";
+    write_residuals_csv(fit_residuals_, c);
+    std::cout << "  residuals   " << fit_residuals_ << "\n";
+  }
+
+  // 6. <case>_fitted.yaml (checked by loading it back) and the fit report.
+  void write_fitted_case()
+  {
+    const std::string stem = fs::path(case_.source_file).stem().string();
+    fitted_case_ = dir_ + "/" + stem + "_fitted.yaml";
+    write_file_atomically(fitted_case_,
+                          fitted_case_text(case_, o_, *fit_, scan_path_, case_.name + "_fitted"));
+    write_file_atomically(dir_ + "/flux_fit.txt", fit_report(*fit_, o_));
+    try
+    {
+      load_case(fitted_case_);
+    }
+    catch (const std::exception &e)
+    {
+      throw std::runtime_error("internal error: the fitted case " + fitted_case_ +
+                               " does not load: " + e.what());
+    }
+    std::cout << "  fitted case " << fitted_case_ << "\n  fit report  " << dir_ << "/flux_fit.txt\n";
+  }
+
+  void plot_overlay()
+  {
+    if (o_.no_plot)
+      return;
+    const std::string title = "Case '" + case_.name + "'" + (fit_ ? " and its fitted poles" : "") +
+                              " against " + scan_path_;
+    plot(residuals_, fit_ ? fit_residuals_ : "", dir_ + "/flux_overlay.png", title,
+         fem_path_.empty() ? "exact ring" : "FEM");
+  }
+
+  // 7. "The FEM as the final check".
+  void check_fit_by_fem()
+  {
+    if (o_.no_fem_check)
+      std::cout << "FEM check skipped (--no-fem-check)\n";
+    else
+      fem_check(fitted_case_, *scan_, dir_);
+  }
+};
+
 int run_flux(const std::vector<std::string> &args)
 {
   for (const auto &a : args)
@@ -542,129 +721,17 @@ int run_flux(const std::vector<std::string> &args)
       std::cout << flux_help;
       return 0;
     }
-  FluxOptions o;
+  FluxOptions options;
   try
   {
-    o = parse_arguments(args);
+    options = parse_arguments(args);
   }
   catch (const UsageError &e)
   {
     std::cerr << "magbrush flux: " << e.what() << "\n";
     return 2;
   }
-
-  // 1. The case and the probe radius.
-  const Case c = load_case(o.case_path, o.overrides);
-  const double r = probe_radius_of(c);
-  MultipoleRing::Options ring_options;
-  ring_options.harmonics = o.harmonics;
-  const MultipoleRing ring(*c.roller, ring_options);
-  const std::string dir =
-      o.output_dir.empty() ? c.output.directory + "/" + c.name + "/flux" : o.output_dir;
-  fs::create_directories(dir);
-  std::cout << "magbrush flux: case '" << c.name << "', probe radius " << fixed(r * 1e3, 3)
-            << " mm (magnet " << fixed(c.roller->magnet_radius * 1e3, 3) << " mm), "
-            << c.roller->poles.size() << " poles\n"
-            << "  exact ring: " << ring.harmonic_count() << " harmonics"
-            << (o.harmonics ? " (as asked)"
-                            : " (chosen from the decay: every coefficient beyond is below " +
-                                  scientific(std::max(ring.harmonic_choice().tail, 1e-16)) +
-                                  " of the largest)")
-            << "\n";
-
-  // 2. Where the computed profile comes from.
-  std::string why_not_fem = "--source ring";
-  const std::string fem_path = o.source == "ring" ? "" : fem_profile_path(c, r, why_not_fem);
-  if (o.source == "fem" && fem_path.empty())
-    throw std::invalid_argument("--source fem: " + why_not_fem);
-  std::vector<double> grid;
-  for (int k = 0; k < 1440; ++k)
-    grid.push_back(k * 0.25 / to_deg);
-  const ComputedProfile on_grid = computed_at(grid, ring, r, fem_path);
-  std::cout << "  computed profile: " << on_grid.source << "\n";
-  if (fem_path.empty())
-    std::cout << "  (" << why_not_fem << ")\n";
-  write_profile_csv(dir + "/flux_profile.csv", c, r, on_grid, grid);
-  std::cout << "  profile     " << dir << "/flux_profile.csv\n";
-
-  // 3. The scan and the comparison.
-  const std::string scan_path = o.measured.empty() ? c.measured_flux_file : o.measured;
-  if (scan_path.empty())
-  {
-    if (o.fit)
-      throw std::invalid_argument("--fit needs a scan: give --measured FILE.csv (or set "
-                                  "measured_flux_file in the case)");
-    const auto peaks = find_pole_peaks(c.roller->poles, grid, on_grid.Bn);
-    std::cout << "\nNo scan given (--measured or measured_flux_file): computed peaks only.\n"
-              << "  pole   angle [deg]   Bn peak [mT]\n";
-    for (size_t i = 0; i < peaks.size(); ++i)
-      std::cout << "  " << c.roller->poles[i].name << "    "
-                << (peaks[i].found ? fixed(peaks[i].angle * to_deg, 2) + "      " +
-                                         fixed(peaks[i].value * 1e3, 2)
-                                   : std::string("(no peak)"))
-                << "\n";
-    return 0;
-  }
-  const FluxScan scan = read_flux_scan(scan_path, o.scan);
-  std::cout << "  scan: " << scan_path << ": " << scan.size() << " points, angle in "
-            << scan.angle_unit << ", field in " << scan.field_unit
-            << (scan.has_tangential() ? ", Bn and Bt" : ", Bn only") << "\n";
-  for (const auto &n : scan.notes)
-    std::cout << "  note: " << n << "\n";
-  const ComputedProfile computed = computed_at(scan.angle, ring, r, fem_path);
-  const FluxComparison comparison = compare_flux(scan, computed.Bn, computed.Bt, c.roller->poles);
-  std::cout << "\n";
-  print_comparison(comparison, "Scan against the " + computed.source + ":");
-  const std::string residuals = dir + "/flux_residuals.csv";
-  write_residuals_csv(residuals, comparison);
-  std::cout << "  residuals   " << residuals << "\n";
-  const std::string label = fem_path.empty() ? "exact ring" : "FEM";
-
-  if (!o.fit)
-  {
-    if (!o.no_plot)
-      plot(residuals, "", dir + "/flux_overlay.png", "Case '" + c.name + "' against " + scan_path,
-           label);
-    return 0;
-  }
-
-  // 4. The fit.
-  const PoleFitResult fit = fit_poles(*c.roller, scan, r, o.fit_options);
-  const std::string report = fit_report(fit, o);
-  std::cout << "\n" << report << "\n";
-  if (!fit.converged)
-    std::cout << "warning: the fit did not converge; the parameters above are the last iterate\n";
-  const MultipoleRing fitted_ring(fit.roller, ring_options);
-  ComputedProfile fitted;
-  fitted_ring.profile(r, scan.angle, fitted.Bn, fitted.Bt);
-  const FluxComparison fc = compare_flux(scan, fitted.Bn, fitted.Bt, fit.roller.poles);
-  print_comparison(fc, "Scan against the fitted pole model (exact ring):");
-  const std::string fit_residuals = dir + "/flux_fit_residuals.csv";
-  write_residuals_csv(fit_residuals, fc);
-
-  const std::string stem = fs::path(c.source_file).stem().string();
-  const std::string fitted_path = dir + "/" + stem + "_fitted.yaml";
-  write_file_atomically(fitted_path, fitted_case_text(c, o, fit, scan_path, c.name + "_fitted"));
-  write_file_atomically(dir + "/flux_fit.txt", report);
-  try
-  {
-    load_case(fitted_path); // the file we wrote must be a valid case
-  }
-  catch (const std::exception &e)
-  {
-    throw std::runtime_error("internal error: the fitted case " + fitted_path +
-                             " does not load: " + e.what());
-  }
-  std::cout << "  residuals   " << fit_residuals << "\n  fitted case " << fitted_path
-            << "\n  fit report  " << dir << "/flux_fit.txt\n";
-  if (!o.no_plot)
-    plot(residuals, fit_residuals, dir + "/flux_overlay.png",
-         "Case '" + c.name + "' and its fitted poles against " + scan_path, label);
-  if (o.no_fem_check)
-    std::cout << "FEM check skipped (--no-fem-check)\n";
-  else
-    fem_check(fitted_path, scan, dir);
-  return 0;
+  return FluxCommand(options).run();
 }
 
 const bool registered = register_subcommand(

@@ -28,7 +28,11 @@ const Material &Case::material(const std::string &name) const
   for (const auto &m : materials)
     if (m.name == name)
       return m;
-  throw std::runtime_error("case '" + source_file + "': no material named '" + name + "'");
+  std::string known;
+  for (const auto &m : materials)
+    known += (known.empty() ? "" : ", ") + m.name;
+  throw std::runtime_error("case '" + source_file + "': no material named '" + name + "' (materials: " +
+                           (known.empty() ? "none" : known) + "); add it under 'materials:'");
 }
 
 } // namespace magbrush

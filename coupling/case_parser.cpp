@@ -52,7 +52,10 @@ std::string node_kind(const YAML::Node &n)
   switch (n.Type())
   {
   case YAML::NodeType::Null: return "nothing";
-  case YAML::NodeType::Scalar: return "'" + n.Scalar() + "'";
+  case YAML::NodeType::Scalar:
+    return n.Scalar().size() <= 80 ? "'" + n.Scalar() + "'"
+                                   : "'" + n.Scalar().substr(0, 60) + "...' (" + std::to_string(n.Scalar().size()) +
+                                         " characters)";
   case YAML::NodeType::Sequence: return "a list";
   case YAML::NodeType::Map: return "a section (key: value lines)";
   default: return "an undefined value";

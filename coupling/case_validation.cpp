@@ -269,6 +269,8 @@ void check_fields(const Case &c, std::vector<CaseIssue> &out)
   if (c.electric.enabled && c.scene == "roller" && !c.drum.present)
     out.push_back({"electric", "the nip field needs a drum; add a 'drum' section or set electric.enabled: false"});
   const auto &f = c.applied_field;
+  if (f.kind == AppliedField::Kind::roller && !c.roller)
+    out.push_back({"applied_field.kind", "the applied field comes from the roller, but the case has no 'roller' section"});
   if (f.kind == AppliedField::Kind::uniform && f.uniform_magnitude <= 0.0)
     out.push_back({"applied_field.magnitude", "a uniform applied field needs a magnitude > 0 (e.g. 130 mT)"});
   if (c.roller && c.field.probe_radius > 0.0 && c.field.probe_radius <= c.roller->magnet_radius)

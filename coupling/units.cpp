@@ -186,10 +186,16 @@ bool lookup_symbol(const std::string &symbol, Exponents &exponents, double &fact
   return false;
 }
 
+// Long inputs are cut in messages (a case value is short; a pasted blob should not flood).
+std::string shortened(const std::string &text)
+{
+  return text.size() <= 80 ? text : text.substr(0, 60) + "...(" + std::to_string(text.size()) + " characters)";
+}
+
 [[noreturn]] void fail(const std::string &text, Dimension expected, const std::string &why)
 {
   throw UnitError("expected " + dimension_description(expected) + " (e.g. " +
-                  dimension_example(expected) + "), found '" + text + "'" +
+                  dimension_example(expected) + "), found '" + shortened(text) + "'" +
                   (why.empty() ? "" : ": " + why));
 }
 
@@ -278,7 +284,7 @@ double parse_quantity(const std::string &original, Dimension expected)
     double f;
     if (!lookup_symbol(symbol, e, f))
       fail(original, expected,
-           "unknown unit '" + symbol +
+           "unknown unit '" + shortened(symbol) +
                "' (units: m, s, g, rad, deg, rpm, Hz, N, Pa, J, C, V, T, G (gauss), A, % with "
                "prefixes f p n u m c k M G, combined with * / ^)");
     int power = 1;

@@ -193,3 +193,11 @@ TEST(Units, FormatThenParseRoundTrips)
       EXPECT_NO_THROW(parse_quantity(dimension_example(d), d)) << dimension_example(d);
     }
 }
+
+TEST(Units, LongInputsAreShortenedInMessages)
+{
+  const std::string blob(100000, 'x');
+  const std::string e = error_of("5 " + blob, Dimension::length);
+  EXPECT_LT(e.size(), 400u);
+  EXPECT_NE(e.find("100002 characters"), std::string::npos) << e;
+}

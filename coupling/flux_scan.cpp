@@ -295,7 +295,11 @@ FluxScan parse_flux_scan(std::istream &in, const std::string &name,
                       " columns, found " + std::to_string(cells.size()) + " in '" + t + "'");
     auto number_in = [&](int column, const char *what) {
       double v;
-      if (!parse_number(cells[column], v))
+      std::string cell = cells[column];
+      // A decimal comma ("1,25") is fine when the separator is not a comma.
+      if (sep != ',' && cell.find(',') != std::string::npos && cell.find('.') == std::string::npos)
+        cell[cell.find(',')] = '.';
+      if (!parse_number(cell, v))
         throw ScanError(where(name, number) + "the " + what + " cell '" + cells[column] +
                         "' (column " + std::to_string(column + 1) + ") is not a number");
       if (!std::isfinite(v))
@@ -341,8 +345,23 @@ FluxScan parse_flux_scan(std::istream &in, const std::string &name,
   if (options.require_tangential && raw_bt.empty())
     throw ScanError(name + ": no tangential (Bt) column, which this operation needs");
 
-  // Strictly monotone angles, at most one turn.
+  // An encoder that wraps (…, 358, 359, 0, 1, …) is unwrapped: a jump back by more than half
+  // a turn against the scan's direction is a wrap, not a step.
   const bool increasing = raw_angle[1] > raw_angle[0];
+  const double turn = 2.0 * pi / fa;
+  double unwrap = 0.0;
+  for (size_t k = 1; k < raw_angle.size(); ++k)
+  {
+    const double step = raw_angle[k] + unwrap - raw_angle[k - 1];
+    if (increasing ? step < -0.5 * turn : step > 0.5 * turn)
+    {
+      unwrap += increasing ? turn : -turn;
+      scan.notes.push_back("the angle wraps around at line " + std::to_string(scan.line[k]) +
+                           "; unwrapped");
+    }
+    raw_angle[k] += unwrap;
+  }
+  // Strictly monotone angles, at most one turn.
   for (size_t k = 1; k < raw_angle.size(); ++k)
   {
     const double step = raw_angle[k] - raw_angle[k - 1];

@@ -9,9 +9,11 @@
 //       Bt:    Bt, B_t, Btheta, B_theta, Btan, tangential, ... (optional: a Bn-only scan is fine)
 //     with the unit in the name (angle_deg, Bn_mT, "Bn [G]", "Bt (mT)", Bn/T); without a header
 //     the columns are angle, Bn[, Bt] in that order;
-//   * separators: comma, semicolon, tab or blanks (taken from the header / first data line).
+//   * separators: comma, semicolon, tab or blanks (taken from the header / first data line);
+//     with a separator other than the comma, a decimal comma is accepted ("1,25").
 // Units: angle deg | rad, field T | mT | G | kG. A unit given as an option overrides the header
 // (with a note); with neither, degrees and millitesla are assumed (with a note).
+// A scan whose angle wraps around (…, 359, 0, 1, …) is unwrapped (with a note).
 // Angular origin and direction: the roller-frame angle is
 //     θ_roller = (clockwise ? −θ_scan : θ_scan) + angle_offset,
 // and a clockwise scan also flips the sign of Bt (Bt is positive counter-clockwise).

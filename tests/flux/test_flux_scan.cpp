@@ -66,6 +66,10 @@ TEST(FluxScan, UnderstandsHeaderNamesAndUnits)
   EXPECT_DOUBLE_EQ(b.angle[0], 10 * deg);
   EXPECT_DOUBLE_EQ(b.Bn[2], 0.3);
   EXPECT_EQ(b.angle_unit, "deg");
+  // Semicolons with decimal commas (a European spreadsheet export).
+  const FluxScan e = parse("angle_deg;Bn_mT;Bt_mT\n0,5;-99,94;-0,68\n1,5;-99,52;-6,83\n2,5;-98,85;-13,98\n");
+  EXPECT_DOUBLE_EQ(e.angle[1], 1.5 * deg);
+  EXPECT_DOUBLE_EQ(e.Bn[0], -99.94e-3);
   // "B_t" is the tangential component, not a column in tesla.
   const FluxScan c = parse("angle_deg,B_n,B_t\n0,1,2\n1,1,2\n2,1,2\n", {"", "mT"});
   EXPECT_EQ(c.bt_column, "B_t");
@@ -113,6 +117,11 @@ TEST(FluxScan, AppliesOffsetAndDirection)
   EXPECT_NEAR(c.angle[2], 0.0, 1e-15);  // −10° + 10°
   EXPECT_DOUBLE_EQ(c.Bt[0], -2e-3);     // Bt positive counter-clockwise
   EXPECT_DOUBLE_EQ(c.Bn[0], 1e-3);
+  // An encoder that wraps at 360° is unwrapped.
+  const FluxScan w = parse("angle_deg,Bn_mT\n350,1\n355,1\n0,1\n5,1\n");
+  EXPECT_NEAR(w.angle[3], 365 * deg, 1e-12);
+  ASSERT_EQ(w.notes.size(), 1u);
+  EXPECT_TRUE(contains(w.notes[0], "wraps around at line 4"));
   // A decreasing scan is fine as it stands.
   EXPECT_NO_THROW(parse("angle_deg,Bn_mT\n10,1\n5,1\n0,1\n"));
 }

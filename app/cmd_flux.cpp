@@ -61,6 +61,7 @@ Options:
   --field-unit T|mT|G|kG unit of the scan's Bn/Bt columns (overrides the header)
   --angle-offset ANGLE   roller angle = scan angle + ANGLE (e.g. 2.5deg)
   --clockwise            the scan's angle runs clockwise (Bt is then negated too)
+  --flip-bt              the probe's Bt is positive clockwise: negate it
   --source auto|ring|fem computed profile from the FEM if present (auto), the exact ring, or
                          the FEM only (error if missing)
   --fit                  fit the pole model to the scan; writes <case>_fitted.yaml in DIR
@@ -121,6 +122,8 @@ FluxOptions parse_arguments(const std::vector<std::string> &args)
       o.scan.angle_offset = parse_quantity(value(i), Dimension::angle);
     else if (a == "--clockwise")
       o.scan.clockwise = true;
+    else if (a == "--flip-bt")
+      o.scan.flip_tangential = true;
     else if (a == "--source")
     {
       o.source = value(i);

@@ -180,6 +180,17 @@ FluxComparison compare_flux(const FluxScan &scan, const std::vector<double> &com
   for (size_t i = 0; i < poles.size(); ++i)
     c.peaks.push_back({poles[i].name, computed[i], measured[i]});
   c.unmatched = unmatched_extrema(scan.angle, scan.Bn, measured);
+  if (c.has_tangential)
+  {
+    double mm = 0, cc = 0, mc = 0;
+    for (size_t k = 0; k < scan.size(); ++k)
+    {
+      mm += scan.Bt[k] * scan.Bt[k];
+      cc += computed_Bt[k] * computed_Bt[k];
+      mc += scan.Bt[k] * computed_Bt[k];
+    }
+    c.tangential_correlation = mm > 0 && cc > 0 ? mc / std::sqrt(mm * cc) : 0.0;
+  }
   return c;
 }
 
@@ -197,6 +208,10 @@ std::string format_errors(const FluxComparison &c)
   row("Bn", c.Bn);
   if (c.has_tangential)
     row("Bt", c.Bt);
+  if (c.has_tangential && c.tangential_correlation < -0.5)
+    out << "  note: the measured Bt is anti-correlated with the computed one (correlation "
+        << c.tangential_correlation
+        << "): the probe's tangential sign is probably clockwise-positive; pass --flip-bt\n";
   return out.str();
 }
 

@@ -51,6 +51,9 @@ struct FluxComparison
   // Clear extrema of the measured Bn (above 20 % of its largest magnitude, the largest within
   // ±10°) that no pole of the case accounts for: a pole missing from the case, or a wrong sign.
   std::vector<PeakMatch> unmatched;
+  // Correlation of measured and computed Bt (1 = same shape); strongly negative means the
+  // scan's Bt has the opposite sign convention.
+  double tangential_correlation = 0.0;
 };
 
 FluxComparison compare_flux(const FluxScan &scan, const std::vector<double> &computed_Bn,

@@ -389,7 +389,7 @@ FluxScan parse_flux_scan(std::istream &in, const std::string &name,
     scan.angle.push_back(direction * raw_angle[k] * fa + options.angle_offset);
     scan.Bn.push_back(raw_bn[k] * fb);
     if (!raw_bt.empty())
-      scan.Bt.push_back(direction * raw_bt[k] * fb);
+      scan.Bt.push_back((options.flip_tangential ? -direction : direction) * raw_bt[k] * fb);
   }
   double largest = 0.0;
   for (double b : scan.Bn)

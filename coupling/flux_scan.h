@@ -41,6 +41,7 @@ struct ScanReadOptions
   std::string field_unit;      // "" = from the header; else "T" | "mT" | "G" | "kG"
   double angle_offset = 0.0;   // [rad], added after the direction is applied
   bool clockwise = false;      // the scan's angle runs clockwise seen from +z
+  bool flip_tangential = false; // the probe's Bt is positive clockwise (negate it)
   size_t min_points = 8;
   bool require_tangential = false;
 };

@@ -194,3 +194,14 @@ TEST(FluxScan, PeriodicInterpolationIsThirdOrderAndWraps)
   }
   EXPECT_LT(previous, 1e-5);
 }
+
+TEST(FluxScan, FlipsTheTangentialSignOnRequest)
+{
+  ScanReadOptions o;
+  o.flip_tangential = true;
+  const FluxScan s = parse("angle_deg,Bn_mT,Bt_mT\n0,1,2\n5,1,2\n10,1,2\n", o);
+  EXPECT_DOUBLE_EQ(s.Bt[0], -2e-3);
+  EXPECT_DOUBLE_EQ(s.Bn[0], 1e-3);
+  o.clockwise = true; // both: the two sign flips cancel
+  EXPECT_DOUBLE_EQ(parse("angle_deg,Bn_mT,Bt_mT\n0,1,2\n5,1,2\n10,1,2\n", o).Bt[0], 2e-3);
+}

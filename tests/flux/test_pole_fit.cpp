@@ -360,3 +360,16 @@ TEST(FluxCompare, FlagsAPeakNoPoleAccountsFor)
   MultipoleRing(example_roller()).profile(10e-3, scan.angle, Bn, Bt);
   EXPECT_TRUE(compare_flux(scan, Bn, Bt, example_roller().poles).unmatched.empty());
 }
+
+TEST(FluxCompare, NoticesAFlippedTangentialSign)
+{
+  FluxScan scan = read_flux_scan(example_scan_path());
+  std::vector<double> Bn, Bt;
+  MultipoleRing(example_roller()).profile(10e-3, scan.angle, Bn, Bt);
+  EXPECT_GT(compare_flux(scan, Bn, Bt, example_roller().poles).tangential_correlation, 0.99);
+  for (double &b : scan.Bt)
+    b = -b;
+  const FluxComparison c = compare_flux(scan, Bn, Bt, example_roller().poles);
+  EXPECT_LT(c.tangential_correlation, -0.99);
+  EXPECT_NE(format_errors(c).find("--flip-bt"), std::string::npos);
+}

@@ -154,7 +154,10 @@ TEST(FluxScan, ErrorsNameTheFileTheLineAndTheFix)
   EXPECT_TRUE(contains(e, "0 data points")) << e;
   e = error_of("angle_deg,Bn_mT,Bt_G\n0,1,2\n1,1,2\n2,1,2\n", few);
   EXPECT_TRUE(contains(e, "same unit")) << e;
-  e = error_of(head + "0,1,2\n1,1,2\n2,1,2\n", {"grad", "", 0, false, 3});
+  ScanReadOptions grad;
+  grad.angle_unit = "grad";
+  grad.min_points = 3;
+  e = error_of(head + "0,1,2\n1,1,2\n2,1,2\n", grad);
   EXPECT_TRUE(contains(e, "unknown angle unit 'grad'")) << e;
   EXPECT_THROW(read_flux_scan("/nonexistent/scan.csv"), ScanError);
   try

@@ -13,6 +13,7 @@ warns and carries on), 2 for bad arguments or unreadable files.
 """
 import argparse
 import csv
+import os
 import sys
 
 
@@ -83,7 +84,10 @@ def main():
     for ax in (top, bottom):
         ax.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(args.output, dpi=120)
+    # Atomic: a half-written PNG never replaces a good one.
+    tmp = f"{args.output}.tmp{os.getpid()}.png"
+    fig.savefig(tmp, dpi=120)
+    os.replace(tmp, args.output)
     return 0
 
 

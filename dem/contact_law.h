@@ -143,6 +143,9 @@ struct ContactOutcome
 };
 
 // The whole law for one touching contact: normal + damping + tangential + rolling.
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
 inline ContactOutcome evaluate_contact(const ContactCoefficients &c, const ContactKinematics &k,
                                        Vector3 &history, double dt)
 {

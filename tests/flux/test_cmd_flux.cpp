@@ -286,3 +286,22 @@ TEST(CmdFlux, MissingPythonOnlyWarns)
   EXPECT_TRUE(fs::exists(dir / "out" / "flux_residuals.csv"));
   EXPECT_FALSE(fs::exists(dir / "out" / "flux_overlay.png"));
 }
+
+TEST(CmdFlux, WritesTheOverlayPlotWhenMatplotlibIsAvailable)
+{
+  if (std::system("/usr/bin/python3 -c 'import matplotlib' > /dev/null 2>&1") != 0)
+    GTEST_SKIP() << "no /usr/bin/python3 with matplotlib here";
+  const fs::path dir = scratch("plot");
+  const fs::path case_file = write_case(dir);
+  const CommandResult r = run_magbrush(case_file.string() + " --measured " + example_scan_path() +
+                                           " -o " + (dir / "out").string() + " --fit --no-fem-check",
+                                       "MAGBRUSH_PYTHON=/usr/bin/python3");
+  ASSERT_EQ(r.status, 0) << r.output;
+  const fs::path png = dir / "out" / "flux_overlay.png";
+  ASSERT_TRUE(fs::exists(png)) << r.output;
+  EXPECT_GT(fs::file_size(png), 20000u);
+  std::ifstream in(png, std::ios::binary);
+  char magic[4] = {};
+  in.read(magic, 4);
+  EXPECT_EQ(std::string(magic + 1, 3), "PNG");
+}

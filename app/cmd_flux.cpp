@@ -591,9 +591,13 @@ private:
               << case_.roller->poles.size() << " poles\n"
               << "  exact ring: " << ring_->harmonic_count() << " harmonics"
               << (o_.harmonics ? " (as asked)"
-                               : " (chosen from the decay: every coefficient beyond is below " +
-                                     scientific(std::max(ring_->harmonic_choice().tail, 1e-16)) +
-                                     " of the largest)")
+                  : ring_->harmonic_choice().capped
+                      ? " (capped: wide poles, α ≲ 3, have a slope kink at the back of the roller "
+                        "and a slowly decaying series; outside the magnet the field still converges "
+                        "geometrically)"
+                      : " (chosen from the decay: every coefficient beyond is below " +
+                            scientific(std::max(ring_->harmonic_choice().tail, 1e-16)) +
+                            " of the largest)")
               << "\n";
   }
 

@@ -516,6 +516,23 @@ void InducedDipoles::add_held_forces(const ForceArrays &out) const
   }
 }
 
+void InducedDipoles::particles_reordered(const std::vector<std::int32_t> &order)
+{
+  auto permute = [&](std::vector<double> &v) {
+    if (v.size() != 3 * order.size())
+      return;
+    std::vector<double> old(v);
+    for (std::size_t k = 0; k < order.size(); ++k)
+      for (int d = 0; d < 3; ++d)
+        v[3 * k + d] = old[3 * static_cast<std::size_t>(order[k]) + d];
+  };
+  permute(p_);
+  permute(force_);
+  permute(torque_);
+  permute(x_last_);
+  list_ = MagneticNeighbourList(); // pair indices refer to the old order
+}
+
 bool InducedDipoles::needs_refresh(const BeadArrays &beads, double time) const
 {
   if (!computed_ || x_last_.size() != 3 * beads.n)

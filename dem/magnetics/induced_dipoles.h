@@ -28,6 +28,7 @@
 #include "two_sphere_table.h"
 
 #include <array>
+#include <cstdint>
 #include <cstddef>
 #include <functional>
 #include <map>
@@ -95,6 +96,10 @@ public:
 
   // Forget the dipoles (the next compute starts from the applied-field dipoles).
   void reset_dipoles() { p_.clear(); }
+
+  // The caller re-sorted its beads (new[k] = old[order[k]]): the kept dipoles, held forces
+  // and reference positions follow, and the neighbour list is rebuilt at the next compute.
+  void particles_reordered(const std::vector<std::int32_t> &order);
 
   const MagneticSettings &settings() const { return settings_; }
   const MagneticNeighbourList &neighbour_list() const { return list_; }

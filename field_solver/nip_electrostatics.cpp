@@ -1,0 +1,147 @@
+#include "nip_electrostatics.h"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace magbrush::field {
+
+namespace {
+constexpr double eps0 = 8.8541878128e-12;
+constexpr double pi = 3.14159265358979323846;
+
+double wrap(double a)
+{
+  a = std::fmod(a + pi, 2.0 * pi);
+  if (a <= 0.0)
+    a += 2.0 * pi;
+  return a - pi;
+}
+} // namespace
+
+double latent_image_value(const LatentImage &image, double s)
+{
+  if (image.period <= 0.0)
+    return image.dark_value;
+  const double u = s / image.period + 0.5 * image.duty;
+  const double frac = u - std::floor(u);
+  return frac < image.duty ? image.light_value : image.dark_value;
+}
+
+NipElectrostatics::NipElectrostatics(MPI_Comm communicator_in, const NipLayout &layout,
+                                     double layer_eps_r_in, double bias_in,
+                                     const LatentImage &image_in,
+                                     const NipDiscretisation &disc)
+  : communicator(communicator_in)
+  , nip(layout)
+  , layer_eps_r(layer_eps_r_in)
+  , bias(bias_in)
+  , image(image_in)
+  , discretisation(disc)
+  , triangulation(communicator, dealii::Triangulation<2>::none, false,
+                  dealii::parallel::shared::Triangulation<2>::partition_metis)
+{
+  if (!(layer_eps_r >= 1.0) || !std::isfinite(layer_eps_r))
+    throw std::invalid_argument("nip field: drum.pc_eps_r must be ≥ 1, found " +
+                                std::to_string(layer_eps_r));
+  if (image.kind == LatentImage::Kind::surface_charge && !(nip.layer_thickness > 0.0))
+    throw std::invalid_argument("nip field: a latent image given as surface charge needs a "
+                                "photoconductor layer (drum.pc_thickness > 0)");
+}
+
+NipElectrostatics::~NipElectrostatics() = default;
+
+double NipElectrostatics::arc_length_from_nip(const Point<2> &x) const
+{
+  const double phi = std::atan2(x[1] - nip.drum_center[1], x[0] - nip.drum_center[0]);
+  return nip.drum_radius * wrap(phi - (nip.drum_angle + pi));
+}
+
+PotentialProblemDescription NipElectrostatics::describe() const
+{
+  PotentialProblemDescription d;
+  d.name = "nip field";
+  d.degree = discretisation.degree;
+  d.solver_tolerance = discretisation.solver_tolerance;
+  d.coefficient[nip_region::air] = eps0;
+  d.coefficient[nip_region::photoconductor] = eps0 * layer_eps_r;
+  const double V = bias;
+  d.dirichlet[nip_boundary::sleeve] = [V](const Point<2> &) { return V; };
+  if (image.kind == LatentImage::Kind::surface_potential)
+    d.dirichlet[nip_boundary::drum] = [this](const Point<2> &x) {
+      return latent_image_value(image, arc_length_from_nip(x));
+    };
+  else
+    d.dirichlet[nip_boundary::drum] = [](const Point<2> &) { return 0.0; };
+  if (image.kind == LatentImage::Kind::surface_charge)
+    d.surface_charges.push_back({nip_region::photoconductor, nip_region::air,
+                                 [this](const Point<2> &x) {
+                                   return latent_image_value(image, arc_length_from_nip(x));
+                                 }});
+  return d;
+}
+
+void NipElectrostatics::run()
+{
+  const bool mesh_layer = image.kind != LatentImage::Kind::surface_potential;
+  NipLayout layout = nip;
+  if (!mesh_layer)
+    layout.layer_thickness = 0.0;
+  triangulation.clear();
+  make_nip_mesh(triangulation, layout, discretisation.n_tau, discretisation.n_sigma,
+                mesh_layer ? discretisation.n_layer : 0);
+  triangulation.refine_global(discretisation.refinements);
+  solver = std::make_unique<PotentialProblem>(triangulation, describe());
+  solver->run();
+}
+
+std::vector<double> NipElectrostatics::potential(const std::vector<Vec2> &points) const
+{
+  const bool mesh_layer =
+    image.kind != LatentImage::Kind::surface_potential && nip.layer_thickness > 0.0;
+  const double substrate = nip.drum_radius - (mesh_layer ? nip.layer_thickness : 0.0);
+  std::vector<double> values(points.size(), 0.0);
+  std::vector<Point<2>> inside;
+  std::vector<std::size_t> index;
+  for (std::size_t k = 0; k < points.size(); ++k)
+  {
+    const double rs = std::hypot(points[k][0], points[k][1]);
+    const double rd =
+      std::hypot(points[k][0] - nip.drum_center[0], points[k][1] - nip.drum_center[1]);
+    if (rs < nip.sleeve_radius)
+      values[k] = bias;
+    else if (rd < substrate)
+      values[k] = image.kind == LatentImage::Kind::surface_potential
+                    ? latent_image_value(image, arc_length_from_nip(
+                                                  Point<2>(points[k][0], points[k][1])))
+                    : 0.0;
+    else
+    {
+      inside.emplace_back(points[k][0], points[k][1]);
+      index.push_back(k);
+    }
+  }
+  const auto v = solver->values_at(inside);
+  for (std::size_t i = 0; i < index.size(); ++i)
+    values[index[i]] = v[i];
+  return values;
+}
+
+std::vector<Vec2> NipElectrostatics::electric_field(const std::vector<Vec2> &points) const
+{
+  std::vector<Point<2>> p;
+  for (const auto &x : points)
+    p.emplace_back(x[0], x[1]);
+  const auto g = solver->gradients_at(p);
+  std::vector<Vec2> E;
+  for (const auto &gr : g)
+    E.push_back({{-gr[0], -gr[1]}});
+  return E;
+}
+
+void NipElectrostatics::write_vtu(const std::string &directory,
+                                  const std::string &basename) const
+{
+  solver->write_vtu(directory, basename, "electric");
+}
+
+} // namespace magbrush::field

@@ -1,0 +1,70 @@
+// The nip's electrostatic field (Kweon eq. 7–8): −∇·(ε∇Φ) = 0 between the biased sleeve and
+// the grounded drum substrate, through the photoconductor layer (thickness t, εr) and the air
+// gap, with the latent image either as a surface charge σ(s) on the layer (a face integral on
+// the layer/air interface) or as a prescribed surface potential (then the layer itself is not
+// meshed: its surface is a Dirichlet boundary). E = −∇Φ by exact differentiation.
+//
+// The mesh (layered_meshes.h make_nip_mesh) uses the bipolar coordinates of the sleeve and the
+// drum surface, so both surfaces and the gap are exact and graded toward the nip by
+// themselves.
+#pragma once
+
+#include "case_model.h"
+#include "layered_meshes.h"
+#include "potential_problem.h"
+
+#include <memory>
+#include <vector>
+
+namespace magbrush::field {
+
+struct NipDiscretisation
+{
+  unsigned int degree = 2;
+  unsigned int n_tau = 4;      // cells across the air from drum to sleeve
+  unsigned int n_sigma = 64;   // cells around (bipolar σ)
+  unsigned int n_layer = 1;    // cells across the photoconductor
+  unsigned int refinements = 0;
+  double solver_tolerance = 1e-12;
+};
+
+// The latent image along the drum surface as a function of the arc length s from the nip
+// point (the drum surface point nearest the sleeve): exposed ("light") where
+// frac(s/period + duty/2) < duty — an exposed strip centred on the nip — dark elsewhere;
+// uniformly dark when period = 0.
+double latent_image_value(const LatentImage &image, double s);
+
+class NipElectrostatics
+{
+public:
+  NipElectrostatics(MPI_Comm communicator, const NipLayout &layout, double layer_eps_r,
+                    double bias, const LatentImage &image, const NipDiscretisation &disc);
+  ~NipElectrostatics();
+
+  void run();
+
+  // Φ at points (collective). Points inside the sleeve get the bias, points inside the drum
+  // substrate 0 V (conductors); all others must be in the meshed region.
+  std::vector<double> potential(const std::vector<Vec2> &points) const;
+  std::vector<Vec2> electric_field(const std::vector<Vec2> &points) const; // meshed region only
+
+  // Arc length from the nip point along the drum surface of the point x [m].
+  double arc_length_from_nip(const Point<2> &x) const;
+
+  void write_vtu(const std::string &directory, const std::string &basename) const;
+  const PotentialProblem &problem() const { return *solver; }
+  const NipLayout &layout() const { return nip; }
+
+private:
+  PotentialProblemDescription describe() const;
+
+  MPI_Comm communicator;
+  NipLayout nip;
+  double layer_eps_r, bias;
+  LatentImage image;
+  NipDiscretisation discretisation;
+  dealii::parallel::shared::Triangulation<2> triangulation;
+  std::unique_ptr<PotentialProblem> solver;
+};
+
+} // namespace magbrush::field

@@ -1,0 +1,190 @@
+#include "roller_magnetostatics.h"
+
+#include "layered_meshes.h"
+#include "pole_magnetisation.h"
+
+#include <deal.II/grid/tria.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace magbrush::field {
+
+namespace {
+constexpr double mu0 = 4.0e-7 * 3.14159265358979323846;
+constexpr double pi = 3.14159265358979323846;
+} // namespace
+
+RollerGeometry RollerGeometry::from(const Roller &roller, const Sleeve &sleeve)
+{
+  RollerGeometry g;
+  g.shaft_radius = roller.shaft_radius;
+  g.shaft_mu_r = roller.shaft_mu_r;
+  g.magnet_radius = roller.magnet_radius;
+  g.magnet_mu_r = roller.magnet_mu_r;
+  g.sleeve_radius = sleeve.radius;
+  return g;
+}
+
+Magnetisation gaussian_pole_magnetisation(const std::vector<Pole> &poles)
+{
+  return [poles](double x, double y) {
+    const double theta = std::atan2(y, x);
+    const double m = radial_magnetisation(poles, theta);
+    const double r = std::hypot(x, y);
+    return r > 0.0 ? Vec2{m * x / r, m * y / r} : Vec2{0.0, 0.0};
+  };
+}
+
+RollerMagnetostatics::RollerMagnetostatics(MPI_Comm communicator_in,
+                                           const RollerGeometry &geometry,
+                                           Magnetisation magnetisation_in,
+                                           const RollerDiscretisation &discretisation_in)
+  : communicator(communicator_in)
+  , roller(geometry)
+  , magnetisation(std::move(magnetisation_in))
+  , discretisation(discretisation_in)
+  , triangulation(communicator, dealii::Triangulation<2>::none, false,
+                  dealii::parallel::shared::Triangulation<2>::partition_metis)
+{
+  const auto fail = [](const std::string &what) {
+    throw std::invalid_argument("roller field: " + what);
+  };
+  if (!(roller.magnet_radius > 0.0))
+    fail("roller.magnet_radius must be positive, found " + std::to_string(roller.magnet_radius));
+  if (roller.shaft_radius < 0.0 || roller.shaft_radius >= roller.magnet_radius)
+    fail("roller.shaft_radius must lie in [0, magnet_radius), found " +
+         std::to_string(roller.shaft_radius) + " m (magnet radius " +
+         std::to_string(roller.magnet_radius) + " m)");
+  if (!(roller.sleeve_radius > roller.magnet_radius))
+    fail("the sleeve radius (" + std::to_string(roller.sleeve_radius) +
+         " m) must exceed the magnet radius (" + std::to_string(roller.magnet_radius) + " m)");
+  if (!(roller.magnet_mu_r >= 1.0) || !(roller.shaft_mu_r >= 1.0) ||
+      !std::isfinite(roller.shaft_mu_r))
+    fail("μr of magnet and shaft must be finite and ≥ 1 (for ideal iron use e.g. 1e4)");
+  if (!(discretisation.outer_radius_factor > 1.0))
+    fail("field.outer_radius_factor must exceed 1 (the shell starts outside the sleeve), "
+         "found " + std::to_string(discretisation.outer_radius_factor));
+}
+
+RollerMagnetostatics::~RollerMagnetostatics() = default;
+
+double RollerMagnetostatics::shell_inner_radius() const
+{
+  return discretisation.outer_radius_factor * roller.sleeve_radius;
+}
+
+// Circles: [shaft], magnet, sleeve surface, requested extra circles, shell start, shell end.
+void RollerMagnetostatics::make_mesh()
+{
+  const double R1 = shell_inner_radius();
+  const double R2 = discretisation.shell_ratio * R1;
+  std::vector<AnnularLayer> layers;
+  if (roller.shaft_radius > 0.0)
+    layers.push_back({roller.shaft_radius, roller_region::shaft, 0});
+  layers.push_back({roller.magnet_radius, roller_region::magnet, 0});
+
+  std::vector<double> circles{roller.sleeve_radius};
+  for (const double r : discretisation.extra_circles)
+    if (r > roller.magnet_radius * (1 + 1e-9) && r < R1 * (1 - 1e-9))
+      circles.push_back(r);
+  std::sort(circles.begin(), circles.end());
+  circles.erase(std::unique(circles.begin(), circles.end(),
+                            [&](double a, double b) { return b - a < 1e-9 * R1; }),
+                circles.end());
+  for (const double r : circles)
+    layers.push_back({r, roller_region::air, 0});
+  layers.push_back({R1, roller_region::air, 0});
+  layers.push_back({R2, roller_region::shell, 0});
+
+  triangulation.clear();
+  make_layered_disk(triangulation, layers, discretisation.n_angular);
+  triangulation.refine_global(discretisation.refinements);
+}
+
+PotentialProblemDescription RollerMagnetostatics::describe() const
+{
+  PotentialProblemDescription d;
+  d.name = "roller field";
+  d.degree = discretisation.degree;
+  d.solver_tolerance = discretisation.solver_tolerance;
+  d.coefficient[roller_region::shaft] = 1.0 / (mu0 * roller.shaft_mu_r);
+  d.coefficient[roller_region::magnet] = 1.0 / (mu0 * roller.magnet_mu_r);
+  d.coefficient[roller_region::air] = 1.0 / mu0;
+  const double R1 = shell_inner_radius();
+  d.shell = ShellRegion{roller_region::shell, 1.0 / mu0,
+                        ShellTransformation(R1, discretisation.shell_ratio * R1)};
+  // ∫ (M_x ∂v/∂y − M_y ∂v/∂x)/μr = ∫ s·∇v with s = (−M_y, M_x)/μr, in the magnet only.
+  const Magnetisation M = magnetisation;
+  const double mu_magnet = roller.magnet_mu_r;
+  d.vector_source = [M, mu_magnet](const Point<2> &x, MaterialId material) {
+    Tensor<1, 2> s;
+    if (material == roller_region::magnet)
+    {
+      const Vec2 m = M(x[0], x[1]);
+      s[0] = -m[1] / mu_magnet;
+      s[1] = m[0] / mu_magnet;
+    }
+    return s;
+  };
+  d.dirichlet[0] = [](const Point<2> &) { return 0.0; }; // A = 0 at R2 ≙ infinity
+  return d;
+}
+
+void RollerMagnetostatics::run()
+{
+  make_mesh();
+  potential = std::make_unique<PotentialProblem>(triangulation, describe());
+  potential->run();
+}
+
+std::vector<Vec2> RollerMagnetostatics::flux_density(const std::vector<Vec2> &points) const
+{
+  std::vector<Point<2>> p(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i)
+    p[i] = Point<2>(points[i][0], points[i][1]);
+  const auto gradients = potential->gradients_at(p);
+  std::vector<Vec2> B(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i)
+    B[i] = {gradients[i][1], -gradients[i][0]};
+  return B;
+}
+
+std::vector<double> RollerMagnetostatics::vector_potential(const std::vector<Vec2> &points) const
+{
+  std::vector<Point<2>> p(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i)
+    p[i] = Point<2>(points[i][0], points[i][1]);
+  return potential->values_at(p);
+}
+
+RollerMagnetostatics::Profile RollerMagnetostatics::profile(double radius,
+                                                            unsigned int n_angles) const
+{
+  Profile out;
+  std::vector<Vec2> points(n_angles);
+  for (unsigned int k = 0; k < n_angles; ++k)
+  {
+    const double theta = 2.0 * pi * k / n_angles;
+    out.angle.push_back(theta);
+    points[k] = {radius * std::cos(theta), radius * std::sin(theta)};
+  }
+  const auto B = flux_density(points);
+  for (unsigned int k = 0; k < n_angles; ++k)
+  {
+    const double c = std::cos(out.angle[k]), s = std::sin(out.angle[k]);
+    out.Bn.push_back(B[k][0] * c + B[k][1] * s);
+    out.Bt.push_back(-B[k][0] * s + B[k][1] * c);
+  }
+  return out;
+}
+
+void RollerMagnetostatics::write_vtu(const std::string &directory,
+                                     const std::string &basename) const
+{
+  potential->write_vtu(directory, basename, "magnetic");
+}
+
+} // namespace magbrush::field

@@ -1,0 +1,92 @@
+// The magnet roller's field: the A_z problem (Kweon eq. 9–10) on a concentric layered mesh
+// (shaft, magnet, air with the sleeve surface and probe circles as mesh lines, open-boundary
+// shell), solved by PotentialProblem. B = curl(A ẑ) = (∂A/∂y, −∂A/∂x) by exact differentiation
+// of the FE solution.
+//
+// The roller is rotationally layered, so the production mesh is built here with deal.II
+// (layered_meshes.h) rather than read from Gmsh: every circle is exact at every refinement
+// level, which is what makes the sleeve profile converge at the full order O(h^p).
+#pragma once
+
+#include "case_model.h"
+#include "potential_problem.h"
+
+#include <array>
+#include <functional>
+#include <memory>
+#include <vector>
+
+namespace magbrush::field {
+
+// Region (material) ids of the roller mesh.
+namespace roller_region {
+constexpr MaterialId shaft = 1, magnet = 2, air = 3, shell = 4;
+}
+
+struct RollerGeometry
+{
+  double shaft_radius = 0.0;  // 0: the magnet fills the disk
+  double shaft_mu_r = 1.0;
+  double magnet_radius = 0.0;
+  double magnet_mu_r = 1.0;
+  double sleeve_radius = 0.0; // outer sleeve surface (non-magnetic)
+
+  static RollerGeometry from(const Roller &roller, const Sleeve &sleeve);
+};
+
+struct RollerDiscretisation
+{
+  unsigned int degree = 2;
+  unsigned int n_angular = 64;           // coarse cells around (multiple of 4)
+  unsigned int refinements = 0;          // global refinements of the coarse mesh
+  double outer_radius_factor = 2.0;      // shell from R1 = factor × sleeve radius ...
+  double shell_ratio = 2.0;              // ... to R2 = shell_ratio × R1
+  std::vector<double> extra_circles;     // further mesh circles (probe, grid edge) [m]
+  double solver_tolerance = 1e-12;
+};
+
+// Magnetisation M(x, y) [A/m] inside the magnet.
+using Magnetisation = std::function<Vec2(double x, double y)>;
+
+// M = r̂ Σ_i M_i exp(−α_i wrap(θ − φ_i)²).
+Magnetisation gaussian_pole_magnetisation(const std::vector<Pole> &poles);
+
+class RollerMagnetostatics
+{
+public:
+  RollerMagnetostatics(MPI_Comm communicator, const RollerGeometry &geometry,
+                       Magnetisation magnetisation, const RollerDiscretisation &discretisation);
+  ~RollerMagnetostatics();
+
+  void run(); // make_mesh → PotentialProblem::run
+
+  // B [T] at points (collective; all ranks pass and receive the same).
+  std::vector<Vec2> flux_density(const std::vector<Vec2> &points) const;
+  std::vector<double> vector_potential(const std::vector<Vec2> &points) const;
+
+  // The gaussmeter's view on a circle: B_n = B·r̂ (outward), B_t = B·θ̂ (counter-clockwise).
+  struct Profile
+  {
+    std::vector<double> angle, Bn, Bt; // [rad], [T], [T]
+  };
+  Profile profile(double radius, unsigned int n_angles) const;
+
+  void write_vtu(const std::string &directory, const std::string &basename) const;
+
+  const PotentialProblem &problem() const { return *potential; }
+  const RollerGeometry &geometry() const { return roller; }
+  double shell_inner_radius() const;
+
+private:
+  void make_mesh();
+  PotentialProblemDescription describe() const;
+
+  MPI_Comm communicator;
+  RollerGeometry roller;
+  Magnetisation magnetisation;
+  RollerDiscretisation discretisation;
+  dealii::parallel::shared::Triangulation<2> triangulation;
+  std::unique_ptr<PotentialProblem> potential;
+};
+
+} // namespace magbrush::field

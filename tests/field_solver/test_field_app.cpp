@@ -1,0 +1,77 @@
+// The production field stage end to end (bin/magbrush-field on a paper case, coarse mesh):
+// the first run stores both fields; an unchanged case is "up to date" and rewrites nothing;
+// moving a pole regenerates only the magnetic field; changing the bias only the electric one.
+#include "field_grid.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string out_dir = std::string(MAGBRUSH_BINARY_DIR) + "/tests/field_app_output";
+
+std::string run_field(const std::string &extra, int &rc)
+{
+  const std::string log = out_dir + ".log";
+  const std::string command =
+    std::string(MAGBRUSH_BINARY_DIR) + "/bin/magbrush-field " + MAGBRUSH_SOURCE_DIR +
+    "/cases/kweon_full_roller.yaml --no-vtu --set field.output_dir=" + out_dir +
+    " --set field.mesh_size_sleeve=0.4mm --set field.mesh_size_gap=50um " + extra + " > " +
+    log + " 2>&1";
+  rc = std::system(command.c_str());
+  std::ifstream in(log);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+} // namespace
+
+TEST(FieldApp, StoresFieldsAndReusesThemUntilTheirInputsChange)
+{
+  fs::remove_all(out_dir);
+  int rc = 0;
+  const std::string first = run_field("", rc);
+  ASSERT_EQ(rc, 0) << first;
+  const std::string magnetic = out_dir + "/kweon_full_roller_magnetic.h5";
+  const std::string electric = out_dir + "/kweon_full_roller_electric.h5";
+  ASSERT_TRUE(fs::exists(magnetic)) << first;
+  ASSERT_TRUE(fs::exists(electric)) << first;
+  ASSERT_TRUE(fs::exists(out_dir + "/kweon_full_roller_profile_sleeve.csv"));
+
+  // The stored magnetic grid carries its case hash and a small error against the exact ring.
+  const auto m = magbrush::read_magnetic_grid(magnetic);
+  EXPECT_EQ(m.info.kind, "magnetic");
+  EXPECT_FALSE(m.info.provenance.case_hash.empty());
+  EXPECT_LT(m.info.provenance.error_estimate, 0.05);
+  const auto e = magbrush::read_electric_grid(electric);
+  // the sleeve at the bias: the window's corner nearest the roller axis is inside the sleeve
+  EXPECT_DOUBLE_EQ(e.grid.at(0, e.grid.n_y / 2), -650.0);
+
+  const auto m_time = fs::last_write_time(magnetic), e_time = fs::last_write_time(electric);
+  const std::string again = run_field("", rc);
+  ASSERT_EQ(rc, 0) << again;
+  EXPECT_NE(again.find("magnetic field up to date"), std::string::npos) << again;
+  EXPECT_NE(again.find("electric field up to date"), std::string::npos) << again;
+  EXPECT_EQ(fs::last_write_time(magnetic), m_time);
+  EXPECT_EQ(fs::last_write_time(electric), e_time);
+
+  const std::string moved = run_field("--set roller.poles.N1.angle=75deg", rc);
+  ASSERT_EQ(rc, 0) << moved;
+  EXPECT_NE(moved.find("computing the magnetic field"), std::string::npos) << moved;
+  EXPECT_NE(moved.find("electric field up to date"), std::string::npos) << moved;
+
+  const std::string biased = run_field("--set roller.poles.N1.angle=75deg --set electric.bias=-700V", rc);
+  ASSERT_EQ(rc, 0) << biased;
+  EXPECT_NE(biased.find("magnetic field up to date"), std::string::npos) << biased;
+  EXPECT_NE(biased.find("computing the electric field"), std::string::npos) << biased;
+  fs::remove_all(out_dir);
+}

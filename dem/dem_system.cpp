@@ -363,31 +363,33 @@ void DemSystem::compute_wall_contacts()
   ForceBuffers &f = forces_;
   const long n = static_cast<long>(s.size());
   const std::size_t W = walls_.size();
-  const double t = time_, dt = dt_, guard = case_.dem.max_overlap_fraction;
-  const bool frozen = walls_frozen_;
+  const double dt = dt_, guard = case_.dem.max_overlap_fraction;
+  walls_.prepare(time_, walls_frozen_);
   long alarm = -1, too_many = -1;
-#pragma omp parallel for schedule(dynamic, 256) reduction(max : alarm, too_many) if (n > 512)
+#pragma omp parallel if (n > 512)
+  {
+    // Per-thread scratch (constructed once, not per particle).
+    WallContactGeometry g[max_wall_contacts + 1];
+    int which[max_wall_contacts + 1];
+#pragma omp for schedule(dynamic, 256) reduction(max : alarm, too_many)
   for (long k = 0; k < n; ++k)
   {
     const std::size_t i = static_cast<std::size_t>(k);
     const Vector3 p = s.position(i);
     const double r = s.radius[i];
     // Pass 1: which walls touch this particle now.
-    WallContactGeometry g[max_wall_contacts];
-    int which[max_wall_contacts];
     int m = 0;
     for (std::size_t w = 0; w < W; ++w)
     {
-      WallContactGeometry tmp;
-      if (!walls_.contact(w, p, r, t, frozen, tmp))
+      if (!walls_.contact(w, p, r, g[m]))
         continue;
+      which[m] = static_cast<int>(w);
       if (m == max_wall_contacts)
       {
         too_many = k;
         break;
       }
-      g[m] = tmp;
-      which[m++] = static_cast<int>(w);
+      ++m;
     }
     // Pass 2: free the slots of walls no longer touched.
     const std::size_t base = i * max_wall_contacts;
@@ -453,6 +455,7 @@ void DemSystem::compute_wall_contacts()
       wall_tz_[sl] = tq.z;
     }
   }
+  } // omp parallel
   if (too_many >= 0)
     throw StabilityError("wall contacts: " + describe_particle(U(static_cast<std::int32_t>(too_many))) +
                          " touches more than " + std::to_string(max_wall_contacts) +

@@ -33,6 +33,15 @@ DemWalls::DemWalls(const WallSet &walls)
       throw std::invalid_argument("wall '" + q.name + "': a prism needs a polygon of at least 3 points");
     walls_.push_back({Kind::prism, q.name, q.material, prisms_.size()});
     prisms_.push_back(q);
+    std::array<double, 4> b{q.polygon[0][0], q.polygon[0][0], q.polygon[0][1], q.polygon[0][1]};
+    for (const auto &v : q.polygon)
+    {
+      b[0] = std::min(b[0], v[0]);
+      b[1] = std::max(b[1], v[0]);
+      b[2] = std::min(b[2], v[1]);
+      b[3] = std::max(b[3], v[1]);
+    }
+    prism_boxes_.push_back(b);
   }
 }
 
@@ -129,8 +138,27 @@ double DemWalls::distance(std::size_t w, const Vector3 &p, double t) const
   return 0.0;
 }
 
-bool DemWalls::contact(std::size_t w, const Vector3 &p, double r, double t, bool frozen,
-                       WallContactGeometry &g) const
+void DemWalls::prepare(double t, bool frozen)
+{
+  current_.resize(walls_.size());
+  for (std::size_t w = 0; w < walls_.size(); ++w)
+  {
+    const Wall &wall = walls_[w];
+    Current &c = current_[w];
+    if (wall.kind == Kind::cylinder)
+      c.omega = cylinder_omega(cylinders_[wall.index], t, frozen);
+    else if (wall.kind == Kind::plane)
+    {
+      const auto &pl = planes_[wall.index];
+      const Vec3 off = pl.displacement(frozen ? 0.0 : t);
+      const Vec3 v = frozen ? Vec3{0, 0, 0} : pl.velocity(t);
+      c.point = {pl.point[0] + off[0], pl.point[1] + off[1], pl.point[2] + off[2]};
+      c.velocity = {v[0], v[1], v[2]};
+    }
+  }
+}
+
+bool DemWalls::contact(std::size_t w, const Vector3 &p, double r, WallContactGeometry &g) const
 {
   const Wall &wall = walls_[w];
   switch (wall.kind)
@@ -147,7 +175,7 @@ bool DemWalls::contact(std::size_t w, const Vector3 &p, double r, double t, bool
     // Outside: the wall is towards the axis; inside: away from it.
     const double s = c.particles_outside ? -1.0 / d : 1.0 / d;
     g.n = {s * dx, s * dy, 0.0};
-    const double om = cylinder_omega(c, t, frozen);
+    const double om = current_[w].omega;
     // Surface point on the cylinder along the line of centres.
     const double ux = dx / d * c.radius, uy = dy / d * c.radius;
     g.surface_velocity = {-om * uy, om * ux, 0.0};
@@ -158,17 +186,13 @@ bool DemWalls::contact(std::size_t w, const Vector3 &p, double r, double t, bool
   case Kind::plane:
   {
     const auto &pl = planes_[wall.index];
-    const double tt = frozen ? 0.0 : t;
-    const Vec3 off = pl.displacement(tt);
     const Vector3 n{pl.normal[0], pl.normal[1], pl.normal[2]};
-    const Vector3 q{pl.point[0] + off[0], pl.point[1] + off[1], pl.point[2] + off[2]};
-    const double gap = dot(p - q, n);
+    const double gap = dot(p - current_[w].point, n);
     if (gap >= r)
       return false;
     g.overlap = r - gap;
     g.n = -n;
-    const Vec3 v = frozen ? Vec3{0, 0, 0} : pl.velocity(t);
-    g.surface_velocity = {v[0], v[1], v[2]};
+    g.surface_velocity = current_[w].velocity;
     g.angular_velocity = {};
     g.torque_origin = {0.0, 0.0, p.z};
     return true;
@@ -176,6 +200,9 @@ bool DemWalls::contact(std::size_t w, const Vector3 &p, double r, double t, bool
   case Kind::prism:
   {
     const auto &pr = prisms_[wall.index];
+    const auto &b = prism_boxes_[wall.index];
+    if (p.x < b[0] - r || p.x > b[1] + r || p.y < b[2] - r || p.y > b[3] + r)
+      return false; // far from the blade: the common case
     double cx = 0, cy = 0;
     bool inside = false;
     closest_on_polygon(pr.polygon, p.x, p.y, cx, cy, inside);

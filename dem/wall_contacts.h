@@ -7,6 +7,7 @@
 
 #include "wall_primitives.h"
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -32,10 +33,13 @@ public:
   const std::string &material(std::size_t w) const { return walls_[w].material; }
   std::vector<std::string> materials() const;
 
-  // Contact of a sphere (centre p, radius r) with wall w at time t. Returns false when not
-  // touching. `frozen`: walls at rest at their t = 0 position (the settling phase).
-  bool contact(std::size_t w, const Vector3 &p, double r, double t, bool frozen,
-               WallContactGeometry &g) const;
+  // Moves the walls to time t (plane positions and velocities, cylinder spin-up), once per
+  // step. `frozen`: walls at rest at their t = 0 position (the settling phase).
+  void prepare(double t, bool frozen);
+
+  // Contact of a sphere (centre p, radius r) with wall w at the prepared time. Returns false
+  // when not touching.
+  bool contact(std::size_t w, const Vector3 &p, double r, WallContactGeometry &g) const;
 
   // Signed distance from p to wall w's surface at time t (> 0 on the particle side).
   double distance(std::size_t w, const Vector3 &p, double t) const;
@@ -55,6 +59,14 @@ private:
   std::vector<CylinderWall> cylinders_;
   std::vector<PlaneWallPrimitive> planes_;
   std::vector<PrismWall> prisms_;
+  std::vector<std::array<double, 4>> prism_boxes_; // x_min, x_max, y_min, y_max
+  // State at the prepared time, per wall: plane point and velocity, cylinder ω.
+  struct Current
+  {
+    Vector3 point, velocity;
+    double omega = 0.0;
+  };
+  std::vector<Current> current_;
 
   // Closest point on polygon boundary to q; `inside` tells whether q is inside the polygon.
   static void closest_on_polygon(const std::vector<Vec2> &poly, double qx, double qy, double &cx,

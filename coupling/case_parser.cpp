@@ -265,10 +265,20 @@ private:
         error(where, key_path, "the value is not valid YAML: " + e.msg);
         continue;
       }
+      // "planes.plate.path[1].time" -> planes, plate, path, [1], time
       std::vector<std::string> parts;
       std::stringstream ss(key_path);
       for (std::string part; std::getline(ss, part, '.');)
-        parts.push_back(part);
+      {
+        const auto bracket = part.find('[');
+        if (bracket != std::string::npos && bracket > 0 && part.back() == ']')
+        {
+          parts.push_back(part.substr(0, bracket));
+          parts.push_back(part.substr(bracket));
+        }
+        else
+          parts.push_back(part);
+      }
       std::string display;
       YAML::Node current;
       current.reset(root);

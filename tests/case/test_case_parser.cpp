@@ -202,6 +202,14 @@ TEST(CaseParser, OverridesUseTheSameConversionAndNames)
       << e;
   EXPECT_NE(error_of(read_file(minimal), {"sleeve.radius"}).find("expected key.path=value"), std::string::npos);
   EXPECT_NE(error_of(read_file(minimal), {"dem.seeed=3"}).find("did you mean 'seed'?"), std::string::npos);
+  // Unnamed list elements by index, also written as key[i].
+  const std::string box = source_dir + "/cases/kawamoto_brush_compression.yaml";
+  EXPECT_DOUBLE_EQ(load_case(box, {"planes.plate.path[3].time=9ms"}).planes[1].path[3].first, 9e-3);
+  EXPECT_DOUBLE_EQ(load_case(box, {"planes.plate.path.[3].time=9ms"}).planes[1].path[3].first, 9e-3);
+  const std::string e2 = error_of(read_file(box), {"planes.plate.path[3].time=1ms"});
+  EXPECT_NE(e2.find("--set 'planes.plate.path[3].time=1ms': planes.plate.path[3].time: path times must increase"),
+            std::string::npos)
+      << e2;
 }
 
 TEST(CaseParser, ErrorsCarryFileLineColumnPathExpectedAndFound)
@@ -305,7 +313,7 @@ TEST(CaseFormat, PrintedCaseReadsBackToTheSameCase)
     const Case c = load_case(source_dir + file);
     std::vector<std::string> overrides;
     for (const auto &e : resolved_entries(c))
-      if (e.path != "measured_flux_file" && e.path.find(".path[") == std::string::npos)
+      if (e.path != "measured_flux_file")
         overrides.push_back(e.path + "=" + e.pretty);
     const Case again = load_case(source_dir + file, overrides);
     const auto a = resolved_entries(c), b = resolved_entries(again);

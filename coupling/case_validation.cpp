@@ -258,6 +258,19 @@ void check_populations(const Case &c, std::vector<CaseIssue> &out)
     if (p.layer_thickness > 0.0 && !c.sleeve)
       out.push_back({path + ".layer_thickness", "a layer on the sleeve needs a sleeve"});
   }
+  // The rotating walls take their contact properties from materials named after them.
+  if (!c.populations.empty())
+    for (const auto &[wall, present] : {std::pair<std::string, bool>{"sleeve", c.sleeve.has_value()},
+                                        std::pair<std::string, bool>{"drum", c.drum.present}})
+    {
+      bool found = false;
+      for (const auto &m : c.materials)
+        found = found || m.name == wall;
+      if (present && !found)
+        out.push_back({"materials", "particles touch the " + wall + ", whose contact properties come from a material named '" +
+                                        wall + "'; add it, e.g. " + wall +
+                                        ": {youngs_modulus: 5e4 MPa, poisson_ratio: 0.3, friction: 0.35}"});
+    }
   for (const auto &m : c.materials)
     if (m.polygon_angles != 0 && m.polygon_angles < 3)
       out.push_back({"materials." + m.name + ".polygon_angles", "expected 0 (off) or >= 3 polygon angles, found " +

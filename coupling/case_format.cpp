@@ -402,7 +402,30 @@ std::string format_schema(bool markdown)
            "with prefixes f p n u (or µ) m c k M G, combined with `*`, `/` and `^` (`kg/m^3`, `Pa*s`).\n"
            "List elements are addressed by name in key paths and overrides: "
            "`magbrush check case.yaml --set roller.poles.N1.angle=95deg`.\n\n"
-           "The last column says which stored field must be recomputed when the key changes.\n\n"
+           "## Conventions\n\n"
+           "* Roller frame: the roller axis is z, the roller centre is the origin, angles are counter-clockwise "
+           "from +x; a positive rpm turns counter-clockwise seen from +z. Sleeve and drum usually turn in "
+           "opposite senses, so that their surfaces move the same way at the nip.\n"
+           "* Poles: `{name, angle, strength}`; north = positive strength, south = negative, or an unsigned "
+           "strength with `polarity: N|S`. `shape_factor` defaults to `roller.shape_factor`. Poles must be at "
+           "least 10 deg apart.\n"
+           "* Sleeve and drum: give `radius` or `diameter` (an override of one replaces the other).\n"
+           "* Blades and guides: either a `profile` polygon in the roller frame, or `angle` + `gap` + "
+           "`thickness` + `length` (a radial plate whose tip is `gap` from the sleeve). A profile's `gap`, if "
+           "given, must match the polygon.\n"
+           "* Walls touching particles take their contact properties from the materials `sleeve`, `drum` "
+           "and (blades, planes) their `material`.\n"
+           "* Populations: exactly one of `count`, `mass`, `concentration` (toner: toner mass / carrier mass); "
+           "toner needs `charge_to_mass`; the size distribution must satisfy mean - 3 std >= 0.\n\n"
+           "## Checking and overriding\n\n"
+           "`magbrush check CASE` validates the file and prints every resolved key as `path = value`; each "
+           "line works as an override: `--set path=value` (list elements by name, or `[i]` for unnamed "
+           "ones, e.g. `planes.plate.path[2].time=5ms`). Errors name `file:line:column` (or the override), "
+           "the key path, what was expected and what was found; exit status 1 for an invalid case, 2 for a "
+           "usage error.\n\n"
+           "## Keys\n\n"
+           "The `field` column says which stored field must be recomputed when the key changes "
+           "(`field_hash` in `coupling/case_hash.h`; a non-magnetic blade does not change the magnetic field).\n\n"
            "| key | type | default | range | field | meaning |\n|---|---|---|---|---|---|\n";
     for (const auto &k : case_schema())
     {
@@ -410,7 +433,9 @@ std::string format_schema(bool markdown)
       for (auto *s : {&doc, &type})
         for (size_t p = 0; (p = s->find('|', p)) != std::string::npos; p += 2)
           s->replace(p, 1, "\\|");
-      out << "| `" << k.path << "` | " << type << " | " << default_of(k) << " | " << k.range_description()
+      const std::string d = default_of(k);
+      out << "| `" << k.path << "` | " << type << " | " << (d == "required" || d == "-" ? d : "`" + d + "`") << " | "
+          << k.range_description()
           << " | " << affects(k.affects) << " | " << doc << " |\n";
     }
     return out.str();

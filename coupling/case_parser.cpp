@@ -528,10 +528,8 @@ private:
     const YAML::Node &at = mark_of(node, key);
     try
     {
-      Value v = leaf_value(node, spec);
-      if (!v.written.empty() || spec.type != KeyType::string)
-        locations[display] = location(at.Mark());
-      values[display] = std::move(v);
+      values[display] = leaf_value(node, spec);
+      locations[display] = location(at.Mark()); // later (geometric) errors point at the value
     }
     catch (const UnitError &e)
     {

@@ -13,7 +13,7 @@
 namespace {
 
 const char *usage =
-    "Usage: magbrush check CASE.yaml [--set key=value ...] [--quiet]\n"
+    "Usage: magbrush check CASE.yaml [--set key=value ...] [--quiet | --inputs magnetic|electric]\n"
     "       magbrush check --explain [--markdown]\n\n"
     "Validates a case file (units, keys, ranges, geometry) and prints the resolved case with\n"
     "units, derived numbers (surface speeds, relative nip speed, particle counts and masses,\n"
@@ -21,6 +21,8 @@ const char *usage =
     "  --set key=value  override a key, e.g. --set drum.gap=0.3mm --set roller.poles.N1.angle=95deg\n"
     "                   (list elements by name or [index]); validated like the file\n"
     "  --quiet          print nothing when the case is valid\n"
+    "  --inputs KIND    print only the inputs the stored KIND field depends on (magnetic, electric),\n"
+    "                   i.e. what its hash covers\n"
     "  --explain        print every key of the case schema: type, default, range, meaning\n"
     "  --markdown       with --explain: Markdown table (docs/case_reference.md)\n\n"
     "Exit status: 0 valid, 1 invalid case (errors on stderr), 2 usage error.\n";
@@ -36,6 +38,7 @@ int run_check(const std::vector<std::string> &args)
   std::string case_file;
   std::vector<std::string> overrides;
   bool explain = false, markdown = false, quiet = false;
+  std::string inputs;
   for (size_t i = 1; i < args.size(); ++i)
   {
     const std::string &a = args[i];
@@ -50,6 +53,12 @@ int run_check(const std::vector<std::string> &args)
       markdown = true;
     else if (a == "--quiet" || a == "-q")
       quiet = true;
+    else if (a == "--inputs")
+    {
+      if (i + 1 >= args.size() || (args[i + 1] != "magnetic" && args[i + 1] != "electric"))
+        return usage_error("--inputs needs 'magnetic' or 'electric'");
+      inputs = args[++i];
+    }
     else if (a == "--set" || a == "-s")
     {
       if (i + 1 >= args.size())
@@ -79,6 +88,14 @@ int run_check(const std::vector<std::string> &args)
     const magbrush::Case c = magbrush::load_case(case_file, overrides);
     if (quiet)
       return 0;
+    if (!inputs.empty())
+    {
+      const auto kind = inputs == "magnetic" ? magbrush::FieldKind::magnetic : magbrush::FieldKind::electric;
+      for (const auto &[key, value] : magbrush::field_inputs(c, kind))
+        std::cout << key << " = " << value << "\n";
+      std::cout << "# hash " << magbrush::field_hash(c, kind) << "\n";
+      return 0;
+    }
     std::cout << "# " << c.source_file << ": valid\n# resolved case (every key, defaults filled in):\n"
               << magbrush::format_case(c) << "\n# derived\n"
               << magbrush::format_derived(c) << "\n# field input hashes\n"

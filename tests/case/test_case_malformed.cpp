@@ -170,4 +170,9 @@ TEST(MalformedCases, ValidCasesExitWith0AndPrintUnits)
   EXPECT_NE(r.output.find("= 400 um"), std::string::npos);
   EXPECT_NE(r.output.find("relative speed at the nip   0.134827 m/s"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("in the same direction"), std::string::npos);
+  const CheckRun inputs = run_check({std::string(MAGBRUSH_SOURCE_DIR) + "/cases/kawamoto_nip.yaml", "--inputs", "electric"});
+  EXPECT_EQ(inputs.exit_code, 0);
+  EXPECT_NE(inputs.output.find("drum.gap = 0.000399999"), std::string::npos) << inputs.output;
+  EXPECT_EQ(inputs.output.find("roller."), std::string::npos) << inputs.output;
+  EXPECT_EQ(run_check({"x.yaml", "--inputs", "thermal"}).exit_code, 2);
 }

@@ -111,6 +111,7 @@ TEST(DemEngine, OneAndTwoThreadsGiveIdenticalBits)
 
 TEST(DemEngine, RestartContinuesBitIdentically)
 {
+  omp_set_num_threads(1); // thread independence is the test above; keep this one quick
   const Case c = packing_case();
   const std::string path = (std::filesystem::temp_directory_path() / "magbrush_dem_restart_test.bin").string();
   auto a = make_packing(c);
@@ -218,6 +219,7 @@ TEST(DemEngine, HistorySurvivesRebuildAndResorting)
 
 TEST(DemEngine, ForcesAreContinuousAcrossForcedRebuilds)
 {
+  omp_set_num_threads(1); // thread independence is the test above; keep this one quick
   // The same run with and without extra rebuilds every 50 steps: the tangential springs
   // carry over, so the trajectories agree to rounding (a lost history would show at O(1)).
   const Case c = packing_case();
@@ -422,6 +424,7 @@ TEST(DemEngine, OverfullInsertionSaysWhatToDo)
 
 TEST(DemEngine, SnapshotIsReadableAndInIdOrder)
 {
+  omp_set_num_threads(1); // thread independence is the test above; keep this one quick
   const Case c = packing_case();
   auto sys = make_packing(c);
   for (int k = 0; k < 50; ++k)

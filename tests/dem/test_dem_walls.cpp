@@ -1,0 +1,142 @@
+// Wall primitives as the DEM sees them: contact geometry of cylinders (outside and inside),
+// planes on a prescribed path and extruded polygons (faces, corners, penetration), and two
+// dynamic checks: a particle carried along by a plate sliding sideways (Kawamoto's shear
+// step) and a particle resting on a blade face at the Hertz static overlap.
+#include "dem_test_scenes.h"
+
+#include "wall_contacts.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+using namespace magbrush;
+using namespace magbrush::dem;
+using namespace magbrush::dem::testing;
+
+TEST(DemWalls, CylinderOutsideAndInside)
+{
+  WallSet ws;
+  CylinderWall sleeve;
+  sleeve.name = "sleeve";
+  sleeve.radius = 10e-3;
+  sleeve.omega = 20.0;
+  sleeve.material = "sleeve";
+  ws.cylinders.push_back(sleeve);
+  sleeve.name = "drum";
+  sleeve.particles_outside = false;
+  sleeve.radius = 20e-3;
+  ws.cylinders.push_back(sleeve);
+  DemWalls walls(ws);
+  walls.prepare(0.0, false);
+  WallContactGeometry g;
+  // Outside the sleeve at angle 90°, 1 µm overlap: the wall is towards the axis (−y).
+  ASSERT_TRUE(walls.contact(0, {0, 10e-3 + 49e-6, 0}, 50e-6, g));
+  EXPECT_NEAR(g.overlap, 1e-6, 1e-15);
+  EXPECT_NEAR(g.n.y, -1.0, 1e-15);
+  // Surface velocity ω ẑ × (0, R) = (−ωR, 0).
+  EXPECT_NEAR(g.surface_velocity.x, -20.0 * 10e-3, 1e-15);
+  EXPECT_NEAR(g.angular_velocity.z, 20.0, 0);
+  EXPECT_FALSE(walls.contact(0, {0, 10e-3 + 51e-6, 0}, 50e-6, g));
+  // Inside the drum near +x: the wall is outward (+x).
+  ASSERT_TRUE(walls.contact(1, {20e-3 - 48e-6, 0, 0}, 50e-6, g));
+  EXPECT_NEAR(g.overlap, 2e-6, 1e-15);
+  EXPECT_NEAR(g.n.x, 1.0, 1e-15);
+  EXPECT_NEAR(g.surface_velocity.y, 20.0 * 20e-3, 1e-15);
+  // Frozen (settling): at rest.
+  walls.prepare(0.0, true);
+  ASSERT_TRUE(walls.contact(1, {20e-3 - 48e-6, 0, 0}, 50e-6, g));
+  EXPECT_EQ(g.surface_velocity.y, 0.0);
+}
+
+TEST(DemWalls, PlaneFollowsItsPath)
+{
+  WallSet ws;
+  PlaneWallPrimitive plate;
+  plate.name = "plate";
+  plate.point = {0, 0, 1e-3};
+  plate.normal = {0, 0, -2}; // normalised by the DEM
+  plate.path = {{0.0, {0, 0, 0}}, {1e-3, {0, 0, -0.5e-3}}, {2e-3, {1e-3, 0, -0.5e-3}}};
+  ws.planes.push_back(plate);
+  DemWalls walls(ws);
+  WallContactGeometry g;
+  walls.prepare(0.5e-3, false); // half-way down: plane at z = 0.75 mm moving at −0.5 m/s
+  EXPECT_FALSE(walls.contact(0, {0, 0, 0.7e-3}, 40e-6, g));
+  ASSERT_TRUE(walls.contact(0, {0, 0, 0.72e-3}, 40e-6, g));
+  EXPECT_NEAR(g.overlap, 10e-6, 1e-12);
+  EXPECT_NEAR(g.n.z, 1.0, 1e-15);
+  EXPECT_NEAR(g.surface_velocity.z, -0.5, 1e-12);
+  walls.prepare(1.5e-3, false); // sliding sideways at +1 m/s
+  ASSERT_TRUE(walls.contact(0, {0, 0, 0.47e-3}, 40e-6, g));
+  EXPECT_NEAR(g.surface_velocity.x, 1.0, 1e-12);
+  EXPECT_NEAR(g.surface_velocity.z, 0.0, 1e-12);
+}
+
+TEST(DemWalls, PrismFacesCornersAndPenetration)
+{
+  WallSet ws;
+  PrismWall blade;
+  blade.name = "blade";
+  blade.polygon = {{0, 0}, {1e-3, 0}, {1e-3, 1e-3}, {0, 1e-3}};
+  ws.prisms.push_back(blade);
+  DemWalls walls(ws);
+  walls.prepare(0.0, false);
+  WallContactGeometry g;
+  // Face below the square.
+  ASSERT_TRUE(walls.contact(0, {0.5e-3, -45e-6, 0.3}, 50e-6, g));
+  EXPECT_NEAR(g.overlap, 5e-6, 1e-15);
+  EXPECT_NEAR(g.n.y, 1.0, 1e-12);
+  // Corner (1 mm, 1 mm) seen along the diagonal.
+  const double s = 40e-6 / std::sqrt(2.0);
+  ASSERT_TRUE(walls.contact(0, {1e-3 + s, 1e-3 + s, 0}, 50e-6, g));
+  EXPECT_NEAR(g.overlap, 10e-6, 1e-12);
+  EXPECT_NEAR(g.n.x, -std::sqrt(0.5), 1e-12);
+  EXPECT_NEAR(g.n.y, -std::sqrt(0.5), 1e-12);
+  // Far away: rejected by the bounding box.
+  EXPECT_FALSE(walls.contact(0, {5e-3, 5e-3, 0}, 50e-6, g));
+  // Centre inside the blade (deep penetration): pushed out through the nearest face (x = 0).
+  ASSERT_TRUE(walls.contact(0, {10e-6, 0.5e-3, 0}, 50e-6, g));
+  EXPECT_NEAR(g.overlap, 60e-6, 1e-12);
+  EXPECT_NEAR(g.n.x, 1.0, 1e-12); // wall towards +x: the force pushes the particle to −x
+  EXPECT_NEAR(walls.distance(0, {10e-6, 0.5e-3, 0}, 0.0), -10e-6, 1e-15);
+}
+
+TEST(DemWalls, SlidingPlateDragsParticleToItsSpeed)
+{
+  // A particle pressed between a stage (z = 0, frictionless) and a plate above it that
+  // slides along +x at 0.05 m/s with friction: it must end up moving with the plate.
+  Material m = elastic_material("bead", 1e8, 0.3, 2500);
+  m.damping = 0.5;
+  Case c = single_species_case(m);
+  const double R = 0.5e-3, gap = 2 * R - 2e-6; // 1 µm overlap on each side
+  Material stage = elastic_material("stage", 1e10, 0.3, 0);
+  Material plate = elastic_material("plate", 1e10, 0.3, 0);
+  plate.friction = 0.5;
+  c.materials.push_back(stage);
+  c.materials.push_back(plate);
+  PlaneWall s;
+  s.name = "stage";
+  s.material = "stage";
+  c.planes.push_back(s);
+  PlaneWall p;
+  p.name = "plate";
+  p.point = {0, 0, gap};
+  p.normal = {0, 0, -1};
+  p.material = "plate";
+  p.path = {{0.0, {0, 0, 0}}, {1.0, {0.05, 0, 0}}};
+  c.planes.push_back(p);
+  DemSystem sys(c);
+  sys.particles().add({0, 0, 0.5 * gap}, R, m.density, 0, 0.0);
+  sys.initialize();
+  while (sys.time() < 0.05)
+    sys.step();
+  const auto &q = sys.particles();
+  // Contact point at the top moves with the plate: v + ω × (R n) = 0.05 m/s.
+  const double top = q.vx[0] + q.wy[0] * (0.5 * gap);
+  std::printf("sliding plate: particle contact-point speed %.6f m/s (plate 0.05), centre %.6f m/s\n", top, q.vx[0]);
+  EXPECT_NEAR(top, 0.05, 5e-4);
+  const auto loads = sys.wall_loads();
+  EXPECT_EQ(loads.size(), 2u);
+  EXPECT_GT(loads[1].force[2], 0.0); // the particle pushes the plate up
+  EXPECT_NEAR(loads[0].force[2], -loads[1].force[2], 1e-6 * loads[1].force[2]);
+}

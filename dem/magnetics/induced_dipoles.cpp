@@ -100,7 +100,8 @@ MagneticStats InducedDipoles::compute(const BeadArrays &beads, const AppliedFiel
   if (settings_.slab_tail_correction)
     prepare_tail(beads, cutoff);
   solve_dipoles(beads, stats);
-  if (settings_.model == DipoleModel::corrected)
+  // Tables depend on the beads' β only: re-check when the list (hence the bead set) changed.
+  if (settings_.model == DipoleModel::corrected && (stats.list_rebuilt || tables_.empty()))
     prepare_correction_tables();
   evaluate_pair_forces(beads, stats);
   gather_forces(out);

@@ -1,6 +1,7 @@
 // A static brush-like configuration for the magnetics benchmarks: chains of touching carrier
-// beads standing on a plane (y = 0) along a uniform field B ŷ, in a slab periodic along x and
-// z (the DEM's periodic slab), open along y. Chains start at random points of the plane,
+// beads standing on a plane (y = 0) along a uniform field B ŷ, in a slab periodic along z and
+// (optionally) x, open along y. With x open, the chain roots cover 0 ≤ x < width: a strip,
+// like the nip slab that is periodic only along the roller axis. Chains start at random points of the plane,
 // lean by a few degrees at every bead, and stop early when they would hit another chain.
 #pragma once
 
@@ -14,7 +15,9 @@ namespace magbrush::magnetics::bench {
 
 struct BrushConfiguration
 {
-  double box = 0.0; // periodic length along x and z [m]
+  double box = 0.0;   // periodic length along z [m] (and along x when periodic_x)
+  bool periodic_x = true;
+  double box_x() const { return periodic_x ? box : 0.0; }
   std::vector<double> x, y, z, radius, mu_r;
   std::vector<std::size_t> on_plane; // beads touching the plane y = 0
   std::size_t size() const { return x.size(); }
@@ -22,10 +25,11 @@ struct BrushConfiguration
 
 inline BrushConfiguration make_brush(std::size_t chains, double box, double mean_radius,
                                      double radius_std, int min_height, int max_height,
-                                     double mu_r, unsigned seed)
+                                     double mu_r, unsigned seed, bool periodic_x = true)
 {
   BrushConfiguration c;
   c.box = box;
+  c.periodic_x = periodic_x;
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> lateral(0.0, box), unit(0.0, 1.0);
   std::normal_distribution<double> radius(mean_radius, radius_std);
@@ -34,7 +38,8 @@ inline BrushConfiguration make_brush(std::size_t chains, double box, double mean
     for (std::size_t k = 0; k < c.size(); ++k)
     {
       double dx = x - c.x[k], dy = y - c.y[k], dz = z - c.z[k];
-      dx -= box * std::round(dx / box);
+      if (periodic_x)
+        dx -= box * std::round(dx / box);
       dz -= box * std::round(dz / box);
       if (dx * dx + dy * dy + dz * dz < (r + c.radius[k]) * (r + c.radius[k]))
         return true;

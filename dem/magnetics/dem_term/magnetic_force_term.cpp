@@ -5,10 +5,20 @@
 
 namespace magbrush::magnetics {
 
-MagneticForceTerm::MagneticForceTerm(const Case &c, const MagneticSettings &settings,
+namespace {
+MagneticSettings with_slab_tail(MagneticSettings s, const std::array<double, 3> &box, bool slab_tail)
+{
+  const int periodic = (box[0] > 0) + (box[1] > 0) + (box[2] > 0);
+  if (slab_tail && periodic == 2)
+    s.slab_tail_correction = true;
+  return s;
+}
+} // namespace
+
+MagneticForceTerm::MagneticForceTerm(const Case &c, MagneticSettings settings,
                                      const AppliedMagneticField &field,
-                                     const std::array<double, 3> &box)
-  : dipoles_(settings, box), field_(field)
+                                     const std::array<double, 3> &box, bool slab_tail)
+  : dipoles_(with_slab_tail(settings, box, slab_tail), box), field_(field)
 {
   for (const Population &pop : c.populations)
   {

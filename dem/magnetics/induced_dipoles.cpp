@@ -121,17 +121,10 @@ MagneticStats InducedDipoles::compute(const BeadArrays &beads, const AppliedFiel
 void InducedDipoles::refresh_list_if_needed(const BeadArrays &beads, double cutoff,
                                             MagneticStats &stats)
 {
-  const double mean_diameter = settings_.cutoff_length > 0.0 && settings_.cutoff_diameters > 0.0
-                                 ? cutoff / settings_.cutoff_diameters
-                                 : cutoff / std::max(settings_.cutoff_diameters, 1e-300);
-  double skin = settings_.skin_fraction * mean_diameter;
-  if (settings_.cutoff_length > 0.0) // no diameter scale given: skin relative to the mean radius
-  {
-    double sum = 0.0;
-    for (std::size_t b = 0; b < beads.n; ++b)
-      sum += beads.radius[b];
-    skin = settings_.skin_fraction * 2.0 * sum / beads.n;
-  }
+  double sum = 0.0;
+  for (std::size_t b = 0; b < beads.n; ++b)
+    sum += beads.radius[b];
+  const double skin = settings_.skin_fraction * 2.0 * sum / beads.n; // fraction of the mean diameter
   const bool stale = !list_.built() || list_.particle_count() != beads.n || list_.box() != box_ ||
                      std::abs(list_.list_radius() - (cutoff + skin)) > 1e-12 * cutoff ||
                      list_.max_displacement(beads.n, beads.x, beads.y, beads.z) > 0.5 * skin;

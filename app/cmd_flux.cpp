@@ -439,7 +439,11 @@ std::string fitted_case_text(const Case &c, const FluxOptions &o, const PoleFitR
     YAML::Node n(YAML::NodeType::Map);
     n.SetStyle(YAML::EmitterStyle::Flow);
     n["name"] = p.pole.name;
-    n["angle"] = fixed(p.pole.angle * to_deg, 4) + " deg";
+    // In [0, 360) also after rounding (359.99996 would print as 360.0000, out of range).
+    double angle_deg = std::round(p.pole.angle * to_deg * 1e4) / 1e4;
+    if (angle_deg >= 360.0)
+      angle_deg -= 360.0;
+    n["angle"] = fixed(angle_deg, 4) + " deg";
     n["strength"] = fixed(p.pole.strength * 1e-3, 3) + " kA/m";
     n["shape_factor"] = fixed(p.pole.shape_factor, 4) + " rad^-2";
     poles.push_back(n);
@@ -499,7 +503,7 @@ std::string fit_report(const PoleFitResult &fit, const FluxOptions &o)
 }
 
 // "The FEM as the final check": magbrush-field on the fitted case, its probe profile against
-// the scan. Returns false (with the reason printed) when it cannot be done.
+// the scan, and the FEM against the exact ring. Says why when it cannot be done.
 void fem_check(const std::string &fitted_case, const FluxScan &scan, const std::string &dir)
 {
   const fs::path field_exe = fs::path(executable_dir()) / "magbrush-field";

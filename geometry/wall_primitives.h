@@ -7,6 +7,7 @@
 #pragma once
 
 #include "case_model.h"
+#include "case_validation.h" // polygon_signed_area, polygon_is_simple (shared with the parser)
 
 #include <string>
 #include <utility>
@@ -25,6 +26,10 @@ struct CylinderWall
   bool particles_outside = true; // true: particles live outside (sleeve, drum)
   std::string material;
   double spin_up_time = 0.0;     // linear ramp of ω from 0 over this time [s]
+
+  // Rigid-rotation velocity of the surface material at `x` (any point, in the x-y plane):
+  // ω ẑ × (x − c). Seen from +z, ω > 0 turns counter-clockwise.
+  Vec2 surface_velocity(const Vec2 &x) const;
 };
 
 // An infinite plane through `point` with unit `normal` pointing into the particle side.
@@ -55,10 +60,28 @@ struct WallSet
   std::vector<CylinderWall> cylinders;
   std::vector<PlaneWallPrimitive> planes;
   std::vector<PrismWall> prisms;
+
+  const CylinderWall *cylinder(const std::string &name) const; // nullptr if absent
 };
 
 // The walls a case implies: sleeve (and drum, when present) as rotating cylinders,
-// blades and guides as prisms, explicit plane walls as planes.
+// blades and guides as prisms (polygons made counter-clockwise), explicit plane walls as
+// planes. Throws when a blade polygon is degenerate (fewer than 3 vertices, zero area,
+// self-intersecting).
 WallSet build_wall_primitives(const Case &c);
+
+// Speed of the sleeve surface relative to the drum surface at the nip point (the slip
+// speed Kawamoto measures, 0.135 m/s for his prototype): the difference of the two
+// tangential surface velocities on the line of centres. Both surfaces moving the same way
+// (sleeve and drum turning in opposite senses) gives the difference of the surface speeds.
+double nip_relative_surface_speed(const WallSet &walls);
+
+// ---- plane polygon helpers (shared by the walls and the meshes) ----------------------------
+std::vector<Vec2> counter_clockwise(std::vector<Vec2> polygon);   // reversed if clockwise
+bool point_in_polygon(const Vec2 &p, const std::vector<Vec2> &polygon);
+double distance_to_segment(const Vec2 &p, const Vec2 &a, const Vec2 &b);
+double distance_to_polygon_boundary(const Vec2 &p, const std::vector<Vec2> &polygon);
+bool segments_cross(const Vec2 &a, const Vec2 &b, const Vec2 &c, const Vec2 &d); // incl. touching
+bool polygons_overlap(const std::vector<Vec2> &p, const std::vector<Vec2> &q); // cross or nest
 
 } // namespace magbrush

@@ -70,7 +70,7 @@ void MagneticNeighbourList::build(std::size_t n, const double *x, const double *
       a.cells = std::clamp(static_cast<long>(std::floor(a.length / list_radius)), 1L,
                            max_cells_per_axis);
       a.width = a.length / a.cells;
-      a.reach = static_cast<long>(std::ceil(list_radius / a.width - 1e-12));
+      a.reach = static_cast<long>(std::ceil(list_radius / a.width));
     }
     else
     {

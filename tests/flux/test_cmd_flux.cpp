@@ -83,7 +83,7 @@ roller:
 sleeve:
   radius: 10 mm
   thickness: 0.3 mm
-)";
+)" << "field:\n  output_dir: " << (dir / "fields").string() << "   # this test's own\n";
   return path;
 }
 

@@ -125,8 +125,11 @@ TEST(CmdFlux, FitOnTheExampleScanRecoversItsHeaderPoles)
 {
   const fs::path dir = scratch("example");
   const fs::path case_file = write_case(dir);
+  // Overrides are carried into the fitted file (the one on a list element by its name is
+  // replaced by the fit, of course).
   const CommandResult r = run_magbrush(case_file.string() + " --measured " + example_scan_path() + " -o " +
-                             (dir / "out").string() + " --fit --no-fem-check --no-plot");
+                             (dir / "out").string() + " --fit --no-fem-check --no-plot" +
+                             " --set sleeve.thickness=0.2mm --set roller.poles.N1.strength=160kA/m");
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_TRUE(contains(r.output, "exact multipole ring")) << r.output;
   EXPECT_TRUE(contains(r.output, "FEM check skipped")) << r.output;
@@ -135,6 +138,7 @@ TEST(CmdFlux, FitOnTheExampleScanRecoversItsHeaderPoles)
     EXPECT_TRUE(fs::exists(dir / "out" / f)) << f;
   const Case fitted = load_case((dir / "out" / "example_roller_fitted.yaml").string());
   EXPECT_EQ(fitted.name, "example_roller_fitted");
+  EXPECT_DOUBLE_EQ(fitted.sleeve->thickness, 0.2e-3);
   expect_poles_near(*fitted.roller, example_roller(), 0.1 * deg, 0.01, 0.01);
   // Before the fit the design poles are ~10 % off; the comparison shows it.
   EXPECT_TRUE(contains(r.output, "Scan against the fitted pole model")) << r.output;

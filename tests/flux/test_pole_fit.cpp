@@ -373,3 +373,26 @@ TEST(FluxCompare, NoticesAFlippedTangentialSign)
   EXPECT_LT(c.tangential_correlation, -0.99);
   EXPECT_NE(format_errors(c).find("--flip-bt"), std::string::npos);
 }
+
+TEST(PoleFit, FixedShapesKeepTheCaseValues)
+{
+  const FluxScan scan = read_flux_scan(example_scan_path());
+  PoleFitOptions options;
+  options.shape = PoleFitOptions::Shape::fixed;
+  const PoleFitResult fit = fit_poles(design_roller(), scan, 10e-3, options);
+  ASSERT_TRUE(fit.converged) << fit.status;
+  EXPECT_EQ(fit.parameters, 5u + 4u + 1u); // strengths, constrained angles, offset
+  for (const auto &p : fit.poles)
+  {
+    EXPECT_EQ(p.pole.shape_factor, 10.0);
+    EXPECT_EQ(p.shape_sigma, 0.0);
+  }
+  Worst w;
+  accumulate(w, fit, example_roller(), 0.0);
+  EXPECT_LT(w.angle, 0.1 * deg);
+  EXPECT_LT(w.strength, 0.01);
+  // A shared shape cannot start from per-pole values that differ.
+  Roller mixed = design_roller();
+  mixed.poles[2].shape_factor = 12.0;
+  EXPECT_THROW(fit_poles(mixed, scan, 10e-3), std::invalid_argument);
+}

@@ -65,6 +65,7 @@ struct ForceArrays
 struct MagneticStats
 {
   int sweeps = 0;               // field gathers (mutual induction sweeps); 0 for point_dipole
+  double relaxation = 1.0;      // final under-relaxation factor ω (1 = plain Jacobi)
   double residual = 0.0;        // max|Δp| / max|p| of the last sweep
   bool converged = true;        // residual ≤ tolerance within max_sweeps
   std::size_t pairs = 0;        // pairs (incl. periodic images) within the cutoff

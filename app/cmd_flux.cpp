@@ -65,8 +65,8 @@ Options:
   --source auto|ring|fem computed profile from the FEM if present (auto), the exact ring, or
                          the FEM only (error if missing)
   --fit                  fit the pole model to the scan; writes <case>_fitted.yaml in DIR
-  --fit-shape shared|per-pole|fixed   shape factors α: one for all (default), one per pole,
-                         or held at the case's values
+  --fit-shape shared|per-pole|fixed   shape factors α: one for all (default when the
+                         case's α agree, else per pole), one per pole, or held at the case's values
   --no-offset            do not fit an encoder offset (every pole angle free)
   --bn-only              fit Bn only (ignore Bt)
   --no-fem-check         skip running magbrush-field on the fitted case
@@ -87,6 +87,7 @@ struct FluxOptions
   std::string source = "auto";
   bool fit = false, no_fem_check = false, no_plot = false;
   PoleFitOptions fit_options;
+  bool shape_given = false; // --fit-shape was given (else: shared if the case's α agree)
   int harmonics = 0;
 };
 
@@ -135,6 +136,7 @@ FluxOptions parse_arguments(const std::vector<std::string> &args)
     else if (a == "--fit-shape")
     {
       const std::string s = value(i);
+      o.shape_given = true;
       if (s == "shared")
         o.fit_options.shape = PoleFitOptions::Shape::shared;
       else if (s == "per-pole" || s == "per_pole")
@@ -682,6 +684,15 @@ private:
   // 5. Levenberg–Marquardt on the exact ring, and the fitted model against the scan.
   void fit_poles_to_scan()
   {
+    if (!o_.shape_given)
+      for (const Pole &p : case_.roller->poles)
+        if (p.shape_factor != case_.roller->poles[0].shape_factor &&
+            o_.fit_options.shape == PoleFitOptions::Shape::shared)
+        {
+          o_.fit_options.shape = PoleFitOptions::Shape::per_pole;
+          std::cout << "  note: the case gives different shape factors per pole: fitting one "
+                       "per pole (--fit-shape shared: one for all, from their geometric mean)\n";
+        }
     fit_ = fit_poles(*case_.roller, *scan_, probe_radius_, o_.fit_options);
     std::cout << "\n" << fit_report(*fit_, o_) << "\n";
     if (!fit_->converged)

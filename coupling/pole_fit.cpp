@@ -225,8 +225,13 @@ public:
       x(i) = poles[i].strength / scale_;
     for (size_t j = 0; j < n_angle_; ++j)
       x(P_ + j) = deviation[j];
-    if (n_shape_ == 1)
-      x(P_ + n_angle_) = std::log(poles[0].shape_factor);
+    if (n_shape_ == 1) // one α for all: start from the geometric mean of the given ones
+    {
+      double log_mean = 0.0;
+      for (const Pole &p : poles)
+        log_mean += std::log(p.shape_factor) / poles.size();
+      x(P_ + n_angle_) = log_mean;
+    }
     else
       for (size_t i = 0; i < n_shape_; ++i)
         x(P_ + n_angle_ + i) = std::log(poles[i].shape_factor);
@@ -316,7 +321,7 @@ int harmonics_for_fit(const std::vector<Pole> &poles, const PoleFitOptions &opti
   return static_cast<int>(std::ceil(2.0 * std::sqrt(4.0 * alpha * std::log(1e12)))) + 4;
 }
 
-void check_starting_poles(const Roller &nominal, const PoleFitOptions &options)
+void check_starting_poles(const Roller &nominal)
 {
   if (nominal.poles.empty())
     throw std::invalid_argument("pole fit: the case has no poles to start from; add roller.poles "
@@ -326,11 +331,6 @@ void check_starting_poles(const Roller &nominal, const PoleFitOptions &options)
       throw std::invalid_argument("pole fit: pole '" + p.name +
                                   "' needs a non-zero strength (its sign says N or S) and a "
                                   "positive shape factor as a starting point");
-  if (options.shape == PoleFitOptions::Shape::shared)
-    for (const Pole &p : nominal.poles)
-      if (p.shape_factor != nominal.poles[0].shape_factor)
-        throw std::invalid_argument("pole fit: a shared shape factor was asked for, but the case "
-                                    "gives different α per pole; use per-pole shapes");
 }
 
 // The starting point of the fit: angles from the scan's peaks, strengths by linear least squares.
@@ -482,7 +482,7 @@ void summarise(const FitProblem &problem, const Eigen::VectorXd &x, double stren
 PoleFitResult fit_poles(const Roller &nominal, const FluxScan &scan, double probe_radius,
                         const PoleFitOptions &options)
 {
-  check_starting_poles(nominal, options);
+  check_starting_poles(nominal);
   PoleFitResult result;
   result.harmonics = harmonics_for_fit(nominal.poles, options);
   const PoleProfileModel model(RingGeometry::from(nominal), probe_radius, result.harmonics);

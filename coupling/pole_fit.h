@@ -3,7 +3,8 @@
 // multipole ring as the forward model.
 //
 // Unknowns: per pole the strength M_i and the angle φ_i; the shape factors α (one shared or
-// one per pole, fitted as ln α so that they stay positive, or held fixed); and the encoder
+// one per pole, fitted as ln α so that they stay positive — a shared one starts from the
+// geometric mean of the case's values —, or held fixed); and the encoder
 // offset δ of the scan (model evaluated at θ_scan + δ).
 //
 // The offset and a common rotation of all poles are the same thing to a scan, so only their

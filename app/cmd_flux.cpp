@@ -10,7 +10,9 @@
 //      fitted case file, and "the FEM as the final check" when magbrush-field is available.
 #include "subcommand.h"
 
+#include "case_hash.h"
 #include "case_parser.h"
+#include "field_grid.h"
 #include "flux_compare.h"
 #include "flux_scan.h"
 #include "multipole_ring.h"
@@ -218,7 +220,9 @@ double probe_radius_of(const Case &c)
   return r;
 }
 
-// The FEM profile at this radius, if magbrush-field wrote one: "# ... radius R mm." line.
+// The FEM profile at this radius, if magbrush-field wrote one for the case as it is now:
+// the profile's "# ... radius R mm." line must match the probe radius, and the stored magnetic
+// field it came from (<case>_magnetic.h5) must carry the case's current field hash.
 std::string fem_profile_path(const Case &c, double probe_radius, std::string &why_not)
 {
   const std::string path = c.field.output_dir + "/" + c.name + "_profile_probe.csv";
@@ -235,13 +239,33 @@ std::string fem_profile_path(const Case &c, double probe_radius, std::string &wh
     if (at == std::string::npos)
       continue;
     const double r = std::atof(line.c_str() + at + 7) * 1e-3;
-    if (std::abs(r - probe_radius) > 1e-9)
+    if (std::abs(r - probe_radius) > 1e-7) // the file prints 6 significant digits
     {
       why_not = path + " is at radius " + fixed(r * 1e3, 3) + " mm, not the probe radius " +
                 fixed(probe_radius * 1e3, 3) + " mm";
       return "";
     }
-    return path;
+    break;
+  }
+  const std::string grid = c.field.output_dir + "/" + c.name + "_magnetic.h5";
+  if (fs::exists(grid))
+  {
+    try
+    {
+      const GridFileInfo info = read_grid_info(grid);
+      const std::string difference =
+          provenance_difference(info, case_provenance(c, FieldKind::magnetic).case_inputs);
+      if (!difference.empty())
+      {
+        why_not = path + " is stale: " + difference;
+        return "";
+      }
+    }
+    catch (const std::exception &e)
+    {
+      why_not = "cannot check that " + path + " belongs to this case (" + e.what() + ")";
+      return "";
+    }
   }
   return path;
 }

@@ -6,6 +6,7 @@
 //  * bad input: unreadable scan, bad cell, probe radius inside the magnet, --fit without a
 //    scan, unknown option — exit status and message; a missing python only warns.
 #include "case_parser.h"
+#include "field_grid.h"
 #include "multipole_ring.h"
 #include "test_support.h"
 
@@ -242,6 +243,26 @@ TEST(CmdFlux, UsesTheFiniteElementProfileWhenPresent)
   EXPECT_TRUE(contains(other.output, "not the probe radius")) << other.output;
   const CommandResult must = run_magbrush(common + " --set field.probe_radius=11mm --source fem");
   EXPECT_EQ(must.status, 1) << must.output;
+
+  // The stored magnetic field records the case it was computed for: with a grid file of the
+  // case as it is, the profile is used; after a pole changes, it is stale and not used.
+  const Case current = load_case(case_file.string(), {"field.output_dir=" + fields.string()});
+  PolarGrid grid;
+  grid.r_min = 10e-3;
+  grid.r_max = 12e-3;
+  grid.n_r = 4;
+  grid.n_theta = 8;
+  grid.A_z.assign(32, 0.0);
+  write_magnetic_grid((fields / "example_roller_magnetic.h5").string(), grid,
+                      case_provenance(current, FieldKind::magnetic));
+  const CommandResult fresh = run_magbrush(common);
+  ASSERT_EQ(fresh.status, 0) << fresh.output;
+  EXPECT_TRUE(contains(fresh.output, "finite-element field")) << fresh.output;
+  const CommandResult stale = run_magbrush(common + " --set roller.poles.N1.strength=100kA/m");
+  ASSERT_EQ(stale.status, 0) << stale.output;
+  EXPECT_TRUE(contains(stale.output, "is stale") && contains(stale.output, "roller.poles.N1.strength"))
+      << stale.output;
+  EXPECT_TRUE(contains(stale.output, "exact multipole ring")) << stale.output;
 }
 
 TEST(CmdFlux, BadInputGivesClearErrors)

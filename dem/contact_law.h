@@ -150,16 +150,18 @@ inline ContactOutcome evaluate_contact(const ContactCoefficients &c, const Conta
                                        Vector3 &history, double dt)
 {
   ContactOutcome out;
-  const double k_n = HertzNormal::stiffness(c.effective_modulus, k.R_star);
+  // The same formulas as the sub-models above, sharing √R* and √δ (4 square roots, not 6).
+  const double sqrt_R = std::sqrt(k.R_star), sqrt_delta = std::sqrt(k.overlap);
+  const double k_n = 4.0 / 3.0 * c.effective_modulus * sqrt_R;            // HertzNormal::stiffness
   // v_rel·n > 0: i moves towards the partner (approach); the dashpot opposes it.
   const double approach = dot(k.v_rel, k.n);
-  const double c_n = ViscoelasticDamping::normal(c.damping_normal, k.m_star, k_n, k.overlap);
+  const double c_n = c.damping_normal * std::sqrt(k.m_star * k_n * sqrt_delta); // ViscoelasticDamping::normal
   // Magnitude of the repulsive normal force; a dashpot may not pull the bodies together.
-  const double f_n = std::max(0.0, HertzNormal::force(k_n, k.overlap) + c_n * approach);
+  const double f_n = std::max(0.0, k_n * k.overlap * sqrt_delta + c_n * approach);
   out.normal_force = f_n;
 
-  const Vector3 v_t = k.v_rel - dot(k.v_rel, k.n) * k.n;
-  const double k_t = MindlinTangential::stiffness(c.effective_shear, k.R_star, k.overlap);
+  const Vector3 v_t = k.v_rel - approach * k.n;
+  const double k_t = 8.0 * c.effective_shear * sqrt_R * sqrt_delta;     // MindlinTangential::stiffness
   const double c_t = ViscoelasticDamping::tangential(c.damping_tangential, k.m_star, k_t);
   MindlinTangential::rotate_into_tangent_plane(history, k.n);
   const Vector3 f_t = MindlinTangential::force(history, v_t, k_t, c_t, c.friction, f_n, dt);

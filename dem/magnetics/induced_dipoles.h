@@ -14,8 +14,8 @@
 //      in the local field of the pair;
 //   6. per bead: F_j = (p_j·∇)B0_j + Σ ± pair forces, gathered in a fixed order.
 // Every parallel loop writes only its own entries and sums in a fixed order, so the result is
-// bit-identical for any number of OpenMP threads. After the first call no memory is
-// allocated unless the number of beads or pairs grows (or a new β needs a table).
+// bit-identical for any number of OpenMP threads. Between neighbour-list rebuilds no memory
+// is allocated (a rebuild uses temporary cell arrays; a new β builds its table once).
 //
 // The DEM may hold the magnetic forces between evaluations: needs_refresh() says when to
 // evaluate again (interval elapsed, or a bead moved more than a fraction of its radius), and

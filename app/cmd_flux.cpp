@@ -48,7 +48,8 @@ the Gaussian pole model (strengths, angles, shape factors, encoder offset) to it
 
 The computed profile is taken at field.probe_radius (0 = the sleeve radius): from the finite-
 element field (<field.output_dir>/<case>_profile_probe.csv, written by `magbrush field`) when
-it exists for that radius, otherwise from the exact multipole-ring solution of the pole model.
+it exists for that radius and its stored field matches the case as it is now (else it is
+called stale, with the key that differs), otherwise from the exact multipole-ring solution.
 
 Scan (CSV): columns angle, Bn[, Bt] in any order (names like angle_deg/theta, Bn/B_n/Br,
 Bt/B_t/Btheta), units in the header (angle_deg, Bn_mT, "Bn [G]") or given below, '#' comments.

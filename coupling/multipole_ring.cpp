@@ -252,37 +252,78 @@ void MultipoleRing::HarmonicResponse::radial_factors(double r, double &beta_r,
 {
   const double rho = r / g_.magnet_radius;
   const double nn = n_;
-  const double mu_m = g_.magnet_mu_r;
   if (rho >= 1.0)
   {
-    beta_r = beta_theta = nn * d_ * std::pow(1.0 / rho, nn + 1.0);
+    radial_factors_from_powers(rho, 0.0, 0.0, std::pow(1.0 / rho, nn + 1.0), beta_r, beta_theta);
     return;
   }
-  auto magnet_factors = [&](double x, double &br, double &bt) {
-    // f = P + p x^n + q (σ/x)^n,  f' = P' + n p x^(n−1) − n q σ^n x^(−n−1)
-    const double up = p_ * std::pow(x, nn - 1.0);                         // p x^(n−1)
-    const double down = sigma_ > 0.0 ? q_ * std::pow(sigma_ / x, nn) / x : 0.0; // q σ^n x^(−n−1)
-    const double f = particular(x) + x * up + x * down;
-    const double df = particular_derivative(x) + nn * up - nn * down;
-    br = -mu_m * df + 1.0;
-    bt = mu_m * nn * f / x;
-  };
   if (rho >= sigma_)
   {
     // The very centre of a shaftless magnet: the field depends on the direction of approach
     // (M_r is discontinuous there), so evaluate just off it.
-    magnet_factors(std::max(rho, 1e-300), beta_r, beta_theta);
+    const double x = std::max(rho, 1e-300);
+    radial_factors_from_powers(x, std::pow(x, nn - 1.0), sigma_ > 0.0 ? std::pow(sigma_ / x, nn) : 0.0,
+                               0.0, beta_r, beta_theta);
     return;
   }
   // Inside the shaft: ψ = c r^n, so β_r = B (r/R_s)^(n−1), β_θ = −β_r, with B = β_r at the
   // shaft surface (B_r is continuous). For ideal iron that is the μ_s → ∞ limit.
   double br_surface, bt_surface;
   if (std::isinf(g_.shaft_mu_r))
-    magnet_factors(sigma_, br_surface, bt_surface);
+    radial_factors_from_powers(sigma_, std::pow(sigma_, nn - 1.0), 1.0, 0.0, br_surface, bt_surface);
   else
     br_surface = -g_.shaft_mu_r * nn * s_ / sigma_;
   beta_r = br_surface * std::pow(rho / sigma_, nn - 1.0);
   beta_theta = -beta_r;
+}
+
+void MultipoleRing::HarmonicResponse::radial_factors_from_powers(double x, double up, double down,
+                                                                 double out, double &beta_r,
+                                                                 double &beta_theta) const
+{
+  const double nn = n_;
+  if (x >= 1.0)
+  {
+    beta_r = beta_theta = nn * d_ * out; // air: f = d x^−n
+    return;
+  }
+  // Magnet: f = P + p x^n + q (σ/x)^n,  f' = P' + n p x^(n−1) − n q σ^n x^(−n−1)
+  const double mu_m = g_.magnet_mu_r;
+  const double p_up = p_ * up;                              // p x^(n−1)
+  const double q_down = sigma_ > 0.0 ? q_ * down / x : 0.0; // q σ^n x^(−n−1)
+  const double f = particular(x) + x * p_up + x * q_down;
+  const double df = particular_derivative(x) + nn * p_up - nn * q_down;
+  beta_r = -mu_m * df + 1.0;
+  beta_theta = mu_m * nn * f / x;
+}
+
+void MultipoleRing::radial_factors_at(double r, std::vector<double> &fr, std::vector<double> &ft) const
+{
+  const size_t N = harmonics_.size();
+  fr.resize(N);
+  ft.resize(N);
+  const double rho = r / geometry_.magnet_radius;
+  const double sigma = geometry_.shaft_radius / geometry_.magnet_radius;
+  if (!consecutive_ || rho < sigma)
+  {
+    for (size_t i = 0; i < N; ++i)
+      responses_[i].radial_factors(r, fr[i], ft[i]);
+    return;
+  }
+  // Orders 1, 2, 3, ...: the powers x^(n−1), (σ/x)^n, (1/x)^(n+1) by recurrence.
+  const double x = std::max(rho, 1e-300);
+  double up = 1.0, down = sigma / x, out = 1.0 / (x * x);
+  for (size_t i = 0; i < N; ++i)
+  {
+    responses_[i].radial_factors_from_powers(x, up, down, out, fr[i], ft[i]);
+    if (x < 1.0)
+    {
+      up *= x;
+      down *= sigma / x;
+    }
+    else
+      out /= x;
+  }
 }
 
 // ---------------------------------------------------------------------------------------
@@ -340,13 +381,14 @@ RingField MultipoleRing::field(double x, double y) const
 RingField MultipoleRing::field_polar(double r, double theta) const
 {
   RingField f;
+  std::vector<double> fr, ft;
+  radial_factors_at(r, fr, ft);
   const std::complex<double> step = std::polar(1.0, theta);
   std::complex<double> z(1.0, 0.0); // e^{inθ} by recurrence when the orders are 1, 2, 3, ...
   for (size_t i = 0; i < harmonics_.size(); ++i)
   {
     const auto &h = harmonics_[i];
-    double br, bt;
-    responses_[i].radial_factors(r, br, bt);
+    const double br = fr[i], bt = ft[i];
     z = consecutive_ ? z * step : std::polar(1.0, h.n * theta);
     const double c = z.real(), s = z.imag();
     f.Br += br * (h.a * c + h.b * s);
@@ -366,9 +408,8 @@ void MultipoleRing::profile(double r, const std::vector<double> &angles, std::ve
                             std::vector<double> &Bt) const
 {
   const size_t N = harmonics_.size();
-  std::vector<double> fr(N), ft(N);
-  for (size_t i = 0; i < N; ++i)
-    responses_[i].radial_factors(r, fr[i], ft[i]);
+  std::vector<double> fr, ft;
+  radial_factors_at(r, fr, ft);
   Bn.assign(angles.size(), 0.0);
   Bt.assign(angles.size(), 0.0);
   for (size_t k = 0; k < angles.size(); ++k)

@@ -143,6 +143,11 @@ public:
     HarmonicResponse(const RingGeometry &geometry, int n);
     int n() const { return n_; }
     void radial_factors(double r, double &beta_r, double &beta_theta) const;
+    // The same outside the shaft (x = r/R_m ≥ R_s/R_m) with the powers supplied by the caller:
+    // up = x^(n−1), down = (σ/x)^n (σ = R_s/R_m), out = (1/x)^(n+1) — so that consecutive
+    // harmonics at one radius cost a multiplication each instead of a pow().
+    void radial_factors_from_powers(double x, double up, double down, double out, double &beta_r,
+                                    double &beta_theta) const;
     // Exterior coefficient d_n in units of M R_m^(n+1): outside, β = n d_n (R_m/r)^(n+1).
     // For μ = 1 everywhere this is the classical E_n/(M R_o^(n+1)).
     double exterior_coefficient() const { return d_; }
@@ -172,8 +177,9 @@ private:
   std::vector<HarmonicResponse> responses_;
   double mean_magnetisation_ = 0.0; // m_0 (no field, kept for magnetisation())
   HarmonicChoice choice_;
-  bool consecutive_ = false; // orders are 1, 2, ..., N: powers of e^{iθ} by recurrence
+  bool consecutive_ = false; // orders are 1, 2, ..., N: powers by recurrence
   void build_responses();
+  void radial_factors_at(double r, std::vector<double> &fr, std::vector<double> &ft) const;
 };
 
 } // namespace magbrush

@@ -13,6 +13,7 @@
 #include <iomanip>
 #include <sstream>
 #include <stdexcept>
+#include <fcntl.h>
 #include <unistd.h>
 #include <unordered_map>
 
@@ -329,6 +330,39 @@ std::vector<int> add_structured_annulus(const Vec2 &c, double r_in, double r_out
 }
 
 namespace {
+// Gmsh's Blossom matcher prints warnings with printf, past General.Terminal = 0. While it runs
+// without --verbose, standard output goes to /dev/null (process-wide: meant for the CLI and
+// the tests, where nothing else prints meanwhile).
+class QuietStdout
+{
+public:
+  explicit QuietStdout(bool active)
+  {
+    if (!active)
+      return;
+    std::fflush(stdout);
+    saved_ = ::dup(STDOUT_FILENO);
+    const int null = ::open("/dev/null", O_WRONLY);
+    if (saved_ >= 0 && null >= 0)
+      ::dup2(null, STDOUT_FILENO);
+    if (null >= 0)
+      ::close(null);
+  }
+  ~QuietStdout()
+  {
+    if (saved_ < 0)
+      return;
+    std::fflush(stdout);
+    ::dup2(saved_, STDOUT_FILENO);
+    ::close(saved_);
+  }
+  QuietStdout(const QuietStdout &) = delete;
+  QuietStdout &operator=(const QuietStdout &) = delete;
+
+private:
+  int saved_ = -1;
+};
+
 std::size_t count_triangles()
 {
   std::vector<int> types;
@@ -355,21 +389,30 @@ void generate_quad_mesh(const std::function<double(const Vec2 &)> &size)
   gmsh::option::setNumber("Mesh.Algorithm", 6);
   gmsh::option::setNumber("Mesh.RecombineAll", 1);
   gmsh::option::setNumber("Mesh.RecombinationAlgorithm", 1);
+  double terminal = 0.0;
+  gmsh::option::getNumber("General.Terminal", terminal);
+  QuietStdout quiet(terminal == 0.0);
   gmsh::model::mesh::setSizeCallback(
       [size](int, int, double x, double y, double) { return size({x, y}); });
   gmsh::model::mesh::generate(2);
   if (count_triangles() > 0)
   {
-    // Blossom could not pair every triangle (an odd number of boundary nodes somewhere):
-    // the full-quad variant meshes at twice the size and splits every cell into quads.
+    // Blossom could not pair every triangle (a surface with an odd number of boundary
+    // segments). Fallback: mesh at twice the size and split every cell into quadrilaterals
+    // (a triangle into 3, a quad into 4). The structured parts are split too, which only
+    // refines them. (Gmsh's full-quad recombination is not used: it fails on transfinite
+    // curves with an odd number of segments.)
     gmsh::model::mesh::clear();
-    gmsh::option::setNumber("Mesh.RecombinationAlgorithm", 3);
+    gmsh::model::mesh::setSizeCallback(
+        [size](int, int, double x, double y, double) { return 2.0 * size({x, y}); });
+    gmsh::option::setNumber("Mesh.SubdivisionAlgorithm", 1);
     gmsh::model::mesh::generate(2);
+    gmsh::option::setNumber("Mesh.SubdivisionAlgorithm", 0);
   }
   gmsh::model::mesh::removeSizeCallback();
   if (const std::size_t n = count_triangles(); n > 0)
     throw std::runtime_error("the mesh still has " + std::to_string(n) +
-                             " triangles after full-quad recombination; deal.II needs "
+                             " triangles after subdivision into quadrilaterals; deal.II needs "
                              "quadrilaterals only (try a slightly different mesh size)");
 }
 

@@ -22,7 +22,7 @@ constexpr double shell_outer_ratio = 1.25;
 
 struct OpenBoundaryShell
 {
-  Vec2 center{0.0, 0.0};
+  Vec2 center{{0.0, 0.0}};
   double inner_radius = 0.0;
   double outer_radius = 0.0;
 };
@@ -35,7 +35,7 @@ struct OpenBoundaryShell
 struct MeshCircle
 {
   std::string name;        // "sleeve_surface", "magnet_surface", "drum_surface", "shell_outer", ...
-  Vec2 center{0.0, 0.0};
+  Vec2 center{{0.0, 0.0}};
   double radius = 0.0;
   int boundary_id = -1;    // its boundary tag (mesh_tags.h) when it bounds the domain, else −1
   int inside_region = -1;  // region tag just inside (−1: none, outside the domain)
@@ -158,7 +158,7 @@ std::vector<int> add_structured_annulus(const Vec2 &c, double r_in, double r_out
                                         std::vector<int> &inner_arcs, std::vector<int> &outer_arcs);
 
 // Meshes in 2D with quadrilaterals only (Frontal-Delaunay + Blossom recombination; when a
-// surface keeps triangles, once more with the full-quad Blossom variant) using `size` as the
+// surface keeps triangles, once more at twice the size with every cell split into quads) using `size` as the
 // target size, then checks that no triangle is left.
 void generate_quad_mesh(const std::function<double(const Vec2 &)> &size);
 

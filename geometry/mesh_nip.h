@@ -26,12 +26,12 @@ namespace magbrush {
 struct NipMeshGeometry
 {
   double sleeve_radius = 0.0;
-  Vec2 drum_center{0.0, 0.0};
+  Vec2 drum_center{{0.0, 0.0}};
   double drum_radius = 0.0;
   double pc_thickness = 0.0;
   double gap = 0.0;
-  Vec2 nip_direction{1.0, 0.0}; // unit vector from the roller centre to the drum centre
-  Vec2 nip_midpoint{0.0, 0.0};  // middle of the development gap on the line of centres
+  Vec2 nip_direction{{1.0, 0.0}}; // unit vector from the roller centre to the drum centre
+  Vec2 nip_midpoint{{0.0, 0.0}};  // middle of the development gap on the line of centres
   double nip_window = 0.0;      // radius of the mesh_size_gap disk around nip_midpoint
   int layer_cells_across = 0;   // photoconductor cells across its thickness (0: no layer)
   OpenBoundaryShell shell;

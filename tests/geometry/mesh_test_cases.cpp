@@ -28,11 +28,11 @@ Case coarse_roller_case()
   blade.mu_r = 50;
   blade.is_doctor_blade = true;
   blade.gap = 0.5e-3;
-  blade.polygon = {Vec2{-0.75e-3, -10.5e-3}, Vec2{-0.75e-3, -16.5e-3}, Vec2{0.75e-3, -16.5e-3}, Vec2{0.75e-3, -10.5e-3}};
+  blade.polygon = {Vec2{{-0.75e-3, -10.5e-3}}, Vec2{{-0.75e-3, -16.5e-3}}, Vec2{{0.75e-3, -16.5e-3}}, Vec2{{0.75e-3, -10.5e-3}}};
   c.blades.push_back(blade);
   BladeOrGuide guide;
   guide.name = "guide";
-  guide.polygon = {Vec2{-6.183e-3, -9.709e-3}, Vec2{-8.433e-3, -13.606e-3}, Vec2{-7.567e-3, -14.106e-3}, Vec2{-5.317e-3, -10.209e-3}};
+  guide.polygon = {Vec2{{-6.183e-3, -9.709e-3}}, Vec2{{-8.433e-3, -13.606e-3}}, Vec2{{-7.567e-3, -14.106e-3}}, Vec2{{-5.317e-3, -10.209e-3}}};
   c.blades.push_back(guide);
   c.field.mesh_size_sleeve = 0.4e-3;
   c.field.mesh_size_far = 3e-3;

@@ -1,0 +1,167 @@
+// End-to-end: bin/magbrush-dem on a small case file (parser → insertion → run → outputs),
+// a restart from the checkpoint that reproduces the uninterrupted run's final snapshot bit for
+// bit, and the messages of a refused time step and an impossible insertion.
+#include <gtest/gtest.h>
+#include <hdf5.h>
+
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const char *case_text = R"(name: dem_cli_test
+scene: box
+planes:
+  - name: stage
+    point: [0 mm, 0 mm, 0 mm]
+    normal: [0, 0, 1]
+    material: wall
+materials:
+  carrier:
+    youngs_modulus: 100 MPa
+    poisson_ratio: 0.35
+    density: 2200 kg/m^3
+    friction: 0.45
+    polygon_angles: 12
+    damping: 0.6
+  wall:
+    youngs_modulus: 5e4 MPa
+    poisson_ratio: 0.3
+    friction: 0.35
+populations:
+  - name: carrier
+    kind: carrier
+    material: carrier
+    diameter: 100 um
+    diameter_std: 10 um
+    count: 250
+    insert_box: [[0 mm, 0 mm, 0.05 mm], [1 mm, 1 mm, 1 mm]]
+dem:
+  duration: 100 us
+  output_interval: 20 us
+  checkpoint_interval: 50 us
+  periodic_length_x: 1 mm
+  periodic_length_y: 1 mm
+  gravity: [0, 0, -9.81 m/s^2]
+)";
+
+struct CliResult
+{
+  int code;
+  std::string output;
+};
+
+CliResult run_dem(const std::string &args)
+{
+  const std::string cmd = std::string(MAGBRUSH_BINARY_DIR) + "/bin/magbrush-dem " + args + " 2>&1";
+  CliResult r{-1, {}};
+  FILE *p = popen(cmd.c_str(), "r");
+  if (!p)
+    return r;
+  char buf[4096];
+  while (fgets(buf, sizeof buf, p))
+    r.output += buf;
+  const int status = pclose(p);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+std::vector<double> read_dataset(const std::string &file, const char *name)
+{
+  std::vector<double> v;
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (f < 0)
+    return v;
+  const hid_t d = H5Dopen2(f, name, H5P_DEFAULT);
+  const hid_t s = H5Dget_space(d);
+  v.resize(static_cast<std::size_t>(H5Sget_simple_extent_npoints(s)));
+  H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data());
+  H5Sclose(s);
+  H5Dclose(d);
+  H5Fclose(f);
+  return v;
+}
+
+class DemCli : public ::testing::Test
+{
+protected:
+  fs::path dir = fs::temp_directory_path() / "magbrush_dem_cli_test";
+  std::string case_file;
+  void SetUp() override
+  {
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    case_file = (dir / "case.yaml").string();
+    std::ofstream(case_file) << case_text;
+  }
+  void TearDown() override { fs::remove_all(dir); }
+};
+
+} // namespace
+
+TEST_F(DemCli, RunsWritesOutputsAndRestartsBitIdentically)
+{
+  const std::string straight = (dir / "straight").string(), split = (dir / "split").string();
+  const CliResult a = run_dem(case_file + " --threads 2 --output " + straight);
+  ASSERT_EQ(a.code, 0) << a.output;
+  EXPECT_NE(a.output.find("force terms on: contacts, gravity, Stokes drag"), std::string::npos) << a.output;
+  EXPECT_NE(a.output.find("time per phase"), std::string::npos) << a.output;
+  for (const char *f : {"particles.xdmf", "time_series.csv", "checkpoint.bin"})
+    EXPECT_TRUE(fs::exists(fs::path(straight) / f)) << f;
+  std::ifstream x(fs::path(straight) / "particles.xdmf");
+  const std::string xdmf((std::istreambuf_iterator<char>(x)), std::istreambuf_iterator<char>());
+  std::size_t grids = 0;
+  for (std::size_t p = xdmf.find("<Time Value"); p != std::string::npos; p = xdmf.find("<Time Value", p + 1))
+    ++grids;
+  EXPECT_EQ(grids, 6u); // t = 0, 20, ..., 100 µs
+  std::ifstream csv(fs::path(straight) / "time_series.csv");
+  std::string header;
+  std::getline(csv, header);
+  EXPECT_NE(header.find("stage_Fz"), std::string::npos) << header;
+
+  // The same run in two pieces: to 50 µs, then restarted from its checkpoint to 100 µs.
+  const CliResult b1 = run_dem(case_file + " --threads 1 --set dem.duration=50us --output " + split);
+  ASSERT_EQ(b1.code, 0) << b1.output;
+  const CliResult b2 = run_dem(case_file + " --threads 1 --output " + split + " --restart " + split + "/checkpoint.bin");
+  ASSERT_EQ(b2.code, 0) << b2.output;
+  EXPECT_NE(b2.output.find("restarted from"), std::string::npos) << b2.output;
+  std::vector<std::string> last;
+  for (const auto &d : {straight, split})
+  {
+    std::vector<std::string> files;
+    for (const auto &e : fs::directory_iterator(fs::path(d) / "snapshots"))
+      files.push_back(e.path().string());
+    std::sort(files.begin(), files.end());
+    ASSERT_GE(files.size(), 6u) << d; // (the split run also has its 50 µs end snapshot)
+    last.push_back(files.back());
+  }
+  for (const char *name : {"position", "velocity", "angular_velocity", "force"})
+  {
+    const auto p = read_dataset(last[0], name), q = read_dataset(last[1], name);
+    ASSERT_EQ(p.size(), 750u) << name;
+    EXPECT_EQ(0, std::memcmp(p.data(), q.data(), p.size() * sizeof(double))) << name << " differs after restart";
+  }
+}
+
+TEST_F(DemCli, RefusesUnstableTimeStepWithTheLimit)
+{
+  const CliResult r = run_dem(case_file + " --set dem.time_step=1us --output " + (dir / "o").string());
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("above the stable limit"), std::string::npos) << r.output;
+}
+
+TEST_F(DemCli, ImpossibleInsertionSaysWhatToDo)
+{
+  const CliResult r = run_dem(case_file + " --set populations.carrier.count=5000 --output " + (dir / "o").string());
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("enlarge the insertion region"), std::string::npos) << r.output;
+}

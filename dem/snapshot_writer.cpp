@@ -176,7 +176,7 @@ void SnapshotWriter::write_index() const
     std::snprintf(tbuf, sizeof tbuf, "%.9g", t);
     x << "  <Grid Name=\"t=" << tbuf << "\" GridType=\"Uniform\">\n"
       << "    <Time Value=\"" << tbuf << "\"/>\n"
-      << "    <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" << n << "\"/>\n"
+      << "    <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" << n << "\" NodesPerElement=\"1\"/>\n"
       << "    <Geometry GeometryType=\"XYZ\"><DataItem Dimensions=\"" << n
       << " 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << file << ":/position</DataItem></Geometry>\n";
     auto attr = [&](const char *name, const char *type, int cols, const char *number, int precision) {

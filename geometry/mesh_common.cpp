@@ -210,6 +210,8 @@ GmshSession::GmshSession(const MeshOptions &options, const std::string &model_na
     gmsh::initialize(0, nullptr, /*readConfigFiles=*/false);
     gmsh::option::setNumber("General.Terminal", options.verbose ? 1 : 0);
     gmsh::option::setNumber("General.Verbosity", options.verbose ? 5 : 1);
+    // One thread: a Gmsh error thrown inside one of its OpenMP regions could not be caught.
+    gmsh::option::setNumber("General.NumThreads", 1);
     gmsh::model::add(model_name);
   });
 }

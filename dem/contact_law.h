@@ -56,7 +56,7 @@ struct ViscoelasticDamping
 // each other), then incremented by v_t dt. We remove the normal component WITHOUT restoring
 // the old magnitude: that equals the exact rotation to first order in the step's rotation
 // angle, and — unlike LAMMPS's magnitude-preserving rescale — can never pump the spring up,
-// which made small particles stick to large ones there (lammps/lammps PR #4244).
+// which is reported to make small particles stick to large ones (lammps/lammps PR #4244).
 // When sliding, ξ is reset to the spring extension that carries the Coulomb force
 // (ξ = −(F_t + c_t v_t)/k_t, as in LAMMPS and Luding 2008), so stick resumes without a jump.
 struct MindlinTangential

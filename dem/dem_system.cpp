@@ -241,14 +241,14 @@ void DemSystem::compute_particle_contacts()
         L.hist_x[p] = L.hist_y[p] = L.hist_z[p] = 0.0;
         continue;
       }
-      const double dist = std::sqrt(r2);
+      const double dist = std::sqrt(r2), inv_dist = 1.0 / dist;
       ContactKinematics c;
-      c.n = (1.0 / dist) * d;
+      c.n = inv_dist * d;
       c.overlap = reach - dist;
       if (c.overlap > guard * std::min(ri, rj))
         overlap_alarm = 1;
       // Distances from the centres to the plane of the contact circle.
-      c.lever_i = 0.5 * (dist + (ri * ri - rj * rj) / dist);
+      c.lever_i = 0.5 * (dist + (ri * ri - rj * rj) * inv_dist);
       c.lever_j = dist - c.lever_i;
       const Vector3 wj = s.angular_velocity(j);
       c.v_rel = vi - s.velocity(j) + cross(c.lever_i * wi + c.lever_j * wj, c.n);

@@ -456,3 +456,47 @@ TEST(DemEngine, SnapshotIsReadableAndInIdOrder)
   EXPECT_FALSE(std::filesystem::exists(dir / "particles.xdmf.tmp"));
   std::filesystem::remove_all(dir);
 }
+
+TEST(DemEngine, InsertedParticlesSettleOnTheStage)
+{
+  omp_set_num_threads(1);
+  Material m = elastic_material("carrier", 1e6, 0.35, 2200); // soft: a large step
+  m.friction = 0.45;
+  m.damping = 0.6;
+  Case c = single_species_case(m);
+  c.populations[0].diameter_mean = 100e-6;
+  c.populations[0].diameter_std = 10e-6;
+  c.populations[0].count = 200;
+  c.populations[0].insert_box = std::array<Vec3, 2>{Vec3{0, 0, 0}, Vec3{1e-3, 1e-3, 0.4e-3}};
+  c.dem.periodic_length_x = c.dem.periodic_length_y = 1e-3;
+  c.dem.gravity = {0, 0, -9.81};
+  c.dem.air_viscosity = 1.81e-5;
+  add_rigid_plane(c, {0, 0, 0}, {0, 0, 1}, 0.3, 0.35);
+  c.materials.back().youngs_modulus = 5e10;
+  DemSystem s(c);
+  s.add_force_term(std::make_unique<Gravity>(c.dem.gravity));
+  s.add_force_term(std::make_unique<StokesDrag>(c.dem.air_viscosity));
+  s.insert_particles();
+  s.initialize();
+  double released = 0.0; // potential energy the fall can release (to z = r)
+  for (std::size_t i = 0; i < s.particles().size(); ++i)
+    released += s.particles().mass[i] * 9.81 * (s.particles().z[i] - s.particles().radius[i]);
+  s.settle(0.03);
+  EXPECT_EQ(s.step_count(), 0);
+  EXPECT_EQ(s.time(), 0.0);
+  const double ke = s.kinetic_energy() + s.rotational_energy();
+  double z_min = 1.0;
+  for (std::size_t i = 0; i < s.particles().size(); ++i)
+    z_min = std::min(z_min, s.particles().z[i] / s.particles().radius[i]);
+  const auto loads = s.wall_loads();
+  double weight = 0.0;
+  for (double mass : s.particles().mass)
+    weight += mass * 9.81;
+  std::printf("settling: kinetic energy %.3g of the %.3g J released, lowest centre at %.3f radii, %ld particle "
+              "and %ld wall contacts, stage load %.4f of the weight\n",
+              ke, released, z_min, s.particle_contacts(), loads[0].contacts, -loads[0].force[2] / weight);
+  EXPECT_LT(ke, 1e-3 * released);
+  EXPECT_GT(z_min, 0.9); // nobody fell through the stage
+  EXPECT_GT(loads[0].contacts, 50);
+  EXPECT_NEAR(-loads[0].force[2] / weight, 1.0, 0.05); // at rest, the stage carries the weight
+}

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <unistd.h>
 
 namespace magbrush::testing {
 
@@ -61,7 +62,9 @@ Case coarse_nip_case(double pc_thickness)
 
 std::string scratch_dir(const std::string &name)
 {
-  const std::filesystem::path dir = std::filesystem::path(MAGBRUSH_BINARY_DIR) / "tests" / "scratch" / name;
+  // One directory per process: ctest runs the test cases of one executable in parallel.
+  const std::filesystem::path dir = std::filesystem::path(MAGBRUSH_BINARY_DIR) / "tests" / "scratch" /
+                                    (name + "-" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir.string();

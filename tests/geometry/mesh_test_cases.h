@@ -11,6 +11,6 @@ namespace magbrush::testing {
 
 Case coarse_roller_case();                    // sleeve 10 mm, magnetic blade + plain guide
 Case coarse_nip_case(double pc_thickness);    // sleeve 10 mm, drum 15 mm, gap 0.35 mm
-std::string scratch_dir(const std::string &name); // an empty directory under the build tree
+std::string scratch_dir(const std::string &name); // an empty directory under the build tree (per process)
 
 } // namespace magbrush::testing

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <string>
+#include <unistd.h>
 
 namespace fs = std::filesystem;
 
@@ -31,7 +32,7 @@ Result run(const std::string &arguments)
 
 std::string scratch(const std::string &name)
 {
-  const fs::path dir = fs::path(MAGBRUSH_BINARY_DIR) / "tests" / "scratch" / name;
+  const fs::path dir = fs::path(MAGBRUSH_BINARY_DIR) / "tests" / "scratch" / (name + "-" + std::to_string(::getpid()));
   fs::remove_all(dir);
   return dir.string();
 }

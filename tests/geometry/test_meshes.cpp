@@ -164,6 +164,7 @@ struct RollerFixture : ::testing::Test
   }
   static void TearDownTestSuite()
   {
+    std::filesystem::remove_all(std::filesystem::path(path).parent_path());
     delete c;
     delete summary;
     delete mesh;

@@ -2,8 +2,7 @@
 //
 //  * make_layered_disk: concentric annuli around an O-grid core — the roller cross-section
 //    (shaft, magnet, gap, sleeve, air, open-boundary shell). Every circle is a mesh line on a
-//    SphericalManifold, the core on a TransfiniteInterpolationManifold, so refinement stays on
-//    the circles.
+//    SphericalManifold, so refinement stays on the circles.
 //  * make_layered_slab: a periodic strip of horizontal layers (photoconductor, air gap) for the
 //    planar nip checks.
 //  * make_bipolar_two_cylinders: the exterior of two cylinders meshed in bipolar coordinates
@@ -30,8 +29,8 @@ struct AnnularLayer
 
 // The first layer is the disk 0 ≤ r < layers[0].outer_radius (an O-grid), each further one the
 // annulus from the previous radius. n_angular (a multiple of 4, ≥ 8) cells around. The outer
-// circle gets boundary id 0. Manifold ids: 0 = circles (SphericalManifold at the origin),
-// 1 = core (TransfiniteInterpolationManifold).
+// circle gets boundary id 0. Manifold ids: 0 = circles (SphericalManifold at the origin);
+// the core is flat inside (its curved rim is blended in by the mapping).
 void make_layered_disk(dealii::Triangulation<2> &triangulation,
                        const std::vector<AnnularLayer> &layers, unsigned int n_angular);
 

@@ -62,6 +62,8 @@ PotentialProblemDescription NipElectrostatics::describe() const
   d.name = "nip field";
   d.degree = discretisation.degree;
   d.solver_tolerance = discretisation.solver_tolerance;
+  d.linear_solver = discretisation.linear_solver;
+  d.estimate_error = false; // the Kelly indicator only for the VTU (write_vtu)
   d.coefficient[nip_region::air] = eps0;
   d.coefficient[nip_region::photoconductor] = eps0 * layer_eps_r;
   const double V = bias;
@@ -120,9 +122,34 @@ std::vector<double> NipElectrostatics::potential(const std::vector<Vec2> &points
       index.push_back(k);
     }
   }
-  const auto v = solver->values_at(inside);
+  std::vector<bool> found;
+  const auto v = solver->values_at(inside, &found);
   for (std::size_t i = 0; i < index.size(); ++i)
-    values[index[i]] = v[i];
+  {
+    if (found[i])
+    {
+      values[index[i]] = v[i];
+      continue;
+    }
+    // Not in any cell: a point a hair outside the polynomial approximation of a curved
+    // conductor surface takes the conductor's value; anything else is an error.
+    const Vec2 &x = points[index[i]];
+    const double ds = std::hypot(x[0], x[1]) - nip.sleeve_radius;
+    const double dd =
+      std::hypot(x[0] - nip.drum_center[0], x[1] - nip.drum_center[1]) - substrate;
+    const double band = 1e-3 * (nip.bipolar.center_left + nip.bipolar.center_right -
+                                nip.sleeve_radius - nip.drum_radius);
+    if (ds < band && ds <= dd)
+      values[index[i]] = bias;
+    else if (dd < band)
+      values[index[i]] = image.kind == LatentImage::Kind::surface_potential
+                           ? latent_image_value(image, arc_length_from_nip(Point<2>(x[0], x[1])))
+                           : 0.0;
+    else
+      throw std::runtime_error("nip field: the point (" + std::to_string(x[0]) + ", " +
+                               std::to_string(x[1]) + ") m lies outside the solved region; "
+                               "the electric grid window must stay near the nip");
+  }
   return values;
 }
 
@@ -141,6 +168,7 @@ std::vector<Vec2> NipElectrostatics::electric_field(const std::vector<Vec2> &poi
 void NipElectrostatics::write_vtu(const std::string &directory,
                                   const std::string &basename) const
 {
+  solver->estimate();
   solver->write_vtu(directory, basename, "electric");
 }
 

@@ -26,6 +26,8 @@ struct NipDiscretisation
   unsigned int n_layer = 1;    // cells across the photoconductor
   unsigned int refinements = 0;
   double solver_tolerance = 1e-12;
+  PotentialProblemDescription::LinearSolver linear_solver =
+    PotentialProblemDescription::LinearSolver::cg_amg;
 };
 
 // The latent image along the drum surface as a function of the arc length s from the nip

@@ -26,6 +26,7 @@
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/fe/fe_q.h>
 #include <deal.II/fe/mapping_q.h>
+#include <deal.II/fe/mapping_q_cache.h>
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/trilinos_vector.h>
@@ -81,6 +82,11 @@ struct PotentialProblemDescription
   std::vector<PeriodicPair> periodic;
   double solver_tolerance = 1e-12;                 // relative residual of CG
   unsigned int max_iterations = 5000;
+  // CG + algebraic multigrid (scales to large and parallel problems), or a sparse direct
+  // factorisation (Amesos KLU: robust against the μr contrast and the shell's anisotropy,
+  // and in 2D faster than AMG up to a few 10^5 unknowns).
+  enum class LinearSolver { cg_amg, direct } linear_solver = LinearSolver::cg_amg;
+  bool estimate_error = true; // run() ends with the Kelly indicator (estimate())
 };
 
 // What the solver did, for logs and for the error messages when it fails.
@@ -100,7 +106,7 @@ public:
   PotentialProblem(dealii::parallel::shared::Triangulation<2> &triangulation,
                    PotentialProblemDescription description);
 
-  void run(); // setup_system → assemble_system → solve → estimate
+  void run(); // setup_system → assemble_system → solve → estimate (if asked for)
 
   void setup_system();
   void assemble_system();
@@ -108,8 +114,10 @@ public:
   void estimate();
 
   // Batch evaluation at arbitrary points (collective: every rank passes the same points and
-  // receives all values). Throws if a point lies outside the mesh.
-  std::vector<double> values_at(const std::vector<Point<2>> &points) const;
+  // receives all values). Throws if a point lies outside the mesh, unless `found` is given:
+  // then it says which points were found (the others get 0).
+  std::vector<double> values_at(const std::vector<Point<2>> &points,
+                                std::vector<bool> *found = nullptr) const;
   std::vector<Tensor<1, 2>> gradients_at(const std::vector<Point<2>> &points) const;
 
   // ∫ K ∇u·∇u over the whole mesh (twice the field energy per unit length; the shell part is
@@ -123,7 +131,7 @@ public:
 
   const SolveReport &report() const { return solve_report; }
   const dealii::DoFHandler<2> &dof_handler() const { return dofs; }
-  const dealii::MappingQ<2> &mapping() const { return curved_mapping; }
+  const dealii::Mapping<2> &mapping() const { return curved_mapping; }
   const dealii::TrilinosWrappers::MPI::Vector &solution() const { return ghosted_solution; }
   MPI_Comm communicator() const { return mpi_communicator; }
 
@@ -138,7 +146,9 @@ private:
   PotentialProblemDescription description;
 
   dealii::FE_Q<2> fe;
-  dealii::MappingQ<2> curved_mapping;
+  // MappingQ(p) through the manifolds, its support points computed once per cell (the
+  // manifolds, the transfinite one above all, are expensive to query on every reinit).
+  dealii::MappingQCache<2> curved_mapping;
   dealii::DoFHandler<2> dofs;
 
   dealii::IndexSet locally_owned_dofs;

@@ -97,7 +97,13 @@ void RollerMagnetostatics::make_mesh()
   for (const double r : circles)
     layers.push_back({r, roller_region::air, 0});
   layers.push_back({R1, roller_region::air, 0});
-  layers.push_back({R2, roller_region::shell, 0});
+  // The shell only carries the decaying exterior: cells three times longer radially than
+  // wide are enough there.
+  const double shell_width = 0.5 * (R1 + R2) * 2.0 * 3.14159265358979323846 /
+                             discretisation.n_angular;
+  const unsigned int shell_cells =
+    std::max(2u, static_cast<unsigned int>(std::round((R2 - R1) / (3.0 * shell_width))));
+  layers.push_back({R2, roller_region::shell, shell_cells});
 
   triangulation.clear();
   make_layered_disk(triangulation, layers, discretisation.n_angular);
@@ -110,6 +116,8 @@ PotentialProblemDescription RollerMagnetostatics::describe() const
   d.name = "roller field";
   d.degree = discretisation.degree;
   d.solver_tolerance = discretisation.solver_tolerance;
+  d.linear_solver = discretisation.linear_solver;
+  d.estimate_error = false; // the Kelly indicator only for the VTU (write_vtu)
   d.coefficient[roller_region::shaft] = 1.0 / (mu0 * roller.shaft_mu_r);
   d.coefficient[roller_region::magnet] = 1.0 / (mu0 * roller.magnet_mu_r);
   d.coefficient[roller_region::air] = 1.0 / mu0;
@@ -184,6 +192,7 @@ RollerMagnetostatics::Profile RollerMagnetostatics::profile(double radius,
 void RollerMagnetostatics::write_vtu(const std::string &directory,
                                      const std::string &basename) const
 {
+  potential->estimate();
   potential->write_vtu(directory, basename, "magnetic");
 }
 

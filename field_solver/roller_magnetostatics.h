@@ -43,6 +43,8 @@ struct RollerDiscretisation
   double shell_ratio = 2.0;              // ... to R2 = shell_ratio × R1
   std::vector<double> extra_circles;     // further mesh circles (probe, grid edge) [m]
   double solver_tolerance = 1e-12;
+  PotentialProblemDescription::LinearSolver linear_solver =
+    PotentialProblemDescription::LinearSolver::cg_amg;
 };
 
 // Magnetisation M(x, y) [A/m] inside the magnet.

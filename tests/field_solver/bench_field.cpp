@@ -62,18 +62,25 @@ void roller_table()
 
   std::printf("\nRoller (five poles, iron shaft): max |dB| on the sleeve / peak |B| vs the exact "
               "multipole ring\n");
-  std::printf("  degree  cells_around  cells     unknowns   CG_its  solve+setup_s  "
+  std::printf("  solver  degree  cells_around  cells     unknowns   its  solve+setup_s  "
               "rel_max_error\n");
+  using LS = PotentialProblemDescription::LinearSolver;
+  for (const LS solver_kind : {LS::direct, LS::cg_amg})
   for (unsigned int degree = 1; degree <= 3; ++degree)
-    for (unsigned int n : {32u, 64u, 128u, 256u})
+    for (unsigned int n : {32u, 64u, 128u, 256u, 384u})
     {
       if (degree == 1 && n < 64)
         continue;
-      if (degree == 3 && n > 128)
+      if (degree == 3 && n > 256)
+        continue;
+      if (degree == 2 && n < 64)
+        continue;
+      if (solver_kind == LS::cg_amg && (degree != 2 || n > 256))
         continue;
       RollerDiscretisation disc;
       disc.degree = degree;
       disc.n_angular = n;
+      disc.linear_solver = solver_kind;
       const double t0 = now();
       RollerMagnetostatics solver(MPI_COMM_WORLD, RollerGeometry::from(roller, sleeve),
                                   gaussian_pole_magnetisation(roller.poles), disc);
@@ -91,7 +98,8 @@ void roller_table()
         err = std::max(err, std::hypot(bn - Bn[k], bt - Bt[k]));
       }
       const auto &r = solver.problem().report();
-      std::printf("  %6u  %12u  %8u  %9llu  %6u  %13.3f  %13.3e\n", degree, n, r.n_cells,
+      std::printf("  %6s  %6u  %12u  %8u  %9llu  %4u  %13.3f  %13.3e\n",
+                  solver_kind == LS::direct ? "direct" : "cg_amg", degree, n, r.n_cells,
                   static_cast<unsigned long long>(r.n_dofs), r.iterations, seconds,
                   err / peak);
       std::fflush(stdout);
@@ -116,7 +124,7 @@ void nip_table()
 
   std::printf("\nNip (two cylinders, 400 um gap): max |dE| across the gap / E_gap vs the "
               "bipolar exact solution\n");
-  std::printf("  degree  level  cells     unknowns   CG_its  solve+setup_s  rel_max_error\n");
+  std::printf("  degree  level  cells     unknowns   its  solve+setup_s  rel_max_error  (direct solver)\n");
   for (unsigned int degree = 1; degree <= 3; ++degree)
     for (unsigned int level = 0; level < 4; ++level)
     {
@@ -126,6 +134,7 @@ void nip_table()
       tria.refine_global(level);
       PotentialProblemDescription d;
       d.degree = degree;
+      d.linear_solver = PotentialProblemDescription::LinearSolver::direct;
       d.coefficient[0] = eps0;
       auto exact_phi = [&](const Point<2> &p) {
         return V * (g.to_bipolar(p[0], p[1])[0] - g.tau_left) / dtau;
@@ -145,7 +154,7 @@ void nip_table()
         err = std::max(err, std::hypot(-grad[k][0] - e[0], -grad[k][1] - e[1]));
       }
       const auto &r = problem.report();
-      std::printf("  %6u  %5u  %8u  %9llu  %6u  %13.3f  %13.3e\n", degree, level, r.n_cells,
+      std::printf("  %6u  %5u  %8u  %9llu  %4u  %13.3f  %13.3e\n", degree, level, r.n_cells,
                   static_cast<unsigned long long>(r.n_dofs), r.iterations, seconds,
                   err / E_gap);
       std::fflush(stdout);

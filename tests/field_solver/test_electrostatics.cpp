@@ -191,7 +191,7 @@ TEST(FieldElectrostatics, TwoCylindersBipolar)
 
   const double energy_exact = V * V / dtau * (2.0 * pi - 2.0 * geometry.sigma_cut) * eps0;
   std::vector<double> E_errors, C_errors;
-  for (unsigned int level = 0; level < 3; ++level)
+  for (unsigned int level = 0; level < 4; ++level)
   {
     auto tria = make_tria();
     make_bipolar_two_cylinders(*tria, geometry, 4, 32);

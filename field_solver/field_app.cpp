@@ -217,7 +217,7 @@ bool compute_magnetic_field(const Case &c, const FieldRunOptions &options, MPI_C
                 solver_summary(report).c_str(), error, seconds_since(t0), h5.c_str(), grid.n_r,
                 grid.n_theta, field_file(c, "profile_sleeve.csv").c_str(),
                 field_file(c, "profile_probe.csv").c_str(),
-                options.vtu ? (", " + field_file(c, "magnetic.pvtu")).c_str() : "");
+                options.vtu ? (", " + field_file(c, "magnetic_0.pvtu")).c_str() : "");
     std::printf("  time: setup %.2f s, assembly %.2f s, solve %.2f s, grid sampling %.2f s\n",
                 report.setup_seconds, report.assemble_seconds, report.solve_seconds,
                 sample_seconds);
@@ -303,7 +303,7 @@ bool compute_electric_field(const Case &c, const FieldRunOptions &options, MPI_C
                 "%.2f s\n  wrote %s (%d x %d window over the nip)%s\n",
                 report.n_cells, static_cast<unsigned long long>(report.n_dofs), disc.degree,
                 solver_summary(report).c_str(), seconds_since(t0), h5.c_str(), n, n,
-                options.vtu ? (", " + field_file(c, "electric.pvtu")).c_str() : "");
+                options.vtu ? (", " + field_file(c, "electric_0.pvtu")).c_str() : "");
     std::fflush(stdout);
   }
   return true;

@@ -5,7 +5,7 @@
 //   <field.output_dir>/<case name>_electric.h5          Φ on the Cartesian window over the nip
 //   <field.output_dir>/<case name>_profile_sleeve.csv   angle_deg,Bn_T,Bt_T at the sleeve surface
 //   <field.output_dir>/<case name>_profile_probe.csv    the same at field.probe_radius
-//   <field.output_dir>/<case name>_magnetic.pvtu, _electric.pvtu (+ .vtu)   ParaView
+//   <field.output_dir>/<case name>_magnetic_0.pvtu, _electric_0.pvtu (+ .vtu)   ParaView
 #pragma once
 
 #include "case_model.h"

@@ -136,7 +136,7 @@ struct Electric
 struct AppliedField
 {
   enum class Kind { none, roller, uniform } kind = Kind::none;
-  Vec3 uniform_direction{0.0, 0.0, 1.0};
+  Vec3 uniform_direction{{0.0, 0.0, 1.0}};
   double uniform_magnitude = 0.0; // |B| [T] at the end of the ramp
   double ramp_time = 0.0;         // linear ramp 0 → |B| over this time [s] (0 = on at once)
 };
@@ -145,8 +145,8 @@ struct AppliedField
 struct PlaneWall
 {
   std::string name;
-  Vec3 point{0, 0, 0};
-  Vec3 normal{0, 0, 1};          // particles live on the side the normal points to
+  Vec3 point{{0, 0, 0}};
+  Vec3 normal{{0, 0, 1}};        // particles live on the side the normal points to
   std::string material = "wall";
   // Prescribed motion: piecewise-linear path of the point, (t, displacement) samples.
   std::vector<std::pair<double, Vec3>> path;
@@ -178,12 +178,12 @@ struct DemSettings
   double periodic_length_x = 0.0;    // optional periodic length along x [m]
   double periodic_length_y = 0.0;    // optional periodic length along y [m]
   std::string magnetic_model = "corrected"; // "point_dipole" | "mutual_dipole" | "corrected"
-  double magnetic_cutoff = 8.0;      // cutoff radius in mean carrier diameters
+  double magnetic_cutoff = 12.0;     // cutoff radius in mean carrier diameters (docs/magnetics.md)
   double magnetic_refresh = 0.0;     // refresh interval [s] (0 = every step)
   double magnetic_tolerance = 1e-6;  // mutual-induction relative tolerance
   double verlet_skin = 0.3;          // skin as a fraction of the mean diameter
   double air_viscosity = 1.81e-5;    // η [Pa s] for Stokes drag (0 = no drag)
-  Vec3 gravity{0.0, -9.81, 0.0};     // [m/s²]
+  Vec3 gravity{{0.0, -9.81, 0.0}};    // [m/s²]
   unsigned long seed = 1;
   int threads = 0;                   // 0 = OpenMP default
   double max_overlap_fraction = 0.1; // stability guard: overlap / radius

@@ -243,7 +243,7 @@ std::vector<KeySpec> build_schema()
       choice("dem.magnetic_model", {"point_dipole", "mutual_dipole", "corrected"},
              "Carrier magnetics: fixed point dipoles, mutual induction, or mutual + exact two-sphere correction.")
           .def("corrected"),
-      number("dem.magnetic_cutoff", "Dipole interaction cutoff in mean carrier diameters.").def("8").positive(),
+      number("dem.magnetic_cutoff", "Dipole interaction cutoff radius in mean carrier diameters (12: <= 1 % force error in a brush with the slab tail, docs/magnetics.md; the papers used 4).").def("12").positive(),
       quantity("dem.magnetic_refresh", D::time, "Magnetic force refresh interval (0 = every step).").def("0 s").non_negative(),
       number("dem.magnetic_tolerance", "Mutual-induction relative tolerance.").def("1e-6").positive(),
       number("dem.verlet_skin", "Neighbour-list skin as a fraction of the mean diameter.").def("0.3").positive(),

@@ -3,13 +3,17 @@
 //   magbrush-dem CASE [--set key=value ...] [--restart FILE] [--threads N] [--output DIR]
 #include "dem_run.h"
 
+#include "applied_magnetic_field.h"
 #include "case_parser.h"
+#include "field_files.h"
+#include "magnetic_force_term.h"
 
 #include <cstdlib>
 #include <unistd.h>
 #include <cstring>
 #include <exception>
 #include <iostream>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -25,6 +29,27 @@ time_series.csv, checkpoint.bin}.
   --threads N      OpenMP threads (default: dem.threads, then all cores)
   --output DIR     output directory instead of <output.directory>/dem
 )";
+// The carriers' induced-dipole magnetics (dem/magnetics), when the scene has an applied field
+// and carriers to feel it: a uniform (ramped) field needs no grid; a roller field is read from
+// the stored magnetic grid, which must have been computed for this very case (`magbrush field`).
+void add_magnetics(magbrush::dem::DemRun &run, const magbrush::Case &c)
+{
+  using magbrush::AppliedField;
+  if (c.applied_field.kind == AppliedField::Kind::none)
+    return;
+  bool has_carriers = false;
+  for (const auto &p : c.populations)
+    has_carriers |= p.kind == magbrush::ParticleKind::carrier;
+  if (!has_carriers)
+    return;
+  const magbrush::AppliedMagneticField field =
+      c.applied_field.kind == AppliedField::Kind::roller
+          ? magbrush::AppliedMagneticField::for_case(c, magbrush::field::magnetic_grid_path(c))
+          : magbrush::AppliedMagneticField::from_settings(c.applied_field);
+  auto &system = run.system();
+  system.add_force_term(std::make_unique<magbrush::magnetics::MagneticForceTerm>(
+      c, magbrush::magnetics::MagneticSettings::from_case(c.dem), field, system.box().length));
+}
 } // namespace
 
 int main(int argc, char **argv)
@@ -102,6 +127,7 @@ int main(int argc, char **argv)
   {
     const magbrush::Case c = magbrush::load_case(case_path, overrides);
     magbrush::dem::DemRun run(c, options, std::cout);
+    add_magnetics(run, c);
     run.run();
   }
   catch (const magbrush::dem::StabilityError &)

@@ -60,9 +60,12 @@ void DemRun::log_setup() const
   for (const auto &t : s.force_terms())
     log_ << ", " << t->name();
   log_ << "\n";
-  if (case_.applied_field.kind != AppliedField::Kind::none)
-    log_ << "  note: the case has an applied magnetic field; the induced-dipole term (dem/magnetics) is "
-            "plugged in by the scene set-up and is NOT part of this run unless added\n";
+  bool magnetics_on = false;
+  for (const auto &t : s.force_terms())
+    magnetics_on |= std::string(t->name()) == "magnetic dipoles";
+  if (case_.applied_field.kind != AppliedField::Kind::none && !magnetics_on)
+    log_ << "  note: the case has an applied magnetic field but no induced-dipole term was added "
+            "(no carriers?)\n";
   if (case_.electric.enabled)
     log_ << "  note: electrostatic terms (Coulomb, qE) are not part of this engine build yet\n";
   log_.flush();

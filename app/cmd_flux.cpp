@@ -12,6 +12,7 @@
 
 #include "case_hash.h"
 #include "case_parser.h"
+#include "field_files.h"
 #include "field_grid.h"
 #include "flux_compare.h"
 #include "flux_scan.h"
@@ -226,7 +227,7 @@ double probe_radius_of(const Case &c)
 // field it came from (<case>_magnetic.h5) must carry the case's current field hash.
 std::string fem_profile_path(const Case &c, double probe_radius, std::string &why_not)
 {
-  const std::string path = c.field.output_dir + "/" + c.name + "_profile_probe.csv";
+  const std::string path = field::field_file(c, "profile_probe.csv");
   std::ifstream in(path);
   if (!in)
   {
@@ -248,7 +249,7 @@ std::string fem_profile_path(const Case &c, double probe_radius, std::string &wh
     }
     break;
   }
-  const std::string grid = c.field.output_dir + "/" + c.name + "_magnetic.h5";
+  const std::string grid = field::magnetic_grid_path(c);
   if (fs::exists(grid))
   {
     try

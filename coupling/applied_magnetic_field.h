@@ -39,7 +39,7 @@ public:
                                             std::shared_ptr<const PolarFieldInterpolator> grid = {});
 
   // What `magbrush dem` does: the case's applied field; for a roller, read the magnetic grid
-  // at `grid_path` (field_solver/field_files.h magnetic_grid_path), check that it was computed
+  // at `grid_path` (coupling/field_files.h magnetic_grid_path), check that it was computed
   // for this case (throws ProvenanceMismatch naming the key otherwise) and interpolate it.
   // FieldGridError when the file is missing or malformed.
   static AppliedMagneticField for_case(const Case &c, const std::string &grid_path);

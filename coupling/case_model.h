@@ -155,9 +155,9 @@ struct PlaneWall
 struct FieldSettings
 {
   double mesh_size_far = 2.0e-3;     // element size away from the sleeve [m]
-  double mesh_size_sleeve = 0.1e-3;  // element size at the sleeve surface [m]
+  double mesh_size_sleeve = 0.25e-3; // element size at the sleeve surface [m]
   double mesh_size_gap = 20e-6;      // element size in the development gap [m]
-  int element_degree = 2;
+  int element_degree = 3;
   double outer_radius_factor = 2.0;  // open-boundary shell starts at this × sleeve radius
   double grid_radial_spacing = 50e-6;   // polar magnetic grid Δr [m]
   double grid_angular_spacing = 0.25 * 3.14159265358979323846 / 180.0; // Δθ [rad]

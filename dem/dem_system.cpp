@@ -137,6 +137,18 @@ void DemSystem::rebuild_neighbor_list()
   ++rebuilds_;
 }
 
+// Velocity Verlet's half step of the velocities: v += (h/m) F, ω += (h/I) T.
+static inline void half_kick(ParticleState &s, const ForceBuffers &f, std::size_t i, double h)
+{
+  const double im = s.inv_mass[i], iI = s.inv_inertia[i];
+  s.vx[i] += h * f.fx[i] * im;
+  s.vy[i] += h * f.fy[i] * im;
+  s.vz[i] += h * f.fz[i] * im;
+  s.wx[i] += h * f.tx[i] * iI;
+  s.wy[i] += h * f.ty[i] * iI;
+  s.wz[i] += h * f.tz[i] * iI;
+}
+
 void DemSystem::kick_and_drift()
 {
   PhaseTimer timer(times_.integrate);
@@ -149,13 +161,7 @@ void DemSystem::kick_and_drift()
   for (long k = 0; k < n; ++k)
   {
     const std::size_t i = static_cast<std::size_t>(k);
-    const double im = s.inv_mass[i], iI = s.inv_inertia[i];
-    s.vx[i] += h * f.fx[i] * im;
-    s.vy[i] += h * f.fy[i] * im;
-    s.vz[i] += h * f.fz[i] * im;
-    s.wx[i] += h * f.tx[i] * iI;
-    s.wy[i] += h * f.ty[i] * iI;
-    s.wz[i] += h * f.tz[i] * iI;
+    half_kick(s, f, i, h);
     s.x[i] += dt * s.vx[i];
     s.y[i] += dt * s.vy[i];
     s.z[i] += dt * s.vz[i];
@@ -177,13 +183,7 @@ void DemSystem::final_kick()
   for (long k = 0; k < n; ++k)
   {
     const std::size_t i = static_cast<std::size_t>(k);
-    const double im = s.inv_mass[i], iI = s.inv_inertia[i];
-    s.vx[i] += h * f.fx[i] * im;
-    s.vy[i] += h * f.fy[i] * im;
-    s.vz[i] += h * f.fz[i] * im;
-    s.wx[i] += h * f.tx[i] * iI;
-    s.wy[i] += h * f.ty[i] * iI;
-    s.wz[i] += h * f.tz[i] * iI;
+    half_kick(s, f, i, h);
     if (!std::isfinite(s.vx[i] + s.vy[i] + s.vz[i] + s.wx[i] + s.wy[i] + s.wz[i] + s.x[i] + s.y[i] + s.z[i]))
       bad = 1;
   }

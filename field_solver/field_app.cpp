@@ -186,7 +186,7 @@ bool compute_magnetic_field(const Case &c, const FieldRunOptions &options, MPI_C
   grid.n_theta = layout.n_theta;
   for (int i = 0; i < grid.n_r; ++i)
     for (int j = 0; j < grid.n_theta; ++j)
-      nodes.push_back({grid.r(i) * std::cos(grid.theta(j)), grid.r(i) * std::sin(grid.theta(j))});
+      nodes.push_back({{grid.r(i) * std::cos(grid.theta(j)), grid.r(i) * std::sin(grid.theta(j))}});
   const auto t_sample = std::chrono::steady_clock::now();
   grid.A_z = solver.vector_potential(nodes);
   const double sample_seconds = seconds_since(t_sample);

@@ -34,7 +34,7 @@ Magnetisation gaussian_pole_magnetisation(const std::vector<Pole> &poles)
     const double theta = std::atan2(y, x);
     const double m = radial_magnetisation(poles, theta);
     const double r = std::hypot(x, y);
-    return r > 0.0 ? Vec2{m * x / r, m * y / r} : Vec2{0.0, 0.0};
+    return r > 0.0 ? Vec2{{m * x / r, m * y / r}} : Vec2{{0.0, 0.0}};
   };
 }
 
@@ -156,7 +156,7 @@ std::vector<Vec2> RollerMagnetostatics::flux_density(const std::vector<Vec2> &po
   const auto gradients = potential->gradients_at(p);
   std::vector<Vec2> B(points.size());
   for (std::size_t i = 0; i < points.size(); ++i)
-    B[i] = {gradients[i][1], -gradients[i][0]};
+    B[i] = {{gradients[i][1], -gradients[i][0]}};
   return B;
 }
 
@@ -177,7 +177,7 @@ RollerMagnetostatics::Profile RollerMagnetostatics::profile(double radius,
   {
     const double theta = 2.0 * pi * k / n_angles;
     out.angle.push_back(theta);
-    points[k] = {radius * std::cos(theta), radius * std::sin(theta)};
+    points[k] = {{radius * std::cos(theta), radius * std::sin(theta)}};
   }
   const auto B = flux_density(points);
   for (unsigned int k = 0; k < n_angles; ++k)

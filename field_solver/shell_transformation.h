@@ -76,7 +76,7 @@ public:
 
 private:
   double R1 = 1.0, R2 = 2.0;
-  std::array<double, 2> center{0.0, 0.0};
+  std::array<double, 2> center{{0.0, 0.0}};
 };
 
 } // namespace magbrush::field

@@ -535,8 +535,13 @@ void DemSystem::settle(double duration)
 {
   if (duration <= 0.0)
     return;
+  // The settling phase happens before t = 0: the clock runs from −duration up to 0, so that
+  // everything prescribed in time (the field ramp, wall paths) starts once the particles are at
+  // rest, as in Kawamoto's procedure (fall, come to rest, then apply the field gradually).
   walls_frozen_ = true;
   const long steps = static_cast<long>(std::ceil(duration / dt_));
+  step_ = -steps;
+  time_ = static_cast<double>(step_) * dt_;
   for (long k = 0; k < steps; ++k)
     step();
   walls_frozen_ = false;

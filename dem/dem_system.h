@@ -71,7 +71,8 @@ public:
   void step();
   // Rebuild (and re-sort) the neighbour list at the next step even if no particle moved far.
   void request_neighbor_rebuild() { force_rebuild_ = true; }
-  // Runs with the walls at rest for `duration`, then resets the clock to t = 0.
+  // Runs with the walls at rest for `duration` on a clock from −duration to t = 0 (a field
+  // ramp or a wall path given from t = 0 has not started yet).
   void settle(double duration);
 
   double time() const { return time_; }

@@ -500,3 +500,39 @@ TEST(DemEngine, InsertedParticlesSettleOnTheStage)
   EXPECT_GT(loads[0].contacts, 50);
   EXPECT_NEAR(-loads[0].force[2] / weight, 1.0, 0.05); // at rest, the stage carries the weight
 }
+
+namespace {
+// Records the times at which the force terms are called.
+class ClockRecorder : public ForceTerm
+{
+public:
+  double t_min = 1e300, t_max = -1e300;
+  const char *name() const override { return "clock recorder"; }
+  void add_forces(const ParticleState &, ForceBuffers &, double t) override
+  {
+    t_min = std::min(t_min, t);
+    t_max = std::max(t_max, t);
+  }
+};
+} // namespace
+
+// Settling happens before t = 0, so that a field ramp or a wall path prescribed from t = 0
+// has not started while the particles come to rest (Kawamoto: fall, rest, then the field).
+TEST(DemEngine, SettlingRunsBeforeTimeZero)
+{
+  Material m = elastic_material("m", 1e7, 0.3, 2000);
+  Case c = single_species_case(m);
+  DemSystem s(c);
+  s.particles().add({0, 0, 0}, 1e-3, 2000, 0, 0.0);
+  auto recorder = std::make_unique<ClockRecorder>();
+  const ClockRecorder &clock = *recorder;
+  s.add_force_term(std::move(recorder));
+  s.initialize();
+  const double settle = 100.5 * s.time_step();
+  s.settle(settle);
+  // ceil(100.5) = 101 steps from t = -101 dt; forces are first evaluated after the drift.
+  EXPECT_DOUBLE_EQ(clock.t_min, -100.0 * s.time_step());
+  EXPECT_DOUBLE_EQ(clock.t_max, 0.0);              // ended at t = 0 ...
+  EXPECT_EQ(s.step_count(), 0);                    // ... with the clock reset for the run
+  EXPECT_EQ(s.time(), 0.0);
+}

@@ -8,12 +8,14 @@
 
 #include <deal.II/base/mpi.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <stdexcept>
 
 namespace magbrush::field {
@@ -148,13 +150,6 @@ bool compute_magnetic_field(const Case &c, const FieldRunOptions &options, MPI_C
                 << std::endl;
     return false;
   }
-  for (const auto &blade : c.blades)
-    if (blade.mu_r > 1.0)
-      throw std::runtime_error(
-        "blade '" + blade.name + "' is soft-magnetic (mu_r = " + std::to_string(blade.mu_r) +
-        "), which this field solver does not model yet (the layered roller mesh has no blade); "
-        "set its mu_r to 1 or leave the magnetic blade out of the case");
-
   const std::string h5 = field_file(c, "magnetic.h5");
   const std::string hash = field_hash(c, FieldKind::magnetic);
   if (!options.force && stored_field_is_current(h5, hash, "magnetic", comm))
@@ -171,8 +166,21 @@ bool compute_magnetic_field(const Case &c, const FieldRunOptions &options, MPI_C
       std::to_string(disc.outer_radius_factor * c.sleeve->radius) +
       " m; raise field.outer_radius_factor or lower field.grid_outer_radius");
 
-  RollerMagnetostatics solver(comm, RollerGeometry::from(*c.roller, *c.sleeve),
-                              gaussian_pole_magnetisation(c.roller->poles), disc);
+  // A soft-magnetic blade breaks the rotational symmetry of the layered mesh: then the solver
+  // reads the Gmsh roller mesh with the blade as its own region (geometry/mesh_roller.h).
+  const bool magnetic_blade = std::any_of(c.blades.begin(), c.blades.end(),
+                                          [](const BladeOrGuide &b) { return b.mu_r > 1.0; });
+  std::unique_ptr<RollerMagnetostatics> solver_ptr;
+  if (magnetic_blade)
+    solver_ptr = std::make_unique<RollerMagnetostatics>(
+      comm, RollerGeometry::from(*c.roller, *c.sleeve),
+      gaussian_pole_magnetisation(c.roller->poles), disc,
+      write_roller_mesh_file(c, field_file(c, "magnetic_mesh.msh"), disc.degree, comm));
+  else
+    solver_ptr = std::make_unique<RollerMagnetostatics>(
+      comm, RollerGeometry::from(*c.roller, *c.sleeve),
+      gaussian_pole_magnetisation(c.roller->poles), disc);
+  RollerMagnetostatics &solver = *solver_ptr;
   solver.run();
   const SolveReport &report = solver.problem().report();
 
@@ -210,11 +218,14 @@ bool compute_magnetic_field(const Case &c, const FieldRunOptions &options, MPI_C
     write_magnetic_grid(h5, grid, provenance);
     write_profile_csv(field_file(c, "profile_sleeve.csv"), c.sleeve->radius, sleeve_profile, c);
     write_profile_csv(field_file(c, "profile_probe.csv"), probe_radius, probe_profile, c);
-    std::printf("magbrush-field: magnetic field: %u cells, %llu unknowns (FE_Q(%u)), %s; "
-                "max |dB|/peak on the sleeve vs the exact multipole ring: %.2e; "
+    std::printf("magbrush-field: magnetic field%s: %u cells, %llu unknowns (FE_Q(%u)), %s; "
+                "max |dB|/peak on the sleeve vs the exact multipole ring: %.2e%s; "
                 "%.2f s\n  wrote %s (%d x %d polar grid), %s, %s%s\n",
+                magnetic_blade ? (" on the Gmsh mesh " + field_file(c, "magnetic_mesh.msh")).c_str() : "",
                 report.n_cells, static_cast<unsigned long long>(report.n_dofs), disc.degree,
-                solver_summary(report).c_str(), error, seconds_since(t0), h5.c_str(), grid.n_r,
+                solver_summary(report).c_str(), error,
+                magnetic_blade ? " (includes the soft-magnetic blade's effect: not an error estimate)" : "",
+                seconds_since(t0), h5.c_str(), grid.n_r,
                 grid.n_theta, field_file(c, "profile_sleeve.csv").c_str(),
                 field_file(c, "profile_probe.csv").c_str(),
                 options.vtu ? (", " + field_file(c, "magnetic_0.pvtu")).c_str() : "");

@@ -1,9 +1,16 @@
 #include "roller_magnetostatics.h"
 
 #include "layered_meshes.h"
+#include "mesh_roller.h"
+#include "mesh_tags.h"
 #include "pole_magnetisation.h"
 
+#include <deal.II/base/mpi.h>
+#include <deal.II/grid/grid_in.h>
+#include <deal.II/grid/manifold_lib.h>
 #include <deal.II/grid/tria.h>
+
+#include <fstream>
 
 #include <algorithm>
 #include <cmath>
@@ -36,6 +43,39 @@ Magnetisation gaussian_pole_magnetisation(const std::vector<Pole> &poles)
     const double r = std::hypot(x, y);
     return r > 0.0 ? Vec2{{m * x / r, m * y / r}} : Vec2{{0.0, 0.0}};
   };
+}
+
+RollerMeshFile write_roller_mesh_file(const Case &c, const std::string &msh_path,
+                                      unsigned int degree, MPI_Comm communicator)
+{
+  Case scaled = c;
+  scaled.field.mesh_size_sleeve = c.field.mesh_size_sleeve * std::max(1u, degree);
+  scaled.field.mesh_size_far = std::max(scaled.field.mesh_size_far, scaled.field.mesh_size_sleeve);
+  RollerMeshFile f;
+  f.path = msh_path;
+  f.circles = roller_mesh_circles(scaled);
+  f.shell = roller_shell(scaled);
+  for (const auto &blade : c.blades)
+    f.blade_mu_r.push_back(blade.mu_r);
+  if (dealii::Utilities::MPI::this_mpi_process(communicator) == 0)
+    write_roller_mesh(scaled, msh_path);
+  MPI_Barrier(communicator);
+  return f;
+}
+
+RollerMagnetostatics::RollerMagnetostatics(MPI_Comm communicator_in,
+                                           const RollerGeometry &geometry,
+                                           Magnetisation magnetisation_in,
+                                           const RollerDiscretisation &discretisation_in,
+                                           RollerMeshFile mesh_file_in)
+  : RollerMagnetostatics(communicator_in, geometry, std::move(magnetisation_in),
+                         discretisation_in)
+{
+  for (const double mu : mesh_file_in.blade_mu_r)
+    if (!(mu >= 1.0) || !std::isfinite(mu))
+      throw std::invalid_argument("roller field: blade mu_r must be finite and >= 1, found " +
+                                  std::to_string(mu));
+  mesh_file = std::move(mesh_file_in);
 }
 
 RollerMagnetostatics::RollerMagnetostatics(MPI_Comm communicator_in,
@@ -73,6 +113,8 @@ RollerMagnetostatics::~RollerMagnetostatics() = default;
 
 double RollerMagnetostatics::shell_inner_radius() const
 {
+  if (mesh_file)
+    return mesh_file->shell.inner_radius;
   return discretisation.outer_radius_factor * roller.sleeve_radius;
 }
 
@@ -110,6 +152,47 @@ void RollerMagnetostatics::make_mesh()
   triangulation.refine_global(discretisation.refinements);
 }
 
+// The Gmsh mesh: cells and ids as written; each face whose two vertices lie on one of the
+// mesh circles gets that circle's SphericalManifold (manifold id = circle index), so that
+// refinement and the MappingQ(p) follow the circle. Cells stay flat: MappingQ blends their
+// interior from the curved perimeter.
+void RollerMagnetostatics::read_mesh_file()
+{
+  triangulation.clear();
+  {
+    dealii::GridIn<2> grid_in;
+    grid_in.attach_triangulation(triangulation);
+    std::ifstream in(mesh_file->path);
+    if (!in)
+      throw std::runtime_error("roller field: cannot open the roller mesh '" + mesh_file->path +
+                               "'");
+    grid_in.read_msh(in);
+  }
+  const auto &circles = mesh_file->circles;
+  for (const auto &cell : triangulation.active_cell_iterators())
+    for (const auto f : cell->face_indices())
+    {
+      const auto face = cell->face(f);
+      for (std::size_t k = 0; k < circles.size(); ++k)
+      {
+        const Point<2> c(circles[k].center[0], circles[k].center[1]);
+        const double R = circles[k].radius, tol = 1e-7 * R;
+        if (std::abs(face->vertex(0).distance(c) - R) < tol &&
+            std::abs(face->vertex(1).distance(c) - R) < tol &&
+            face->vertex(0).distance(face->vertex(1)) < R)
+        {
+          face->set_manifold_id(static_cast<dealii::types::manifold_id>(k));
+          break;
+        }
+      }
+    }
+  for (std::size_t k = 0; k < circles.size(); ++k)
+    triangulation.set_manifold(static_cast<dealii::types::manifold_id>(k),
+                               dealii::SphericalManifold<2>(
+                                 Point<2>(circles[k].center[0], circles[k].center[1])));
+  triangulation.refine_global(discretisation.refinements);
+}
+
 PotentialProblemDescription RollerMagnetostatics::describe() const
 {
   PotentialProblemDescription d;
@@ -118,18 +201,40 @@ PotentialProblemDescription RollerMagnetostatics::describe() const
   d.solver_tolerance = discretisation.solver_tolerance;
   d.linear_solver = discretisation.linear_solver;
   d.estimate_error = false; // the Kelly indicator only for the VTU (write_vtu)
-  d.coefficient[roller_region::shaft] = 1.0 / (mu0 * roller.shaft_mu_r);
-  d.coefficient[roller_region::magnet] = 1.0 / (mu0 * roller.magnet_mu_r);
-  d.coefficient[roller_region::air] = 1.0 / mu0;
-  const double R1 = shell_inner_radius();
-  d.shell = ShellRegion{roller_region::shell, 1.0 / mu0,
-                        ShellTransformation(R1, discretisation.shell_ratio * R1)};
+  MaterialId magnet_region = roller_region::magnet;
+  if (mesh_file)
+  {
+    namespace tags = mesh_tags;
+    d.coefficient[tags::shaft] = 1.0 / (mu0 * roller.shaft_mu_r);
+    d.coefficient[tags::magnet] = 1.0 / (mu0 * roller.magnet_mu_r);
+    d.coefficient[tags::sleeve_wall] = 1.0 / mu0;
+    d.coefficient[tags::air] = 1.0 / mu0;
+    for (std::size_t i = 0; i < mesh_file->blade_mu_r.size(); ++i)
+      d.coefficient[static_cast<MaterialId>(tags::blade_base + i)] =
+        1.0 / (mu0 * mesh_file->blade_mu_r[i]);
+    const OpenBoundaryShell &s = mesh_file->shell;
+    d.shell = ShellRegion{tags::shell, 1.0 / mu0,
+                          ShellTransformation(s.inner_radius, s.outer_radius, s.center[0],
+                                              s.center[1])};
+    magnet_region = tags::magnet;
+    d.dirichlet[tags::outer_boundary] = [](const Point<2> &) { return 0.0; };
+  }
+  else
+  {
+    d.coefficient[roller_region::shaft] = 1.0 / (mu0 * roller.shaft_mu_r);
+    d.coefficient[roller_region::magnet] = 1.0 / (mu0 * roller.magnet_mu_r);
+    d.coefficient[roller_region::air] = 1.0 / mu0;
+    const double R1 = shell_inner_radius();
+    d.shell = ShellRegion{roller_region::shell, 1.0 / mu0,
+                          ShellTransformation(R1, discretisation.shell_ratio * R1)};
+    d.dirichlet[0] = [](const Point<2> &) { return 0.0; }; // A = 0 at R2 ≙ infinity
+  }
   // ∫ (M_x ∂v/∂y − M_y ∂v/∂x)/μr = ∫ s·∇v with s = (−M_y, M_x)/μr, in the magnet only.
   const Magnetisation M = magnetisation;
   const double mu_magnet = roller.magnet_mu_r;
-  d.vector_source = [M, mu_magnet](const Point<2> &x, MaterialId material) {
+  d.vector_source = [M, mu_magnet, magnet_region](const Point<2> &x, MaterialId material) {
     Tensor<1, 2> s;
-    if (material == roller_region::magnet)
+    if (material == magnet_region)
     {
       const Vec2 m = M(x[0], x[1]);
       s[0] = -m[1] / mu_magnet;
@@ -137,13 +242,15 @@ PotentialProblemDescription RollerMagnetostatics::describe() const
     }
     return s;
   };
-  d.dirichlet[0] = [](const Point<2> &) { return 0.0; }; // A = 0 at R2 ≙ infinity
   return d;
 }
 
 void RollerMagnetostatics::run()
 {
-  make_mesh();
+  if (mesh_file)
+    read_mesh_file();
+  else
+    make_mesh();
   potential = std::make_unique<PotentialProblem>(triangulation, describe());
   potential->run();
 }

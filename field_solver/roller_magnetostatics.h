@@ -6,14 +6,22 @@
 // The roller is rotationally layered, so the production mesh is built here with deal.II
 // (layered_meshes.h) rather than read from Gmsh: every circle is exact at every refinement
 // level, which is what makes the sleeve profile converge at the full order O(h^p).
+//
+// A soft-magnetic blade (μr > 1) breaks the rotational symmetry: for such a case the solver
+// reads the Gmsh roller mesh of geometry/ instead (RollerMeshFile, write_roller_mesh_file):
+// regions by mesh_tags.h, straight faces curved onto the circles of roller_mesh_circles() by a
+// SphericalManifold per circle.
 #pragma once
 
 #include "case_model.h"
+#include "mesh_common.h"
 #include "potential_problem.h"
 
 #include <array>
 #include <functional>
 #include <memory>
+#include <optional>
+#include <string>
 #include <vector>
 
 namespace magbrush::field {
@@ -47,6 +55,23 @@ struct RollerDiscretisation
     PotentialProblemDescription::LinearSolver::cg_amg;
 };
 
+// The Gmsh roller mesh (geometry/mesh_roller.h) and what the solver needs to know about it.
+// Regions are mesh_tags (shaft 1, magnet 2, sleeve wall 3, air 4, shell 5, blade 20 + i),
+// A = 0 on mesh_tags::outer_boundary.
+struct RollerMeshFile
+{
+  std::string path;                 // MSH 2.2
+  std::vector<MeshCircle> circles;  // every curved mesh line (roller_mesh_circles)
+  OpenBoundaryShell shell;          // the shell-transformed annulus (roller_shell)
+  std::vector<double> blade_mu_r;   // μr of Case::blades[i] (region blade_base + i)
+};
+
+// Writes the case's roller mesh to `msh_path` (on rank 0; all ranks return after it is
+// written). Cells are `degree` × field.mesh_size_sleeve at the sleeve, the rule of the layered
+// mesh (p nodes per element edge).
+RollerMeshFile write_roller_mesh_file(const Case &c, const std::string &msh_path,
+                                      unsigned int degree, MPI_Comm communicator);
+
 // Magnetisation M(x, y) [A/m] inside the magnet.
 using Magnetisation = std::function<Vec2(double x, double y)>;
 
@@ -58,6 +83,10 @@ class RollerMagnetostatics
 public:
   RollerMagnetostatics(MPI_Comm communicator, const RollerGeometry &geometry,
                        Magnetisation magnetisation, const RollerDiscretisation &discretisation);
+  // On the Gmsh mesh (discretisation.n_angular, extra_circles and the shell factors unused).
+  RollerMagnetostatics(MPI_Comm communicator, const RollerGeometry &geometry,
+                       Magnetisation magnetisation, const RollerDiscretisation &discretisation,
+                       RollerMeshFile mesh_file);
   ~RollerMagnetostatics();
 
   void run(); // make_mesh → PotentialProblem::run
@@ -81,12 +110,14 @@ public:
 
 private:
   void make_mesh();
+  void read_mesh_file();
   PotentialProblemDescription describe() const;
 
   MPI_Comm communicator;
   RollerGeometry roller;
   Magnetisation magnetisation;
   RollerDiscretisation discretisation;
+  std::optional<RollerMeshFile> mesh_file;
   dealii::parallel::shared::Triangulation<2> triangulation;
   std::unique_ptr<PotentialProblem> potential;
 };

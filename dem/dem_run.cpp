@@ -95,6 +95,15 @@ void DemRun::log_timings(double wall) const
   row("total", wall);
 }
 
+void DemRun::write_measurements() const
+{
+  for (const auto &m : measurements_)
+  {
+    m->write(out_dir_);
+    log_ << "measurement '" << m->name() << "' written to " << out_dir_ << "\n";
+  }
+}
+
 void DemRun::run()
 {
   DemSystem &s = *system_;
@@ -138,6 +147,10 @@ void DemRun::run()
     snapshots.write(s);
   }
   const long start_step = s.step_count();
+  // Measurement k samples every sample_every[k] steps (at least every step).
+  std::vector<long> sample_every;
+  for (const auto &m : measurements_)
+    sample_every.push_back(std::max(1L, std::lround(m->interval() / dt)));
   double last_progress = omp_get_wtime();
   try
   {
@@ -149,6 +162,9 @@ void DemRun::run()
         series.record(s);
       if (out_every > 0 && k % out_every == 0)
         snapshots.write(s);
+      for (std::size_t m = 0; m < measurements_.size(); ++m)
+        if (k % sample_every[m] == 0)
+          measurements_[m]->sample(s);
       if (ckpt_every > 0 && k % ckpt_every == 0)
         s.write_checkpoint(checkpoint_path());
       const double now = omp_get_wtime();
@@ -175,6 +191,7 @@ void DemRun::run()
       log_ << "the last good checkpoint is kept: " << checkpoint_path() << " (restart from it with --restart)\n";
     else
       log_ << "no checkpoint was written before the failure (set dem.checkpoint_interval to keep one)\n";
+    write_measurements();
     log_timings(omp_get_wtime() - t_wall0);
     throw;
   }
@@ -183,6 +200,7 @@ void DemRun::run()
   if (s.step_count() % series_every != 0)
     series.record(s);
   s.write_checkpoint(checkpoint_path());
+  write_measurements();
   const double wall = omp_get_wtime() - t_wall0;
   char line[256];
   std::snprintf(line, sizeof line, "done: %ld steps to t = %.6g s in %.2f s wall (%.3g particle-steps/s), %ld list rebuilds\n",

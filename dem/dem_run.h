@@ -9,6 +9,7 @@
 #pragma once
 
 #include "dem_system.h"
+#include "measurement.h"
 #include "snapshot_writer.h"
 
 #include "case_model.h"
@@ -16,6 +17,7 @@
 #include <iosfwd>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace magbrush::dem {
 
@@ -34,6 +36,9 @@ public:
 
   // The engine, e.g. to plug in further force terms (magnetics) before run().
   DemSystem &system() { return *system_; }
+  // A measurement sampled during the run and written into output_dir() at its end.
+  void add_measurement(std::unique_ptr<Measurement> m) { measurements_.push_back(std::move(m)); }
+  const std::vector<std::unique_ptr<Measurement>> &measurements() const { return measurements_; }
 
   // Inserts (or restarts), settles and runs to case.dem.duration. Throws StabilityError
   // after keeping the last good checkpoint.
@@ -48,10 +53,12 @@ private:
   std::ostream &log_;
   std::string out_dir_;
   std::unique_ptr<DemSystem> system_;
+  std::vector<std::unique_ptr<Measurement>> measurements_;
 
   void add_scene_force_terms();
   void log_setup() const;
   void log_timings(double wall) const;
+  void write_measurements() const;
 };
 
 } // namespace magbrush::dem

@@ -615,6 +615,22 @@ std::vector<WallLoad> DemSystem::wall_loads() const
   return loads;
 }
 
+void DemSystem::wall_contacts(std::size_t w, std::vector<WallContactRecord> &out) const
+{
+  out.clear();
+  const int wall = static_cast<int>(w);
+  for (std::size_t sl = 0; sl < wall_id_.size(); ++sl)
+  {
+    if (wall_id_[sl] != wall)
+      continue;
+    WallContactRecord r;
+    r.particle = static_cast<std::uint32_t>(sl / max_wall_contacts);
+    r.force_on_wall = {wall_fx_[sl], wall_fy_[sl], wall_fz_[sl]};
+    r.torque_on_wall = {wall_tx_[sl], wall_ty_[sl], wall_tz_[sl]};
+    out.push_back(r);
+  }
+}
+
 std::size_t DemSystem::memory_bytes() const
 {
   const auto &s = particles_;

@@ -18,6 +18,7 @@
 #include "case_model.h"
 
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -39,6 +40,15 @@ struct WallLoad
   std::array<double, 3> force{0, 0, 0};
   std::array<double, 3> torque{0, 0, 0};
   long contacts = 0;
+};
+
+// One particle touching one wall at the current step: what the wall feels from it. Used by
+// measurements (pressure on the drum, beads touching the compression plate, slip speed).
+struct WallContactRecord
+{
+  std::uint32_t particle = 0;  // current index into particles() (not stable: see `id`)
+  Vector3 force_on_wall;       // −(contact force on the particle) [N]
+  Vector3 torque_on_wall;      // about the wall's reference point [N m]
 };
 
 // Wall time spent in each phase of the step [s].
@@ -95,6 +105,9 @@ public:
   double elastic_energy() const;      // Hertz normal springs of touching particle pairs
   long particle_contacts() const;     // touching particle pairs
   std::vector<WallLoad> wall_loads() const;
+  // The particles touching wall `w` now, in particle-index order (deterministic). `out` is
+  // cleared first; reuse it between calls to avoid allocation.
+  void wall_contacts(std::size_t w, std::vector<WallContactRecord> &out) const;
   std::size_t memory_bytes() const;   // particle, list, history and wall-slot storage
 
   // Checkpoint: the complete dynamic state (particles in their current order, forces,

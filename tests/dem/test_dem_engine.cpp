@@ -5,6 +5,7 @@
 #include "dem_test_scenes.h"
 
 #include "insertion.h"
+#include "dem_run.h"
 #include "snapshot_writer.h"
 
 #include <gtest/gtest.h>
@@ -16,6 +17,7 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <sstream>
 
 using namespace magbrush;
 using namespace magbrush::dem;
@@ -535,4 +537,53 @@ TEST(DemEngine, SettlingRunsBeforeTimeZero)
   EXPECT_DOUBLE_EQ(clock.t_max, 0.0);              // ended at t = 0 ...
   EXPECT_EQ(s.step_count(), 0);                    // ... with the clock reset for the run
   EXPECT_EQ(s.time(), 0.0);
+}
+
+namespace {
+// Counts its samples and remembers their times; writes one line into its file.
+class SampleCounter : public Measurement
+{
+public:
+  explicit SampleCounter(double every) : every_(every) {}
+  const char *name() const override { return "sample counter"; }
+  double interval() const override { return every_; }
+  void sample(const DemSystem &s) override { times.push_back(s.time()); }
+  void write(const std::string &dir) const override
+  {
+    std::ofstream(dir + "/samples.txt") << times.size() << "\n";
+  }
+  std::vector<double> times;
+
+private:
+  double every_;
+};
+} // namespace
+
+TEST(DemEngine, MeasurementsAreSampledAtTheirIntervalAndWritten)
+{
+  Material m = elastic_material("m", 1e7, 0.3, 2000);
+  Case c = single_species_case(m);
+  c.populations[0].count = 1;
+  c.populations[0].insert_box = std::array<Vec3, 2>{Vec3{0, 0, 0}, Vec3{3e-3, 3e-3, 3e-3}};
+  c.dem.time_step = 1e-6;
+  c.dem.duration = 100e-6;
+  const std::string dir = (std::filesystem::temp_directory_path() / "magbrush_measurement_test").string();
+  std::filesystem::remove_all(dir);
+  RunOptions o;
+  o.output_dir = dir;
+  o.threads = 1;
+  std::ostringstream log;
+  DemRun run(c, o, log);
+  auto counter = std::make_unique<SampleCounter>(10e-6);
+  const SampleCounter &seen = *counter;
+  run.add_measurement(std::move(counter));
+  run.run();
+  ASSERT_EQ(seen.times.size(), 10u); // t = 10, 20, ..., 100 µs
+  for (std::size_t k = 0; k < seen.times.size(); ++k)
+    EXPECT_NEAR(seen.times[k], 10e-6 * static_cast<double>(k + 1), 1e-12);
+  std::ifstream in(dir + "/samples.txt");
+  int n = 0;
+  in >> n;
+  EXPECT_EQ(n, 10);
+  std::filesystem::remove_all(dir);
 }

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <memory>
 
 using namespace magbrush;
 using namespace magbrush::dem;
@@ -139,4 +140,38 @@ TEST(DemWalls, SlidingPlateDragsParticleToItsSpeed)
   EXPECT_EQ(loads.size(), 2u);
   EXPECT_GT(loads[1].force[2], 0.0); // the particle pushes the plate up
   EXPECT_NEAR(loads[0].force[2], -loads[1].force[2], 1e-6 * loads[1].force[2]);
+}
+
+TEST(DemWalls, WallContactRecordsCarryTheWeightOfRestingBeads)
+{
+  // Three beads resting on a stage under gravity (damped to rest): the stage's contact
+  // records name exactly those beads, each carrying its weight m g along −z, and their sum
+  // equals the total wall load.
+  Material m = elastic_material("bead", 1e8, 0.3, 2500);
+  m.damping = 0.9;
+  Case c = single_species_case(m);
+  c.dem.gravity = {0.0, 0.0, -9.81};
+  add_rigid_plane(c, {0, 0, 0}, {0, 0, 1});
+  DemSystem sys(c);
+  const double R = 0.5e-3;
+  for (int k = 0; k < 3; ++k)
+    sys.particles().add({3.0 * R * k, 0, R * (1.0 + 0.1 * k)}, R * (1.0 + 0.1 * k), m.density, 0, 0.0);
+  sys.particles().add({20 * R, 0, 10 * R}, R, m.density, 0, 0.0); // still in the air
+  sys.add_force_term(std::make_unique<Gravity>(c.dem.gravity));
+  sys.initialize();
+  while (sys.time() < 0.004)
+    sys.step();
+  std::vector<WallContactRecord> rec;
+  sys.wall_contacts(0, rec);
+  ASSERT_EQ(rec.size(), 3u);
+  const auto &q = sys.particles();
+  double total = 0.0;
+  for (const auto &r : rec)
+  {
+    EXPECT_LT(q.z[r.particle], 2 * R);
+    EXPECT_NEAR(r.force_on_wall.z, -q.mass[r.particle] * 9.81, 1e-3 * q.mass[r.particle] * 9.81);
+    EXPECT_NEAR(r.force_on_wall.x, 0.0, 1e-9);
+    total += r.force_on_wall.z;
+  }
+  EXPECT_NEAR(sys.wall_loads()[0].force[2], total, 1e-12 * std::abs(total));
 }

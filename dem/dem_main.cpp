@@ -7,6 +7,7 @@
 #include "case_parser.h"
 #include "field_files.h"
 #include "magnetic_force_term.h"
+#include "measurement_registry.h"
 
 #include <cstdlib>
 #include <unistd.h>
@@ -128,6 +129,7 @@ int main(int argc, char **argv)
     const magbrush::Case c = magbrush::load_case(case_path, overrides);
     magbrush::dem::DemRun run(c, options, std::cout);
     add_magnetics(run, c);
+    magbrush::dem::add_case_measurements(run, c);
     run.run();
   }
   catch (const magbrush::dem::StabilityError &)

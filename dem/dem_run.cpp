@@ -60,6 +60,13 @@ void DemRun::log_setup() const
   for (const auto &t : s.force_terms())
     log_ << ", " << t->name();
   log_ << "\n";
+  if (!measurements_.empty())
+  {
+    log_ << "  measurements:";
+    for (const auto &m : measurements_)
+      log_ << " " << m->name() << (&m == &measurements_.back() ? "" : ",");
+    log_ << "\n";
+  }
   bool magnetics_on = false;
   for (const auto &t : s.force_terms())
     magnetics_on |= std::string(t->name()) == "magnetic dipoles";

@@ -124,6 +124,7 @@ private:
   DemWalls walls_;
   PeriodicBox box_;
   ContactTable table_;
+  std::vector<double> coefficient_fields_; // table_ as six arrays (E*, G*, μ, μ_r, α_n, α_t)
   StableTimeStep stable_;
   ParticleState particles_;
   ForceBuffers forces_;

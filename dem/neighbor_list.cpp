@@ -224,6 +224,7 @@ void NeighborList::build_pairs(const ParticleState &s, const PeriodicBox &box, d
   for (std::size_t i = 0; i < n; ++i)
     row_start[i + 1] += row_start[i];
   const std::size_t P = static_cast<std::size_t>(row_start[n]);
+  owner.resize(P);
   partner.resize(P);
   image.resize(P);
   touching.assign(P, 0);
@@ -235,6 +236,7 @@ void NeighborList::build_pairs(const ParticleState &s, const PeriodicBox &box, d
   {
     std::size_t p = static_cast<std::size_t>(row_start[static_cast<std::size_t>(i)]);
     for_each_partner(i, [&](std::int32_t j, std::uint8_t code) {
+      owner[p] = i;
       partner[p] = j;
       image[p] = code;
       ++p;
@@ -301,7 +303,7 @@ void NeighborList::restore_history(const ParticleState &s)
 std::size_t NeighborList::memory_bytes() const
 {
   std::size_t b = 0;
-  for (const auto *a : {&row_start, &partner, &col_start, &col_pair, &cell_of_, &cell_start_, &order_,
+  for (const auto *a : {&row_start, &owner, &partner, &col_start, &col_pair, &cell_of_, &cell_start_, &order_,
                         &counts_, &old_start_, &old_partner_id_})
     b += a->capacity() * sizeof(std::int32_t);
   b += image.capacity() + touching.capacity();

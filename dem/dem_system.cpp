@@ -238,7 +238,7 @@ struct PairKernelData
   const std::int32_t *species;
   // Pairs (read).
   const std::int32_t *owner, *partner;
-  const std::uint8_t *image;
+  const std::int32_t *image;
   const double *shift_x, *shift_y, *shift_z; // by image code
   // Coefficients by interaction type (species s, t at s * table_columns + t), one array per
   // field so that the vector code can gather them.
@@ -249,7 +249,7 @@ struct PairKernelData
   // Pairs (read and write): history; (write) the contact's outputs.
   double *hx, *hy, *hz;
   double *fx, *fy, *fz, *tix, *tiy, *tiz, *tjx, *tjy, *tjz;
-  std::uint8_t *touching;
+  std::int32_t *touching;
 };
 
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
@@ -269,7 +269,7 @@ int particle_pair_kernel(const PairKernelData &D, std::int64_t p_begin, std::int
   const double *__restrict wx = D.wx, *__restrict wy = D.wy, *__restrict wz = D.wz;
   const double *__restrict radius = D.radius, *__restrict mass = D.mass, *__restrict inv_inertia = D.inv_inertia;
   const std::int32_t *__restrict species = D.species, *__restrict owner = D.owner, *__restrict partner = D.partner;
-  const std::uint8_t *__restrict image = D.image;
+  const std::int32_t *__restrict image = D.image;
   const double *__restrict shift_x = D.shift_x, *__restrict shift_y = D.shift_y, *__restrict shift_z = D.shift_z;
   const double *__restrict E_star = D.effective_modulus, *__restrict G_star = D.effective_shear;
   const double *__restrict mu = D.friction, *__restrict mu_r = D.rolling_friction;
@@ -280,7 +280,7 @@ int particle_pair_kernel(const PairKernelData &D, std::int64_t p_begin, std::int
   double *__restrict fx = D.fx, *__restrict fy = D.fy, *__restrict fz = D.fz;
   double *__restrict tix = D.tix, *__restrict tiy = D.tiy, *__restrict tiz = D.tiz;
   double *__restrict tjx = D.tjx, *__restrict tjy = D.tjy, *__restrict tjz = D.tjz;
-  std::uint8_t *__restrict touching = D.touching;
+  std::int32_t *__restrict touching = D.touching;
   int alarm = 0;
 #pragma omp simd reduction(| : alarm)
   for (std::int64_t p = p_begin; p < p_end; ++p)
@@ -750,10 +750,10 @@ std::size_t DemSystem::memory_bytes() const
 }
 
 // ---------------------------------------------------------------------------------------
-// Checkpoints: a flat binary file, "MBDEMCK1", then the clock and every dynamic array with
+// Checkpoints: a flat binary file, "MBDEMCK2" (2: 32-bit pair flags), then the clock and every dynamic array with
 // its length. Written to <path>.tmp and renamed, so a crash never leaves half a checkpoint.
 namespace {
-constexpr char checkpoint_magic[9] = "MBDEMCK1";
+constexpr char checkpoint_magic[9] = "MBDEMCK2";
 
 template <typename T>
 void put(std::ofstream &o, const T &v) { o.write(reinterpret_cast<const char *>(&v), sizeof(T)); }
@@ -832,7 +832,7 @@ void DemSystem::read_checkpoint(const std::string &path)
   char magic[8];
   in.read(magic, 8);
   if (!in || std::memcmp(magic, checkpoint_magic, 8) != 0)
-    throw std::runtime_error("'" + path + "' is not a magbrush DEM checkpoint (expected header MBDEMCK1)");
+    throw std::runtime_error("'" + path + "' is not a magbrush DEM checkpoint (expected header MBDEMCK2)");
   step_ = get<long>(in);
   time_ = get<double>(in);
   const double dt = get<double>(in);

@@ -36,8 +36,8 @@ public:
   std::vector<std::int32_t> row_start; // N + 1
   std::vector<std::int32_t> owner;     // i of pair p (the row it belongs to)
   std::vector<std::int32_t> partner;   // j of pair p
-  std::vector<std::uint8_t> image;     // periodic image code of j relative to i (see shift())
-  std::vector<std::uint8_t> touching;  // 1 while the pair overlaps
+  std::vector<std::int32_t> image;     // periodic image code of j relative to i (see shift())
+  std::vector<std::int32_t> touching;  // 1 while the pair overlaps
   std::vector<double> hist_x, hist_y, hist_z;                     // Mindlin ξ (on i)
   std::vector<double> force_x, force_y, force_z;                  // contact force on i
   std::vector<double> torque_i_x, torque_i_y, torque_i_z;         // torque on i

@@ -222,14 +222,25 @@ std::string DemSystem::describe_particle(std::size_t i) const
 }
 
 // ---------------------------------------------------------------------------------------
-// The particle–particle pair kernel. It runs over a contiguous range of pairs of the half
-// list (pairs are stored row by row, so a range of rows is a range of pairs) and writes each
-// pair's force and torques into the pair's own slots; the per-particle gather that follows
-// adds them up in a fixed order. The loop body is branch-free (a non-touching pair computes
-// with a clamped overlap and its outputs are selected to zero), so it vectorises: an AVX-512
-// or AVX2 clone is picked at load time where the CPU has it. Vector and scalar code give the
-// same bits: every operation is an IEEE add, multiply, divide or square root, done in the
-// same order, and contraction into fused multiply-adds is off for this function.
+// Particle–particle contacts.
+//
+// The half list stores each pair once, row by row (rows in particle order), so a range of
+// rows is a contiguous range of pairs. Rows are cut into fixed blocks (independent of the
+// thread count). For each block:
+//   * the pair kernel computes every pair's contact: the force on i (kept in the pair's slot,
+//     the partner needs it too), the torque on i (into a small per-thread buffer: only the
+//     row needs it) and the torque on j (into the pair's slot);
+//   * while that is still in cache, each row of the block sums its pairs: force and torque
+//     of particle i from its own pairs, in pair order.
+// After a barrier each particle adds the pairs in which it is the partner (its column, in
+// ascending pair order). The order of every sum is fixed by the list alone, so the forces
+// have the same bits on any number of threads, with no atomics.
+//
+// The kernel's loop body is branch-free (a pair that does not touch goes through the same
+// arithmetic at a harmless stand-in geometry and its outputs are selected to zero), so it
+// vectorises; an AVX-512 or AVX2 clone is picked at load time where the CPU has one. Vector
+// and scalar code give the same bits: every operation is an IEEE add, multiply, divide or
+// square root in the same order, and fused multiply-adds are off (dem/CMakeLists.txt).
 namespace {
 struct PairKernelData
 {
@@ -241,26 +252,32 @@ struct PairKernelData
   const std::int32_t *image;
   const double *shift_x, *shift_y, *shift_z; // by image code
   // Coefficients by interaction type (species s, t at s * table_columns + t), one array per
-  // field so that the vector code can gather them.
+  // field so that the vector code can gather them. `uniform`: one type only (one species),
+  // then the coefficients are loop constants and nothing is gathered.
   const double *effective_modulus, *effective_shear, *friction, *rolling_friction, *damping_normal,
       *damping_tangential;
   std::int64_t table_columns;
+  bool uniform;
   double dt, overlap_guard;
-  // Pairs (read and write): history; (write) the contact's outputs.
+  // Pairs (read and write): history; (write) force on i, torque on j, touching flag.
   double *hx, *hy, *hz;
-  double *fx, *fy, *fz, *tix, *tiy, *tiz, *tjx, *tjy, *tjz;
+  double *fx, *fy, *fz, *tjx, *tjy, *tjz;
   std::int32_t *touching;
 };
 
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-#define MAGBRUSH_PAIR_KERNEL_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
-#else
-#define MAGBRUSH_PAIR_KERNEL_CLONES
-#endif
+// Torque on i of the pairs p_begin + k, k = 0 .. block size (a per-thread buffer).
+struct RowTorques
+{
+  double *x, *y, *z;
+};
 
-// Returns 1 when some pair overlaps by more than the guard fraction of the smaller radius.
-MAGBRUSH_PAIR_KERNEL_CLONES
-int particle_pair_kernel(const PairKernelData &D, std::int64_t p_begin, std::int64_t p_end)
+// The kernel body for pairs [p_begin, p_end). Returns 1 when some pair overlaps by more than
+// the guard fraction of the smaller radius.
+template <bool Uniform>
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+inline int pair_loop(const PairKernelData &D, const RowTorques &T, std::int64_t p_begin, std::int64_t p_end)
 {
   // Local restrict copies: the outputs alias neither the inputs nor each other, and the
   // compiler must not reload the pointers from D after every store.
@@ -278,9 +295,12 @@ int particle_pair_kernel(const PairKernelData &D, std::int64_t p_begin, std::int
   const double dt = D.dt, guard = D.overlap_guard;
   double *__restrict hx = D.hx, *__restrict hy = D.hy, *__restrict hz = D.hz;
   double *__restrict fx = D.fx, *__restrict fy = D.fy, *__restrict fz = D.fz;
-  double *__restrict tix = D.tix, *__restrict tiy = D.tiy, *__restrict tiz = D.tiz;
   double *__restrict tjx = D.tjx, *__restrict tjy = D.tjy, *__restrict tjz = D.tjz;
+  double *__restrict tix = T.x - p_begin, *__restrict tiy = T.y - p_begin, *__restrict tiz = T.z - p_begin;
   std::int32_t *__restrict touching = D.touching;
+  ContactCoefficients uniform_k;
+  if (Uniform)
+    uniform_k = {E_star[0], G_star[0], mu[0], mu_r[0], alpha_n[0], alpha_t[0]};
   int alarm = 0;
 #pragma omp simd reduction(| : alarm)
   for (std::int64_t p = p_begin; p < p_end; ++p)
@@ -291,8 +311,8 @@ int particle_pair_kernel(const PairKernelData &D, std::int64_t p_begin, std::int
     const double ri = radius[i], rj = radius[j], reach = ri + rj;
     const double r2 = dot(d, d);
     const bool touch = r2 < reach * reach;
-    // A non-touching pair goes through the same arithmetic at a harmless stand-in geometry
-    // (unit distance, zero overlap); its outputs are zeroed below.
+    // A pair that does not touch computes at unit distance and zero overlap (no NaN, no
+    // infinity); its outputs are zeroed below.
     const double dist = std::sqrt(touch ? r2 : 1.0), inv_dist = 1.0 / dist;
     ContactKinematics c;
     c.n = inv_dist * d;
@@ -312,14 +332,12 @@ int particle_pair_kernel(const PairKernelData &D, std::int64_t p_begin, std::int
     c.radius_j = rj;
     c.inv_inertia_i = inv_inertia[i];
     c.inv_inertia_j = inv_inertia[j];
-    const std::int64_t type = species[i] * columns + species[j];
-    ContactCoefficients k;
-    k.effective_modulus = E_star[type];
-    k.effective_shear = G_star[type];
-    k.friction = mu[type];
-    k.rolling_friction = mu_r[type];
-    k.damping_normal = alpha_n[type];
-    k.damping_tangential = alpha_t[type];
+    ContactCoefficients k = uniform_k;
+    if (!Uniform)
+    {
+      const std::int64_t type = species[i] * columns + species[j];
+      k = {E_star[type], G_star[type], mu[type], mu_r[type], alpha_n[type], alpha_t[type]};
+    }
     Vector3 xi_t{hx[p], hy[p], hz[p]};
     const ContactOutcome o = evaluate_contact(k, c, xi_t, dt);
     // A pair that stopped touching forgets its history.
@@ -340,6 +358,18 @@ int particle_pair_kernel(const PairKernelData &D, std::int64_t p_begin, std::int
   }
   return alarm;
 }
+
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define MAGBRUSH_PAIR_KERNEL_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
+#else
+#define MAGBRUSH_PAIR_KERNEL_CLONES
+#endif
+
+MAGBRUSH_PAIR_KERNEL_CLONES
+int particle_pair_kernel(const PairKernelData &D, const RowTorques &T, std::int64_t p_begin, std::int64_t p_end)
+{
+  return D.uniform ? pair_loop<true>(D, T, p_begin, p_end) : pair_loop<false>(D, T, p_begin, p_end);
+}
 } // namespace
 
 void DemSystem::compute_particle_contacts()
@@ -359,69 +389,83 @@ void DemSystem::compute_particle_contacts()
   }
   const std::size_t types = table_.species() * table_.columns();
   const double *coef = coefficient_fields_.data();
-  PairKernelData D{s.x.data(), s.y.data(), s.z.data(), s.vx.data(), s.vy.data(), s.vz.data(),
-                   s.wx.data(), s.wy.data(), s.wz.data(), s.radius.data(), s.mass.data(),
-                   s.inv_inertia.data(), s.species.data(), L.owner.data(), L.partner.data(),
-                   L.image.data(), shift[0], shift[1], shift[2], coef, coef + types, coef + 2 * types,
-                   coef + 3 * types, coef + 4 * types, coef + 5 * types,
-                   static_cast<std::int64_t>(table_.columns()), dt_, case_.dem.max_overlap_fraction,
-                   L.hist_x.data(), L.hist_y.data(), L.hist_z.data(), L.force_x.data(),
-                   L.force_y.data(), L.force_z.data(), L.torque_i_x.data(), L.torque_i_y.data(),
-                   L.torque_i_z.data(), L.torque_j_x.data(), L.torque_j_y.data(), L.torque_j_z.data(),
-                   L.touching.data()};
+  const PairKernelData D{s.x.data(), s.y.data(), s.z.data(), s.vx.data(), s.vy.data(), s.vz.data(),
+                         s.wx.data(), s.wy.data(), s.wz.data(), s.radius.data(), s.mass.data(),
+                         s.inv_inertia.data(), s.species.data(), L.owner.data(), L.partner.data(),
+                         L.image.data(), shift[0], shift[1], shift[2], coef, coef + types, coef + 2 * types,
+                         coef + 3 * types, coef + 4 * types, coef + 5 * types,
+                         static_cast<std::int64_t>(table_.columns()), table_.species() == 1, dt_,
+                         case_.dem.max_overlap_fraction, L.hist_x.data(), L.hist_y.data(), L.hist_z.data(),
+                         L.force_x.data(), L.force_y.data(), L.force_z.data(), L.torque_j_x.data(),
+                         L.torque_j_y.data(), L.torque_j_z.data(), L.touching.data()};
+  const std::int32_t *row_start = L.row_start.data();
   int overlap_alarm = 0;
-  // 1. Each pair computes its contact into its own slots (no races, no order dependence),
-  //    in blocks of rows.
-  constexpr long rows_per_block = 128;
-  const long blocks = (n + rows_per_block - 1) / rows_per_block;
-#pragma omp parallel for schedule(dynamic, 4) reduction(| : overlap_alarm) if (n > 512)
-  for (long b = 0; b < blocks; ++b)
-  {
-    const long i0 = b * rows_per_block, i1 = std::min(n, i0 + rows_per_block);
-    overlap_alarm |= particle_pair_kernel(D, L.row_start[U(static_cast<std::int32_t>(i0))],
-                                          L.row_start[U(static_cast<std::int32_t>(i1))]);
-  }
-  // 2. Each particle gathers its pairs in a fixed order: its own row, then its column.
   ForceBuffers &f = forces_;
-#pragma omp parallel for schedule(static) if (n > 512)
-  for (long k = 0; k < n; ++k)
+  const long blocks = (n + contact_block_rows - 1) / contact_block_rows;
+  // One parallel region, two phases separated by the loop's barrier.
+#pragma omp parallel if (n > 512)
   {
-    const std::size_t i = static_cast<std::size_t>(k);
-    double fx = 0, fy = 0, fz = 0, tx = 0, ty = 0, tz = 0;
-    std::int32_t count = 0;
-    for (std::int32_t pp = L.row_start[i]; pp < L.row_start[i + 1]; ++pp)
+    std::vector<double> row_torques; // per thread: the torques on i of one block's pairs
+    // 1. Pairs and rows, block by block.
+#pragma omp for schedule(dynamic, 2) reduction(| : overlap_alarm)
+    for (long b = 0; b < blocks; ++b)
     {
-      const std::size_t p = U(pp);
-      if (!L.touching[p])
-        continue;
-      ++count;
-      fx += L.force_x[p];
-      fy += L.force_y[p];
-      fz += L.force_z[p];
-      tx += L.torque_i_x[p];
-      ty += L.torque_i_y[p];
-      tz += L.torque_i_z[p];
+      const long i0 = b * contact_block_rows, i1 = std::min(n, i0 + contact_block_rows);
+      const std::int64_t p0 = row_start[i0], p1 = row_start[i1];
+      row_torques.resize(3 * static_cast<std::size_t>(p1 - p0));
+      const RowTorques T{row_torques.data(), row_torques.data() + (p1 - p0), row_torques.data() + 2 * (p1 - p0)};
+      overlap_alarm |= particle_pair_kernel(D, T, p0, p1);
+      for (long i = i0; i < i1; ++i)
+      {
+        double fx = 0, fy = 0, fz = 0, tx = 0, ty = 0, tz = 0;
+        std::int32_t count = 0;
+        for (std::int64_t p = row_start[i]; p < row_start[i + 1]; ++p)
+        {
+          count += D.touching[p];
+          fx += D.fx[p];
+          fy += D.fy[p];
+          fz += D.fz[p];
+          tx += T.x[p - p0];
+          ty += T.y[p - p0];
+          tz += T.z[p - p0];
+        }
+        f.fx[U(static_cast<std::int32_t>(i))] = fx;
+        f.fy[U(static_cast<std::int32_t>(i))] = fy;
+        f.fz[U(static_cast<std::int32_t>(i))] = fz;
+        f.tx[U(static_cast<std::int32_t>(i))] = tx;
+        f.ty[U(static_cast<std::int32_t>(i))] = ty;
+        f.tz[U(static_cast<std::int32_t>(i))] = tz;
+        contact_count_[U(static_cast<std::int32_t>(i))] = count;
+      }
     }
-    for (std::int32_t q = L.col_start[i]; q < L.col_start[i + 1]; ++q)
+    // 2. Columns: each particle adds the pairs in which it is the partner, in ascending pair
+    //    order (−F on it, and the pair's torque on j).
+    const std::int32_t *col_start = L.col_start.data(), *col_pair = L.col_pair.data();
+#pragma omp for schedule(dynamic, 512)
+    for (long k = 0; k < n; ++k)
     {
-      const std::size_t p = U(L.col_pair[U(q)]);
-      if (!L.touching[p])
-        continue;
-      ++count;
-      fx -= L.force_x[p];
-      fy -= L.force_y[p];
-      fz -= L.force_z[p];
-      tx += L.torque_j_x[p];
-      ty += L.torque_j_y[p];
-      tz += L.torque_j_z[p];
+      const std::size_t i = static_cast<std::size_t>(k);
+      double fx = f.fx[i], fy = f.fy[i], fz = f.fz[i], tx = f.tx[i], ty = f.ty[i], tz = f.tz[i];
+      std::int32_t count = contact_count_[i];
+      for (std::int32_t q = col_start[i]; q < col_start[i + 1]; ++q)
+      {
+        const std::size_t p = U(col_pair[q]);
+        count += D.touching[p];
+        fx -= D.fx[p];
+        fy -= D.fy[p];
+        fz -= D.fz[p];
+        tx += D.tjx[p];
+        ty += D.tjy[p];
+        tz += D.tjz[p];
+      }
+      f.fx[i] = fx;
+      f.fy[i] = fy;
+      f.fz[i] = fz;
+      f.tx[i] = tx;
+      f.ty[i] = ty;
+      f.tz[i] = tz;
+      contact_count_[i] = count;
     }
-    f.fx[i] = fx;
-    f.fy[i] = fy;
-    f.fz[i] = fz;
-    f.tx[i] = tx;
-    f.ty[i] = ty;
-    f.tz[i] = tz;
-    contact_count_[i] = count;
   }
   if (overlap_alarm)
     check_overlaps();

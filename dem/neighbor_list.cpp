@@ -228,8 +228,7 @@ void NeighborList::build_pairs(const ParticleState &s, const PeriodicBox &box, d
   partner.resize(P);
   image.resize(P);
   touching.assign(P, 0);
-  for (auto *a : {&hist_x, &hist_y, &hist_z, &force_x, &force_y, &force_z, &torque_i_x, &torque_i_y,
-                  &torque_i_z, &torque_j_x, &torque_j_y, &torque_j_z})
+  for (auto *a : {&hist_x, &hist_y, &hist_z, &force_x, &force_y, &force_z, &torque_j_x, &torque_j_y, &torque_j_z})
     a->resize(P);
 #pragma omp parallel for schedule(dynamic, 256) if (N > 512)
   for (std::int32_t i = 0; i < N; ++i)
@@ -306,8 +305,7 @@ std::size_t NeighborList::memory_bytes() const
   for (const auto *a : {&row_start, &owner, &partner, &image, &touching, &col_start, &col_pair, &cell_of_, &cell_start_, &order_,
                         &counts_, &old_start_, &old_partner_id_})
     b += a->capacity() * sizeof(std::int32_t);
-  for (const auto *a : {&hist_x, &hist_y, &hist_z, &force_x, &force_y, &force_z, &torque_i_x, &torque_i_y,
-                        &torque_i_z, &torque_j_x, &torque_j_y, &torque_j_z, &old_hx_, &old_hy_, &old_hz_})
+  for (const auto *a : {&hist_x, &hist_y, &hist_z, &force_x, &force_y, &force_z, &torque_j_x, &torque_j_y, &torque_j_z, &old_hx_, &old_hy_, &old_hz_})
     b += a->capacity() * sizeof(double);
   return b;
 }

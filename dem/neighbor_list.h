@@ -40,8 +40,8 @@ public:
   std::vector<std::int32_t> touching;  // 1 while the pair overlaps
   std::vector<double> hist_x, hist_y, hist_z;                     // Mindlin ξ (on i)
   std::vector<double> force_x, force_y, force_z;                  // contact force on i
-  std::vector<double> torque_i_x, torque_i_y, torque_i_z;         // torque on i
-  std::vector<double> torque_j_x, torque_j_y, torque_j_z;         // torque on j
+  std::vector<double> torque_j_x, torque_j_y, torque_j_z;         // torque on j (the torque on
+                                                                  // i is summed by its row at once)
   // Transposed index: pairs in which particle k is the second member, ascending.
   std::vector<std::int32_t> col_start, col_pair;
 

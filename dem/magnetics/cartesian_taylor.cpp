@@ -152,6 +152,12 @@ void CartesianTaylor::multipole_to_local(const double *D, const double *M, doubl
     L[term.out] += M[term.in] * D[term.coeff];
 }
 
+void CartesianTaylor::translation_matrix(const double *D, double *A) const
+{
+  for (const Term &term : m2l_)
+    A[term.out * n_multipole_ + term.in] = D[term.coeff];
+}
+
 void CartesianTaylor::shift_local(const double e[3], const double *L_parent, double *L_child) const
 {
   double w[1024];

@@ -49,6 +49,22 @@ public:
   void shift_multipole(const double d[3], const double *M_child, double *M_parent) const;
   // Adds L_γ += Σ_β M_β D_(β+γ) (D evaluated at t − c).
   void multipole_to_local(const double *D, const double *M, double *L) const;
+  // The same translation as a dense matrix A[γ][β] = D_(β+γ) (local_size × multipole_size):
+  // tabulated once per cell offset, applied as a matrix-vector product (vectorises).
+  void translation_matrix(const double *D, double *A) const;
+  void apply_translation(const double *A, const double *M, double *L) const
+  {
+    const std::size_t nm = n_multipole_, nl = n_local_;
+    for (std::size_t g = 0; g < nl; ++g)
+    {
+      const double *row = A + g * nm;
+      double sum = 0.0;
+#pragma omp simd reduction(+ : sum)
+      for (std::size_t b = 0; b < nm; ++b)
+        sum += row[b] * M[b];
+      L[g] += sum;
+    }
+  }
   // Adds the parent's local expansion (centre t) re-centred at the child centre t' = t + e.
   void shift_local(const double e[3], const double *L_parent, double *L_child) const;
   // Field B [T] and gradient gradB[a][b] = ∂B_a/∂x_b at u = x − t, ADDED.

@@ -85,24 +85,37 @@ void CellMultipoleField::build(std::size_t n, const double *x, const double *y, 
   n_ = n;
   const double *coord[3] = {x, y, z};
 
-  // Fine cells: 2^m cells along every periodic axis (m common to all, so that the periodic
-  // axes all reach one cell at the same top level), cubic-ish cells along the open axes.
+  // Fine cells: k·2^m cells along every periodic axis (k = 1 or 3, the same for all periodic
+  // axes, so that they all reach k cells at the same top level m; cell sizes within ±22 % of
+  // the target), cubic-ish cells along the open axes.
   int m = 0;
+  long k = 1;
   if (periodic_axes_ > 0)
   {
     double shortest = std::numeric_limits<double>::infinity();
     for (double L : box_)
       if (L > 0.0)
         shortest = std::min(shortest, L);
-    m = std::max(0, static_cast<int>(std::lround(std::log2(shortest / cell_size))));
-    m = std::min(m, 20);
+    const double want = std::log(std::max(1.0, shortest / cell_size));
+    double best = std::numeric_limits<double>::infinity();
+    for (long kk : {1L, 3L})
+      for (int mm = 0; mm <= 20; ++mm)
+      {
+        const double miss = std::abs(std::log(static_cast<double>(kk << mm)) - want);
+        if (miss < best)
+        {
+          best = miss;
+          k = kk;
+          m = mm;
+        }
+      }
   }
   double periodic_h = 0.0;
   for (int d = 0; d < 3; ++d)
     if (box_[d] > 0.0)
-      periodic_h += box_[d] / static_cast<double>(1L << m) / periodic_axes_;
+      periodic_h += box_[d] / static_cast<double>(k << m) / periodic_axes_;
   for (int d = 0; d < 3; ++d)
-    h_[d] = box_[d] > 0.0 ? box_[d] / static_cast<double>(1L << m)
+    h_[d] = box_[d] > 0.0 ? box_[d] / static_cast<double>(k << m)
                           : (periodic_axes_ > 0 ? periodic_h : cell_size);
 
   xw_.resize(3 * n);
@@ -142,7 +155,7 @@ void CellMultipoleField::build(std::size_t n, const double *x, const double *y, 
   Level &fine = levels_[0];
   fine.size = h_;
   for (int d = 0; d < 3; ++d)
-    fine.cells[d] = box_[d] > 0.0 ? (1L << m) : 0;
+    fine.cells[d] = box_[d] > 0.0 ? (k << m) : 0;
   std::vector<std::pair<std::uint64_t, std::uint32_t>> sorted(n);
   std::vector<std::array<long, 3>> bead_index(n);
   for (std::size_t b = 0; b < n; ++b)
@@ -176,7 +189,7 @@ void CellMultipoleField::build(std::size_t n, const double *x, const double *y, 
   }
   bead_begin_.push_back(static_cast<std::uint32_t>(n));
 
-  // Coarser levels until the top: one cell across the periodic axes (level m), or, with no
+  // Coarser levels until the top: k cells across the periodic axes (level m), or, with no
   // periodic axis, at most 4 cells across every axis.
   for (int level = 0;; ++level)
   {
@@ -252,10 +265,12 @@ void CellMultipoleField::build(std::size_t n, const double *x, const double *y, 
     cached_h_ = h_;
     offset_D_.assign(levels_.size(), {});
     const std::size_t nd = taylor_.derivative_size();
+    const std::size_t na = taylor_.local_size() * taylor_.multipole_size();
+    std::vector<double> D(nd);
     for (std::size_t level = 0; level + 1 < levels_.size(); ++level)
     {
-      std::vector<double> &D = offset_D_[level];
-      D.assign(343 * nd, 0.0);
+      std::vector<double> &A = offset_D_[level];
+      A.assign(343 * na, 0.0);
       for (int o = 0; o < 343; ++o)
       {
         const long dx = o % 7 - 3, dy = (o / 7) % 7 - 3, dz = o / 49 - 3;
@@ -263,7 +278,8 @@ void CellMultipoleField::build(std::size_t n, const double *x, const double *y, 
           continue;
         const double R[3] = {-dx * levels_[level].size[0], -dy * levels_[level].size[1],
                              -dz * levels_[level].size[2]};
-        taylor_.derivatives(R, &D[o * nd]);
+        taylor_.derivatives(R, D.data());
+        taylor_.translation_matrix(D.data(), &A[o * na]);
       }
     }
   }
@@ -371,7 +387,7 @@ const std::vector<double> &CellMultipoleField::top_tensor(const std::array<long,
     for (long m = -one_axis_images; m <= one_axis_images; ++m)
     {
       std::array<long, 3> Delta = offset;
-      Delta[axes[0]] += m;
+      Delta[axes[0]] += m * t.cells[axes[0]];
       add_image(Delta);
     }
   }
@@ -393,11 +409,11 @@ const std::vector<double> &CellMultipoleField::top_tensor(const std::array<long,
           continue;
         ++count;
         std::array<long, 3> Delta = offset;
-        Delta[axes[0]] += m1;
-        Delta[axes[1]] += m2;
+        Delta[axes[0]] += m1 * t.cells[axes[0]];
+        Delta[axes[1]] += m2 * t.cells[axes[1]];
         add_image(Delta);
       }
-    const double A = t.size[axes[0]] * t.size[axes[1]];
+    const double A = box_[axes[0]] * box_[axes[1]];
     const double R2 = count * A / pi;
     const double hn = -offset[open] * t.size[open];
     const double s0 = R2 + hn * hn;
@@ -416,7 +432,9 @@ const std::vector<double> &CellMultipoleField::top_tensor(const std::array<long,
     S[at(1, 2, 0)] += pi / A * q3;
     S[at(1, 0, 2)] += pi / A * q3;
   }
-  return top_D_.emplace(offset, std::move(S)).first->second;
+  std::vector<double> A(taylor_.local_size() * taylor_.multipole_size());
+  taylor_.translation_matrix(S.data(), A.data());
+  return top_D_.emplace(offset, std::move(A)).first->second;
 }
 
 void CellMultipoleField::build_near_pairs(const double *const coord[3])
@@ -489,7 +507,7 @@ void CellMultipoleField::evaluate(const double *p, double *B, double *gradB)
 {
   const int top = static_cast<int>(levels_.size()) - 1;
   const std::size_t nm = taylor_.multipole_size(), nl = taylor_.local_size();
-  const std::size_t nd = taylor_.derivative_size();
+  const std::size_t na = nl * nm;
 
   // 1. P2M.
   {
@@ -550,14 +568,14 @@ void CellMultipoleField::evaluate(const double *p, double *B, double *gradB)
         const double e[3] = {centre_c[0] - centre_p[0], centre_c[1] - centre_p[1],
                              centre_c[2] - centre_p[2]};
         taylor_.shift_local(e, &up.L[l.parent[c] * nl], L);
-        const double *D = offset_D_[level].data();
+        const double *A = offset_D_[level].data();
         for (std::uint32_t k = l.list_begin[c]; k < l.list_begin[c + 1]; ++k)
-          taylor_.multipole_to_local(&D[l.list_offset[k] * nd], &l.M[l.list_source[k] * nm], L);
+          taylor_.apply_translation(&A[l.list_offset[k] * na], &l.M[l.list_source[k] * nm], L);
       }
       else
         for (std::uint32_t k = l.list_begin[c]; k < l.list_begin[c + 1]; ++k)
-          taylor_.multipole_to_local(top_tensors_[top_tensor_[k]]->data(),
-                                     &l.M[l.list_source[k] * nm], L);
+          taylor_.apply_translation(top_tensors_[top_tensor_[k]]->data(),
+                                    &l.M[l.list_source[k] * nm], L);
     }
   }
   // 5. L2P.

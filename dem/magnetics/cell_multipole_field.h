@@ -12,7 +12,7 @@
 //   3. M2L  at every level a cell receives, as a local Taylor expansion about its centre,
 //           the field of the cells that are children of its parent's neighbours but not its
 //           own neighbours (the classical interaction list, at most 189 cells); at the top
-//           level (one cell across each periodic axis, or a few cells when nothing is
+//           level (1 or 3 cells across each periodic axis, or a few cells when nothing is
 //           periodic) it receives every non-adjacent top cell and all their periodic images,
 //           through lattice-summed derivative tensors (1 periodic axis: ±400 images, error
 //           ~1e-6; 2 periodic axes: images in a disc of radius 64 periods plus the analytic
@@ -46,8 +46,8 @@ public:
   // far interactions from a separation ratio of 0.87 to 0.58: far more accurate per order).
   CellMultipoleField(int order, const std::array<double, 3> &box, int near_reach = 2);
 
-  // Sorts the beads into fine cells of target size `cell_size` [m] (periodic axes get 2^m
-  // cells exactly), builds the levels and interaction lists and the near pair list.
+  // Sorts the beads into fine cells of target size `cell_size` [m] (periodic axes get k·2^m
+  // cells exactly, k = 1 or 3), builds the levels, interaction lists and the near pair list.
   void build(std::size_t n, const double *x, const double *y, const double *z, double cell_size);
 
   // Pairs of beads (and periodic images) in adjacent fine cells, each once, in a fixed order;
@@ -90,8 +90,9 @@ private:
   std::vector<std::uint32_t> bead_cell_;   // fine cell of every bead
   std::vector<MagneticNeighbourList::Pair> near_pairs_;
 
-  // Translation tensors D_α(−Δ h_ℓ) for the 7³ offsets of every lower level, and the
-  // lattice-summed tensors of the top level per offset (cached while h is unchanged).
+  // Translation matrices A[γ][β] = D_(β+γ)(−Δ h_ℓ) for the 7³ offsets of every lower
+  // level, and the lattice-summed ones of the top level per offset (cached while h and the
+  // number of levels are unchanged).
   std::vector<std::vector<double>> offset_D_;
   std::map<std::array<long, 3>, std::vector<double>> top_D_;
   std::array<double, 3> cached_h_{0, 0, 0};

@@ -139,6 +139,11 @@ struct AppliedField
   Vec3 uniform_direction{{0.0, 0.0, 1.0}};
   double uniform_magnitude = 0.0; // |B| [T] at the end of the ramp
   double ramp_time = 0.0;         // linear ramp 0 → |B| over this time [s] (0 = on at once)
+  // Added for Kawamoto's compression study (field sweep at a held plate): an optional
+  // piecewise-linear schedule of the uniform field's magnitude, (t [s], |B| [T]) samples with
+  // increasing times, held at the first value before it and at the last after it. When given
+  // it replaces magnitude + ramp_time, and uniform_magnitude is the schedule's peak |B|.
+  std::vector<std::pair<double, double>> schedule;
 };
 
 // Explicit walls for scenes without a roller (Kawamoto's compression test: stage and plate).
@@ -202,6 +207,17 @@ struct DemSettings
                                           // factor between two guard checks (100 steps)
 };
 
+// Kawamoto's compression test (dem/measurements/plate_compression.h): what the plate
+// measurement samples. It is taken when a box scene has both named planes.
+struct CompressionSettings
+{
+  std::string plate = "plate";      // name of the moving plane (the pseudo-photoreceptor)
+  std::string stage = "stage";      // name of the plane the brush stands on
+  double sample_interval = 1e-6;    // time between samples of the plate contacts [s]
+  double average_window = 20e-6;    // one output row = the mean of the samples in this window [s]
+  double map_interval = 0.0;        // time between per-bead contact maps [s] (0 = one at the end)
+};
+
 struct OutputSettings
 {
   std::string directory = "results";
@@ -226,6 +242,7 @@ struct Case
   AppliedField applied_field;
   FieldSettings field;
   DemSettings dem;
+  CompressionSettings compression; // added by the compression study
   OutputSettings output;
   std::string measured_flux_file;     // optional gaussmeter scan to overlay in the report
 

@@ -2,15 +2,17 @@
 //
 //   bench_compression_study full [UNTIL_MS]
 //       the case cases/kawamoto_brush_compression.yaml at its defaults (60 um, 4,420 beads,
-//       2 x 2 mm², 12-diameter cutoff with the slab tail, 20 ns step, plate down at 0.1 m/s to
+//       2 x 2 mm², the project's magnetics at their defaults, 20 ns step, plate down at 0.1 m/s to
 //       0.4 mm, then slid 1.5 mm): wall time, magnetic share, normal force against brush length
 //       and the sliding ratio. With UNTIL_MS the run stops there (dem.duration) and the table
 //       says so — a timing sample when the whole run does not fit.
-//   bench_compression_study diameters [BOX_IN_DIAMETERS [SEEDS]]
+//   bench_compression_study diameters [BOX_IN_DIAMETERS [SEEDS [defaults|paper]]]
 //       the reduced protocol of the regression test (compression_run.h) with the field sweep and
 //       the slide, for 42, 50 and 60 um in periodic squares of BOX_IN_DIAMETERS mean diameters
-//       (default 12), SEEDS insertions each (default 1): the 3-diameter table (forces in mN,
-//       densities, force per bead, spacing, F_t/F_n, the field exponent) and their spread.
+//       (default 12), SEEDS insertions each (default 1), with the project's default magnetics
+//       (untruncated cell-multipole far field) or the paper's (cutoff 4 d + slab tail): the
+//       3-diameter table (forces in mN, densities, force per bead, spacing, F_t/F_n, the field
+//       exponent) and the pooled ratios to Kawamoto's scaling.
 //
 // Prints tables, asserts nothing, exits 0 (a failed run is reported in the table).
 #include "compression_run.h"
@@ -46,10 +48,10 @@ void full(double until_ms)
     o.push_back("dem.duration=" + std::to_string(until_ms) + "ms");
   const Case c = load_case(std::string(MAGBRUSH_SOURCE_DIR) + "/cases/kawamoto_brush_compression.yaml", o);
   std::printf("# Kawamoto compression test at the case defaults: %s um x %ld beads on %.1f x %.1f mm², "
-              "cutoff %.0f d (slab tail), refresh %.3g us, step %.3g ns, simulated %.3g ms%s\n",
+              "far field %s (cutoff %.0f d if none), refresh %.3g us, step %.3g ns, simulated %.3g ms%s\n",
               std::to_string(std::lround(c.populations[0].diameter_mean * 1e6)).c_str(), c.populations[0].count,
-              c.dem.periodic_length_x * 1e3, c.dem.periodic_length_y * 1e3, c.dem.magnetic_cutoff,
-              c.dem.magnetic_refresh * 1e6, c.dem.time_step * 1e9, c.dem.duration * 1e3,
+              c.dem.periodic_length_x * 1e3, c.dem.periodic_length_y * 1e3, c.dem.magnetic_far_field.c_str(),
+              c.dem.magnetic_cutoff, c.dem.magnetic_refresh * 1e6, c.dem.time_step * 1e9, c.dem.duration * 1e3,
               until_ms > 0 ? " (STOPPED EARLY: a timing sample, not the whole test)" : "");
   RunResult r;
   try
@@ -63,10 +65,11 @@ void full(double until_ms)
     return;
   }
   const double steps = c.dem.duration / c.dem.time_step;
-  std::printf("\n| beads | simulated [ms] | wall [s] | magnetic share | wall per simulated ms [s] | particle-steps/s |\n"
-              "|---|---|---|---|---|---|\n| %ld | %.3g | %.1f | %.1f %% | %.1f | %.3g |\n",
-              r.beads, c.dem.duration * 1e3, r.wall_s, 100 * r.magnetic_s / r.wall_s, r.wall_s / (c.dem.duration * 1e3),
-              steps * static_cast<double>(r.beads) / r.wall_s);
+  std::printf(
+      "\n| beads | simulated [ms] | wall [s] | magnetic share | wall per simulated ms [s] | particle-steps/s |\n"
+      "|---|---|---|---|---|---|\n| %ld | %.3g | %.1f | %.1f %% | %.1f | %.3g |\n",
+      r.beads, c.dem.duration * 1e3, r.wall_s, 100 * r.magnetic_s / r.wall_s, r.wall_s / (c.dem.duration * 1e3),
+      steps * static_cast<double>(r.beads) / r.wall_s);
   std::printf("\nnormal force against brush length (130 mT, plate at 0.1 m/s):\n\n"
               "| brush length [mm] | F_n [mN] | pressure [kPa] | touching | density [1/mm²] | force/bead [uN] | "
               "l/sqrt(n) [um] |\n|---|---|---|---|---|---|---|\n");
@@ -79,8 +82,8 @@ void full(double until_ms)
     const WindowMean w = mean_over(in, {0.0, 1.0});
     if (w.rows == 0)
       continue;
-    std::printf("| %.2f | %.4f | %.3f | %.1f | %.1f | %.2f | %.1f |\n", L, w.fn * 1e3, w.fn / r.area * 1e-3,
-                w.touching, w.touching / r.area * 1e-6, w.touching > 0 ? w.fn / w.touching * 1e6 : 0.0,
+    std::printf("| %.2f | %.4f | %.3f | %.1f | %.1f | %.2f | %.1f |\n", L, w.fn * 1e3, w.fn / r.area * 1e-3, w.touching,
+                w.touching / r.area * 1e-6, w.touching > 0 ? w.fn / w.touching * 1e6 : 0.0,
                 w.touching > 0 ? std::sqrt(r.area / w.touching) * 1e6 : 0.0);
   }
   const WindowMean s = mean_over(r.rows, {12.5e-3, 14.5e-3});
@@ -90,18 +93,19 @@ void full(double until_ms)
   fs::remove_all(dir);
 }
 
-void diameters(double box_in_d, int seeds)
+void diameters(double box_in_d, int seeds, bool paper)
 {
   std::printf("# Kawamoto compression, reduced protocol (compression_run.h) in squares of %.0f mean diameters, "
-              "%d insertion(s) per size, cutoff 4 d + slab tail, step 35 ns\n\n",
-              box_in_d, seeds);
+              "%d insertion(s) per size, %s magnetics, step 35 ns\n\n",
+              box_in_d, seeds,
+              paper ? "the paper's (cutoff 4 d + slab tail)" : "the project's default (cell-multipole far field)");
   std::printf("| d [um] | box [mm] | beads | wall [s] | magnetic | F_n 0.95 mm [mN] | F_n 0.65 mm [mN] | "
               "p(0.6 mm) [kPa] | density [1/mm²] | force/bead [uN] | l/sqrt(n) [um] | F_t/F_n | k (F~B^k, 20-50 mT) |\n"
               "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   struct Row
   {
     int d;
-    double p, density, per_bead;
+    double fn, touching, area; // at the hold, 0.6 mm and 130 mT
   };
   std::vector<Row> rows;
   for (int d : {42, 50, 60})
@@ -113,6 +117,7 @@ void diameters(double box_in_d, int seeds)
       s.diameter_um = d;
       s.box_mm = box;
       s.seed = static_cast<unsigned long>(seed);
+      s.paper_magnetics = paper;
       const fs::path dir = scratch(std::to_string(d) + "_" + std::to_string(seed));
       RunResult r;
       try
@@ -141,24 +146,42 @@ void diameters(double box_in_d, int seeds)
                   h.fn / r.area * 1e-3, density * 1e-6, per_bead * 1e6, 1e6 / std::sqrt(density), sl.ft / sl.fn,
                   power_law_exponent(b, f));
       std::fflush(stdout);
-      rows.push_back({d, h.fn / r.area, density, per_bead});
+      rows.push_back({d, h.fn, h.touching, r.area});
       fs::remove_all(dir);
     }
   }
-  if (rows.size() < 2)
-    return;
-  double pm = 0;
-  for (const auto &r : rows)
-    pm += r.p / static_cast<double>(rows.size());
-  const Row &ref = rows.back(); // 60 um
-  std::printf("\nrelative to the %d um row: pressure / mean pressure, density x d² and force per bead / d² "
-              "(1 = Kawamoto's scaling)\n\n| d [um] | p / mean | density d² | force/bead / d² |\n|---|---|---|---|\n",
-              ref.d);
+  // Pool the insertions of each size (total force, beads and area), then compare the sizes.
+  struct Pool
+  {
+    int d;
+    double fn = 0, touching = 0, area = 0;
+  };
+  std::vector<Pool> pools;
   for (const auto &r : rows)
   {
-    const double d2 = (static_cast<double>(r.d) / ref.d) * (static_cast<double>(r.d) / ref.d);
-    std::printf("| %d | %.3f | %.3f | %.3f |\n", r.d, r.p / pm, r.density * d2 / ref.density,
-                r.per_bead / d2 / ref.per_bead);
+    if (pools.empty() || pools.back().d != r.d)
+      pools.push_back({r.d});
+    pools.back().fn += r.fn;
+    pools.back().touching += r.touching;
+    pools.back().area += r.area;
+  }
+  if (pools.size() < 2)
+    return;
+  double pm = 0;
+  for (const auto &p : pools)
+    pm += p.fn / p.area / static_cast<double>(pools.size());
+  const Pool &ref = pools.back(); // 60 um
+  std::printf("\npooled insertions, relative to %d um: pressure / mean pressure, density x d² and force per bead / d² "
+              "(1 = Kawamoto's scaling)\n\n| d [um] | p [kPa] | p / mean | density [1/mm²] | density d² | "
+              "force/bead [uN] | force/bead / d² |\n|---|---|---|---|---|---|---|\n",
+              ref.d);
+  for (const auto &p : pools)
+  {
+    const double d2 = (static_cast<double>(p.d) / ref.d) * (static_cast<double>(p.d) / ref.d);
+    const double density = p.touching / p.area, ref_density = ref.touching / ref.area;
+    const double per_bead = p.fn / p.touching, ref_per_bead = ref.fn / ref.touching;
+    std::printf("| %d | %.3f | %.3f | %.1f | %.3f | %.2f | %.3f |\n", p.d, p.fn / p.area * 1e-3, p.fn / p.area / pm,
+                density * 1e-6, density * d2 / ref_density, per_bead * 1e6, per_bead / d2 / ref_per_bead);
   }
 }
 
@@ -170,8 +193,10 @@ int main(int argc, char **argv)
   if (mode == "full")
     full(argc > 2 ? std::atof(argv[2]) : 0.0);
   else if (mode == "diameters")
-    diameters(argc > 2 ? std::atof(argv[2]) : 12.0, argc > 3 ? std::atoi(argv[3]) : 1);
+    diameters(argc > 2 ? std::atof(argv[2]) : 12.0, argc > 3 ? std::atoi(argv[3]) : 1,
+              argc > 4 && std::string(argv[4]) == "paper");
   else
-    std::printf("usage: bench_compression_study full [UNTIL_MS] | diameters [BOX_IN_DIAMETERS [SEEDS]]\n");
+    std::printf(
+        "usage: bench_compression_study full [UNTIL_MS] | diameters [BOX_IN_DIAMETERS [SEEDS [defaults|paper]]]\n");
   return 0;
 }

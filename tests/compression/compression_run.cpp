@@ -52,23 +52,26 @@ const std::vector<FieldHold> &field_holds()
 Case reduced_case(const ReducedScene &s, const std::string &output_dir)
 {
   const std::string box = fmt("%gmm", s.box_mm);
-  std::vector<std::string> o{
-      "populations.carrier.diameter=" + std::to_string(s.diameter_um) + "um",
-      "populations.carrier.diameter_std=" + fmt("%gum", s.diameter_um / 10.0),
-      "populations.carrier.count=" + std::to_string(bead_count(s.diameter_um, s.box_mm)),
-      "dem.periodic_length_x=" + box,
-      "dem.periodic_length_y=" + box,
-      "populations.carrier.insert_box=[[0mm, 0mm, 0.03mm], [" + box + ", " + box + ", 0.9mm]]",
-      "dem.seed=" + std::to_string(s.seed),
-      "dem.time_step=" + fmt("%gs", s.time_step),
-      "dem.magnetic_cutoff=" + fmt("%g", s.cutoff),
-      "dem.output_interval=0s",
-      "output.directory=" + output_dir,
-      "output.vtu=false",
-      "output.xdmf=false",
-      "compression.average_window=10us",
-      "compression.map_interval=0s",
-      "planes.plate.point=[0mm, 0mm, 1.0mm]"};
+  std::vector<std::string> o{"populations.carrier.diameter=" + std::to_string(s.diameter_um) + "um",
+                             "populations.carrier.diameter_std=" + fmt("%gum", s.diameter_um / 10.0),
+                             "populations.carrier.count=" + std::to_string(bead_count(s.diameter_um, s.box_mm)),
+                             "dem.periodic_length_x=" + box,
+                             "dem.periodic_length_y=" + box,
+                             "populations.carrier.insert_box=[[0mm, 0mm, 0.03mm], [" + box + ", " + box + ", 0.9mm]]",
+                             "dem.seed=" + std::to_string(s.seed),
+                             "dem.time_step=" + fmt("%gs", s.time_step),
+                             "dem.output_interval=0s",
+                             "output.directory=" + output_dir,
+                             "output.vtu=false",
+                             "output.xdmf=false",
+                             "compression.average_window=10us",
+                             "compression.map_interval=0s",
+                             "planes.plate.point=[0mm, 0mm, 1.0mm]"};
+  if (s.paper_magnetics)
+  {
+    o.push_back("dem.magnetic_far_field=none");
+    o.push_back("dem.magnetic_cutoff=4");
+  }
   if (s.sweep_and_slide)
   {
     o.push_back("planes.plate.path=[{time: 0ms, displacement: [0,0,0]}, {time: 0.4ms, displacement: [0,0,0]},"

@@ -24,11 +24,14 @@ namespace magbrush::compression_test {
 struct ReducedScene
 {
   int diameter_um = 60;
-  double box_mm = 0.7;        // periodic square side
+  double box_mm = 0.7; // periodic square side
   unsigned long seed = 1;
   bool sweep_and_slide = true;
-  double time_step = 3.5e-8;  // below the 3.8e-8 s limit of the 42 um beads
-  double cutoff = 4.0;        // the paper's interaction sphere (8 diameters wide), with the slab tail
+  double time_step = 3.5e-8; // below the 3.8e-8 s limit of the 42 um beads
+  // true: the paper's magnetics (A9–A11 truncated at its interaction sphere 8 diameters wide:
+  // far field none, cutoff 4 d, plus our slab tail); false: the case's, i.e. the project
+  // defaults (no cutoff: the cell-multipole far field).
+  bool paper_magnetics = true;
 };
 
 // Kawamoto's bead count of this size on 2 x 2 mm² (equal mass per area), scaled to the box.
@@ -46,18 +49,18 @@ struct FieldHold
   double field_mT;
   Window w;
 };
-const std::vector<FieldHold> &field_holds(); // 130, 80, 50, 30, 20 mT (the second half of each hold)
-constexpr Window slide_steady{6.7e-3, 7.7e-3};  // the last 0.25 mm of the slide
+const std::vector<FieldHold> &field_holds();   // 130, 80, 50, 30, 20 mT (the second half of each hold)
+constexpr Window slide_steady{6.7e-3, 7.7e-3}; // the last 0.25 mm of the slide
 
 Case reduced_case(const ReducedScene &s, const std::string &output_dir);
 
 struct RunResult
 {
   std::vector<dem::PlateCompressionRow> rows;
-  double area = 0.0;          // [m²]
+  double area = 0.0; // [m²]
   long beads = 0;
-  double wall_s = 0.0;        // run() wall time
-  double magnetic_s = 0.0;    // of which the magnetic term
+  double wall_s = 0.0;     // run() wall time
+  double magnetic_s = 0.0; // of which the magnetic term
   std::string log;
 };
 

@@ -4,6 +4,7 @@
 #include "case_hash.h"
 #include "field_grid.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -41,6 +42,32 @@ AppliedMagneticField AppliedMagneticField::uniform(const Vec3 &direction, double
   return f;
 }
 
+AppliedMagneticField AppliedMagneticField::uniform_schedule(
+    const Vec3 &direction, const std::vector<std::pair<double, double>> &schedule)
+{
+  double peak = 0.0;
+  for (std::size_t i = 0; i < schedule.size(); ++i)
+  {
+    const auto &[t, b] = schedule[i];
+    if (!(std::isfinite(t) && std::isfinite(b) && b >= 0.0))
+      throw std::invalid_argument("applied magnetic field: schedule sample " + std::to_string(i) +
+                                  " must have a finite time and a magnitude ≥ 0, found (" + std::to_string(t) +
+                                  " s, " + std::to_string(b) + " T)");
+    if (i > 0 && !(t > schedule[i - 1].first))
+      throw std::invalid_argument("applied magnetic field: schedule times must increase; sample " +
+                                  std::to_string(i) + " at " + std::to_string(t) + " s follows " +
+                                  std::to_string(schedule[i - 1].first) + " s");
+    peak = std::max(peak, b);
+  }
+  if (!(peak > 0.0))
+    throw std::invalid_argument(
+        "applied magnetic field: a schedule needs at least one sample with |B| > 0 (applied_field.schedule)");
+  AppliedMagneticField f = uniform(direction, peak);
+  for (const auto &[t, b] : schedule)
+    f.schedule_.emplace_back(t, b / peak);
+  return f;
+}
+
 AppliedMagneticField AppliedMagneticField::roller(std::shared_ptr<const PolarFieldInterpolator> grid,
                                                   double ramp_time)
 {
@@ -64,6 +91,8 @@ AppliedMagneticField AppliedMagneticField::from_settings(
   case AppliedField::Kind::none:
     return AppliedMagneticField();
   case AppliedField::Kind::uniform:
+    if (!settings.schedule.empty())
+      return uniform_schedule(settings.uniform_direction, settings.schedule);
     return uniform(settings.uniform_direction, settings.uniform_magnitude, settings.ramp_time);
   case AppliedField::Kind::roller:
     return roller(std::move(grid), settings.ramp_time);

@@ -6,6 +6,9 @@
 //  * uniform: B = s(t) B_0 d̂, ∇B = 0, no grid lookup at all (Kawamoto's compression test);
 //  * roller:  s(t) × the polar-grid interpolator of the roller's A_z (polar_field_interpolator.h).
 // The ramp s(t) = min(1, t / ramp_time) (s = 1 when ramp_time = 0) multiplies either kind.
+// A uniform field may instead follow a piecewise-linear schedule |B|(t) (AppliedField::schedule:
+// Kawamoto's field sweep at a held plate): then s(t) = |B|(t) / max|B|, linear between the
+// samples, held at the end values outside them.
 //
 // With a uniform (or no) field, ∇B = 0 and the applied force (p·∇)B vanishes:
 // has_gradient() lets the DEM skip that term and report it as off.
@@ -20,6 +23,8 @@
 #include <array>
 #include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace magbrush {
 
@@ -31,6 +36,10 @@ public:
   AppliedMagneticField() = default; // none
   static AppliedMagneticField uniform(const Vec3 &direction, double magnitude,
                                       double ramp_time = 0.0);
+  // A uniform field whose magnitude follows the piecewise-linear schedule (t [s], |B| [T]):
+  // times strictly increasing, magnitudes ≥ 0 with at least one > 0.
+  static AppliedMagneticField uniform_schedule(const Vec3 &direction,
+                                               const std::vector<std::pair<double, double>> &schedule);
   static AppliedMagneticField roller(std::shared_ptr<const PolarFieldInterpolator> grid,
                                      double ramp_time = 0.0);
   // From the case's AppliedField; `grid` is required for Kind::roller (read it with
@@ -53,6 +62,8 @@ public:
   // The ramp factor s(t) ∈ [0, 1].
   double ramp(double t) const
   {
+    if (!schedule_.empty())
+      return scheduled(t);
     if (ramp_time_ <= 0.0 || t >= ramp_time_)
       return 1.0;
     return t > 0.0 ? t / ramp_time_ : 0.0;
@@ -123,7 +134,28 @@ public:
     }
   }
 
+  // The schedule as (t, s) samples (empty for the linear ramp).
+  const std::vector<std::pair<double, double>> &schedule() const { return schedule_; }
+
 private:
+  // Piecewise-linear s(t) through the schedule's samples (binary search: a handful of points).
+  double scheduled(double t) const
+  {
+    if (t <= schedule_.front().first)
+      return schedule_.front().second;
+    if (t >= schedule_.back().first)
+      return schedule_.back().second;
+    std::size_t lo = 0, hi = schedule_.size() - 1;
+    while (hi - lo > 1)
+    {
+      const std::size_t mid = (lo + hi) / 2;
+      (schedule_[mid].first <= t ? lo : hi) = mid;
+    }
+    const auto &[t0, s0] = schedule_[lo];
+    const auto &[t1, s1] = schedule_[hi];
+    return s0 + (s1 - s0) * (t - t0) / (t1 - t0);
+  }
+
   static void scale(double s, Vec3 &B, std::array<Vec3, 3> &gradB)
   {
     for (int i = 0; i < 3; ++i)
@@ -137,6 +169,7 @@ private:
   Kind kind_ = Kind::none;
   Vec3 uniform_B_{0.0, 0.0, 0.0}; // final field B_0 d̂ [T]
   double ramp_time_ = 0.0;
+  std::vector<std::pair<double, double>> schedule_; // (t, s(t)) samples; empty = linear ramp
   std::shared_ptr<const PolarFieldInterpolator> grid_;
 };
 

@@ -205,8 +205,17 @@ std::vector<ResolvedEntry> resolved_entries(const Case &c)
   e.s("applied_field.kind", "applied_field.kind",
       f.kind == AppliedField::Kind::roller ? "roller" : f.kind == AppliedField::Kind::uniform ? "uniform" : "none");
   e.v3("applied_field.direction", "applied_field.direction", f.uniform_direction);
-  e.q("applied_field.magnitude", "applied_field.magnitude", f.uniform_magnitude);
-  e.q("applied_field.ramp_time", "applied_field.ramp_time", f.ramp_time);
+  if (f.schedule.empty())
+  {
+    e.q("applied_field.magnitude", "applied_field.magnitude", f.uniform_magnitude);
+    e.q("applied_field.ramp_time", "applied_field.ramp_time", f.ramp_time);
+  }
+  for (std::size_t k = 0; k < f.schedule.size(); ++k)
+  {
+    const std::string s = "applied_field.schedule[" + std::to_string(k) + "]";
+    e.q(s + ".time", "applied_field.schedule[].time", f.schedule[k].first);
+    e.q(s + ".magnitude", "applied_field.schedule[].magnitude", f.schedule[k].second);
+  }
 
   const auto &fs = c.field;
   e.q("field.mesh_size_far", "field.mesh_size_far", fs.mesh_size_far);
@@ -250,6 +259,13 @@ std::vector<ResolvedEntry> resolved_entries(const Case &c)
   e.q("nip.half_width", "nip.half_width", c.nip.half_width);
   e.q("nip.chain_bin_angle", "nip.chain_bin_angle", c.nip.chain_bin_angle);
   e.q("nip.chain_half_angle", "nip.chain_half_angle", c.nip.chain_half_angle);
+
+  const auto &m = c.compression;
+  e.s("compression.plate", "compression.plate", m.plate);
+  e.s("compression.stage", "compression.stage", m.stage);
+  e.q("compression.sample_interval", "compression.sample_interval", m.sample_interval);
+  e.q("compression.average_window", "compression.average_window", m.average_window);
+  e.q("compression.map_interval", "compression.map_interval", m.map_interval);
 
   e.s("output.directory", "output.directory", c.output.directory);
   e.b("output.vtu", "output.vtu", c.output.vtu);

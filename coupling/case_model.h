@@ -139,6 +139,11 @@ struct AppliedField
   Vec3 uniform_direction{{0.0, 0.0, 1.0}};
   double uniform_magnitude = 0.0; // |B| [T] at the end of the ramp
   double ramp_time = 0.0;         // linear ramp 0 → |B| over this time [s] (0 = on at once)
+  // Added for Kawamoto's compression study (field sweep at a held plate): an optional
+  // piecewise-linear schedule of the uniform field's magnitude, (t [s], |B| [T]) samples with
+  // increasing times, held at the first value before it and at the last after it. When given
+  // it replaces magnitude + ramp_time, and uniform_magnitude is the schedule's peak |B|.
+  std::vector<std::pair<double, double>> schedule;
 };
 
 // Explicit walls for scenes without a roller (Kawamoto's compression test: stage and plate).
@@ -197,7 +202,7 @@ struct DemSettings
 };
 
 // The development-nip measurements (dem/measurements/nip_profile.h, chain_inclination.h,
-// nip_bead_count.h): what they sample and how they bin. Taken when the scene has a sleeve and
+// nip_time_series.h): what they sample and how they bin. Taken when the scene has a sleeve and
 // a drum. Positions along the nip are x, the distance from the gap centre along the common
 // tangent of sleeve and drum (positive downstream, the way the sleeve surface moves).
 struct NipSettings
@@ -208,6 +213,17 @@ struct NipSettings
   double half_width = 4e-3;         // profiles cover -half_width <= x <= half_width [m]
   double chain_bin_angle = 2.0 * 3.14159265358979323846 / 180.0;   // chain bins in sleeve angle [rad]
   double chain_half_angle = 30.0 * 3.14159265358979323846 / 180.0; // chain profile extent [rad]
+};
+
+// Kawamoto's compression test (dem/measurements/plate_compression.h): what the plate
+// measurement samples. It is taken when a box scene has both named planes.
+struct CompressionSettings
+{
+  std::string plate = "plate";      // name of the moving plane (the pseudo-photoreceptor)
+  std::string stage = "stage";      // name of the plane the brush stands on
+  double sample_interval = 1e-6;    // time between samples of the plate contacts [s]
+  double average_window = 20e-6;    // one output row = the mean of the samples in this window [s]
+  double map_interval = 0.0;        // time between per-bead contact maps [s] (0 = one at the end)
 };
 
 struct OutputSettings
@@ -235,6 +251,7 @@ struct Case
   FieldSettings field;
   DemSettings dem;
   NipSettings nip;                    // added by the nip measurements
+  CompressionSettings compression; // added by the compression study
   OutputSettings output;
   std::string measured_flux_file;     // optional gaussmeter scan to overlay in the report
 

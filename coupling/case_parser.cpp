@@ -767,6 +767,7 @@ private:
     build_field(c.field, top.child("field"));
     build_dem(c.dem, top.child("dem"));
     build_nip(c.nip, top.child("nip"));
+    build_compression(c.compression, top.child("compression"));
     const Scope o = top.child("output");
     c.output.directory = str(o, "directory");
     c.output.vtu = flag(o, "vtu");
@@ -951,6 +952,27 @@ private:
       error_at_path(s.child("direction").display, "expected a non-zero direction, found [0, 0, 0]");
     f.uniform_magnitude = q(s, "magnitude");
     f.ramp_time = q(s, "ramp_time");
+    for (const auto &e : elements(s.child("schedule"), "[]"))
+      f.schedule.emplace_back(q(e, "time"), q(e, "magnitude"));
+    if (!f.schedule.empty())
+    {
+      for (const char *k : {"magnitude", "ramp_time"})
+        if (has(s, k) && q(s, k) != 0.0)
+          error_at_path(s.child(k).display, std::string("give either a schedule or ") + k +
+                                                " (the schedule sets |B|(t) itself); remove one of them (or set it to 0)");
+      f.uniform_magnitude = 0.0;
+      for (const auto &[t, b] : f.schedule)
+        f.uniform_magnitude = std::max(f.uniform_magnitude, b);
+    }
+  }
+
+  void build_compression(CompressionSettings &m, const Scope &s)
+  {
+    m.plate = str(s, "plate");
+    m.stage = str(s, "stage");
+    m.sample_interval = q(s, "sample_interval");
+    m.average_window = q(s, "average_window");
+    m.map_interval = q(s, "map_interval");
   }
 
   void build_field(FieldSettings &f, const Scope &s)

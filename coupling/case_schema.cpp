@@ -215,6 +215,12 @@ std::vector<KeySpec> build_schema()
           .def("0 mT").non_negative(),
       quantity("applied_field.ramp_time", D::time, "Linear ramp 0 -> |B| over this time (0 = on at once).")
           .def("0 s").non_negative(),
+      list("applied_field.schedule",
+           "Uniform field only: piecewise-linear |B|(t) as (time, magnitude) samples, times increasing, held "
+           "before the first and after the last (replaces magnitude and ramp_time; e.g. a field sweep at a held plate)."),
+      quantity("applied_field.schedule[].time", D::time, "Sample time.").required().non_negative(),
+      quantity("applied_field.schedule[].magnitude", D::magnetic_flux_density, "|B| at that time.")
+          .required().non_negative(),
 
       section("field", "Field solver: meshes, element degree, exported grids."),
       quantity("field.mesh_size_far", D::length, "Element size away from the sleeve.").def("2 mm").positive().affects(A::both),
@@ -271,6 +277,17 @@ std::vector<KeySpec> build_schema()
           .def("2 deg").positive(),
       quantity("nip.chain_half_angle", D::angle, "The chain-inclination profile covers sleeve angles within this of the gap centre.")
           .def("30 deg").positive().max(180.0 * pi / 180.0),
+
+      section("compression", "Kawamoto's compression test: the plate measurement of a box scene with a moving "
+                             "plate and a stage (forces, touching beads, chain spacing, contact maps; docs/compression_study.md)."),
+      text("compression.plate", "Name of the moving plane wall (the pseudo-photoreceptor plate).").def("plate"),
+      text("compression.stage", "Name of the plane wall the brush stands on.").def("stage"),
+      quantity("compression.sample_interval", D::time, "Time between samples of the beads touching the plate.")
+          .def("1 us").positive(),
+      quantity("compression.average_window", D::time, "One output row is the mean of the samples in this window.")
+          .def("20 us").positive(),
+      quantity("compression.map_interval", D::time, "Time between per-bead contact maps (0 = one map at the end).")
+          .def("0 s").non_negative(),
 
       section("output", "Results."),
       text("output.directory", "Results directory.").def("results"),

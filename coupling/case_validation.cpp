@@ -285,7 +285,17 @@ void check_fields(const Case &c, std::vector<CaseIssue> &out)
   if (f.kind == AppliedField::Kind::roller && !c.roller)
     out.push_back({"applied_field.kind", "the applied field comes from the roller, but the case has no 'roller' section"});
   if (f.kind == AppliedField::Kind::uniform && f.uniform_magnitude <= 0.0)
-    out.push_back({"applied_field.magnitude", "a uniform applied field needs a magnitude > 0 (e.g. 130 mT)"});
+    out.push_back({f.schedule.empty() ? "applied_field.magnitude" : "applied_field.schedule",
+                   f.schedule.empty() ? "a uniform applied field needs a magnitude > 0 (e.g. 130 mT)"
+                                      : "a uniform field schedule needs at least one magnitude > 0"});
+  if (!f.schedule.empty() && f.kind != AppliedField::Kind::uniform)
+    out.push_back({"applied_field.schedule", "a schedule is for the uniform field (applied_field.kind: uniform); "
+                                             "a roller field is ramped with ramp_time"});
+  for (size_t i = 1; i < f.schedule.size(); ++i)
+    if (f.schedule[i].first <= f.schedule[i - 1].first)
+      out.push_back({"applied_field.schedule[" + std::to_string(i) + "].time",
+                     "schedule times must increase; found " + format_quantity(f.schedule[i].first, Dimension::time) +
+                         " after " + format_quantity(f.schedule[i - 1].first, Dimension::time)});
   if (c.roller && c.field.probe_radius > 0.0 && c.field.probe_radius <= c.roller->magnet_radius)
     out.push_back({"field.probe_radius", "the probe radius " + L(c.field.probe_radius) +
                                              " lies inside the magnet (radius " + L(c.roller->magnet_radius) + ")"});

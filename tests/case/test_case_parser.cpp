@@ -280,6 +280,7 @@ TEST(CaseSchema, PrintedEntriesAndSchemaAgree)
                                      "blades[].length", "electric.image.dark_potential",
                                      "electric.image.light_potential", "planes[].path[].time",
                                      "planes[].path[].displacement", "planes[].name", "planes[].point",
+                                     "applied_field.schedule[].time", "applied_field.schedule[].magnitude",
                                      "planes[].normal", "planes[].material"};
   for (const auto &k : case_schema())
     if (!k.is_container() && !folded.count(k.path))

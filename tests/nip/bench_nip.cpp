@@ -197,7 +197,7 @@ int main(int argc, char **argv)
         std::printf("  %-24s %10.2f  %5.1f %%\n", name.c_str(), sec, costs[k].wall > 0 ? 100 * sec / costs[k].wall : 0);
     }
     const Table a = read_csv(dirs[0] / "dem" / "nip_profile.csv"), b = read_csv(dirs[1] / "dem" / "nip_profile.csv");
-    const auto sa = summary(dirs[0] / "dem"), sb = summary(dirs[1] / "dem");
+    auto sa = summary(dirs[0] / "dem"), sb = summary(dirs[1] / "dem");
     if (a.count("x_mm") && b.count("x_mm"))
     {
       std::printf("\n== nip profiles: papers' magnetics against ours ==\n");

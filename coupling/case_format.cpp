@@ -244,6 +244,9 @@ std::vector<ResolvedEntry> resolved_entries(const Case &c)
   e.q("dem.magnetic_refresh", "dem.magnetic_refresh", d.magnetic_refresh);
   e.q("dem.magnetic_tolerance", "dem.magnetic_tolerance", d.magnetic_tolerance);
   e.q("dem.verlet_skin", "dem.verlet_skin", d.verlet_skin);
+  e.s("dem.magnetic_far_field", "dem.magnetic_far_field", d.magnetic_far_field);
+  e.i("dem.magnetic_far_order", "dem.magnetic_far_order", d.magnetic_far_order);
+  e.q("dem.magnetic_far_cell", "dem.magnetic_far_cell", d.magnetic_far_cell);
   e.q("dem.air_viscosity", "dem.air_viscosity", d.air_viscosity);
   e.v3("dem.gravity", "dem.gravity", d.gravity);
   e.i("dem.seed", "dem.seed", static_cast<long long>(d.seed));

@@ -1015,6 +1015,9 @@ private:
     d.magnetic_refresh = q(s, "magnetic_refresh");
     d.magnetic_tolerance = q(s, "magnetic_tolerance");
     d.verlet_skin = q(s, "verlet_skin");
+    d.magnetic_far_field = str(s, "magnetic_far_field");
+    d.magnetic_far_order = static_cast<int>(integer(s, "magnetic_far_order"));
+    d.magnetic_far_cell = q(s, "magnetic_far_cell");
     d.air_viscosity = q(s, "air_viscosity");
     d.gravity = vec3(s, "gravity");
     d.seed = static_cast<unsigned long>(integer(s, "seed"));

@@ -249,10 +249,15 @@ std::vector<KeySpec> build_schema()
       choice("dem.magnetic_model", {"point_dipole", "mutual_dipole", "corrected"},
              "Carrier magnetics: fixed point dipoles, mutual induction, or mutual + exact two-sphere correction.")
           .def("corrected"),
-      number("dem.magnetic_cutoff", "Dipole interaction cutoff radius in mean carrier diameters (12: <= 1 % force error in a brush with the slab tail, docs/magnetics.md; the papers used 4).").def("12").positive(),
+      number("dem.magnetic_cutoff", "Hard cutoff radius in mean carrier diameters, used only with magnetic_far_field: none (12: ~1 % force error in a brush with the slab tail, 5 % in the nip slab, docs/magnetics.md; the papers used 4).").def("12").positive(),
       quantity("dem.magnetic_refresh", D::time, "Magnetic force refresh interval (0 = every step).").def("0 s").non_negative(),
-      number("dem.magnetic_tolerance", "Mutual-induction relative tolerance.").def("1e-6").positive(),
+      number("dem.magnetic_tolerance", "Mutual-induction relative tolerance (1e-4: force error ~1e-5, docs/magnetics.md).").def("1e-4").positive(),
       number("dem.verlet_skin", "Neighbour-list skin as a fraction of the mean diameter.").def("0.3").positive(),
+      choice("dem.magnetic_far_field", {"none", "cell_multipole"},
+             "Magnetic far field: cell_multipole (no cutoff: exact pairs within 2 fine cells, the whole rest of the domain and every periodic image by cell multipoles, docs/magnetics.md) or none (hard cutoff at magnetic_cutoff).")
+          .def("cell_multipole"),
+      integer("dem.magnetic_far_order", "Taylor order of the cell multipoles (error vs cost in docs/magnetics.md).").def("2").non_negative().max(6),
+      number("dem.magnetic_far_cell", "Fine cell size of the magnetic far field in mean carrier diameters (1.5 with order 2: <= 0.7 % RMS force error in brushes, docs/magnetics.md).").def("1.5").positive().max(10.0),
       quantity("dem.air_viscosity", D::viscosity, "Air viscosity for Stokes drag (0 = no drag).").def("1.81e-5 Pa*s").non_negative(),
       vector3("dem.gravity", D::acceleration, "Gravitational acceleration.").def("[0, -9.81 m/s^2, 0]"),
       integer("dem.seed", "Random seed (insertion, size distribution).").def("1").non_negative(),

@@ -69,19 +69,23 @@ struct MindlinTangential
   {
     xi = xi - dot(xi, n) * n;
   }
-  // Returns the tangential force on i and updates ξ.
+  // Returns the tangential force on i and updates ξ. Written without branches (the sliding
+  // case is a select), so that the pair kernel vectorises; the result is the same as the
+  // branchy form, bit for bit.
   static Vector3 force(Vector3 &xi, const Vector3 &v_t, double k_t, double c_t, double mu,
                        double f_n, double dt)
   {
     xi += dt * v_t;
-    Vector3 f = -(k_t * xi) - c_t * v_t;
+    const Vector3 f_stick = -(k_t * xi) - c_t * v_t;
     const double limit = mu * f_n;
-    const double f2 = dot(f, f);
-    if (f2 > limit * limit)
-    {
-      f = (limit / std::sqrt(f2)) * f;
-      xi = (k_t > 0.0 ? -1.0 / k_t : 0.0) * (f + c_t * v_t);
-    }
+    const double f2 = dot(f_stick, f_stick);
+    const bool sliding = f2 > limit * limit; // implies f2 > 0
+    const double scale = sliding ? limit / std::sqrt(sliding ? f2 : 1.0) : 1.0;
+    const Vector3 f = scale * f_stick;
+    // Sliding: the spring extension that carries the Coulomb force (k_t > 0 while touching).
+    const double inv_k = k_t > 0.0 ? -1.0 / (k_t > 0.0 ? k_t : 1.0) : 0.0;
+    const Vector3 xi_slide = inv_k * (f + c_t * v_t);
+    xi = {sliding ? xi_slide.x : xi.x, sliding ? xi_slide.y : xi.y, sliding ? xi_slide.z : xi.z};
     return f;
   }
 };
@@ -92,6 +96,7 @@ struct MindlinTangential
 // wall and is frame-independent (a bead riding rigidly on a turning sleeve feels none).
 // A constant-magnitude torque chatters when ω_roll ≈ 0; it is therefore capped so that one
 // step cannot reverse the relative rolling velocity (then it acts like a stiff viscous lock).
+// Branch-free like the tangential spring: μ_r = 0, F_n = 0 or ω_roll = 0 give zero torques.
 struct RollingFriction
 {
   struct Torques
@@ -101,18 +106,16 @@ struct RollingFriction
   static Torques torque(const Vector3 &w_rel, const Vector3 &n, double mu_r, double f_n,
                         double r_i, double r_j, double inv_I_i, double inv_I_j, double dt)
   {
-    Torques t;
-    if (mu_r <= 0.0 || f_n <= 0.0)
-      return t;
     const Vector3 w_roll = w_rel - dot(w_rel, n) * n;
     const double w = norm(w_roll);
-    if (w <= 0.0)
-      return t;
-    const double m = mu_r * f_n;
+    const double m = std::max(0.0, mu_r * f_n); // torque magnitude before the cap
     // Change of |ω_roll| in one step under the full torques: m dt (r_i/I_i + r_j/I_j).
     const double full_change = m * dt * (r_i * inv_I_i + r_j * inv_I_j);
-    const double scale = full_change > w ? w / full_change : 1.0;
-    const Vector3 dir = (1.0 / w) * w_roll;
+    const bool capped = full_change > w; // implies full_change > 0
+    const double scale = capped ? w / (capped ? full_change : 1.0) : 1.0;
+    const double inv_w = w > 0.0 ? 1.0 / (w > 0.0 ? w : 1.0) : 0.0;
+    const Vector3 dir = inv_w * w_roll;
+    Torques t;
     t.on_i = -(scale * m * r_i) * dir;
     t.on_j = (scale * m * r_j) * dir;
     return t;

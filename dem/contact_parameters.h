@@ -55,6 +55,10 @@ public:
     return table_[static_cast<std::size_t>(s) * columns_ + n_species_ + static_cast<std::size_t>(w)];
   }
   std::size_t species() const { return n_species_; }
+  // Raw row-major view for the vectorised pair kernel: particle_pair(s, t) is
+  // data()[s * columns() + t].
+  const ContactCoefficients *data() const { return table_.data(); }
+  std::size_t columns() const { return columns_; }
   // One line per interaction type, for the log.
   std::string describe() const;
 

@@ -68,6 +68,17 @@ void DemSystem::setup_derived()
                                   std::to_string(particles_.species[i]) + " but the case has " +
                                   std::to_string(species_materials.size()) + " populations");
   table_.build(case_, species_materials, walls_.materials());
+  // The table again, one array per field (the pair kernel gathers from these).
+  const std::size_t types = table_.species() * table_.columns();
+  coefficient_fields_.assign(6 * types, 0.0);
+  for (std::size_t t = 0; t < types; ++t)
+  {
+    const ContactCoefficients &k = table_.data()[t];
+    const double fields[6] = {k.effective_modulus, k.effective_shear, k.friction,
+                              k.rolling_friction, k.damping_normal, k.damping_tangential};
+    for (std::size_t f = 0; f < 6; ++f)
+      coefficient_fields_[f * types + t] = fields[f];
+  }
   stable_ = stable_time_step(particles_, materials, species_names, table_, walls_.size(),
                              std::max(1.0, 2.0 * walls_.max_surface_speed()));
   dt_ = choose_time_step(case_.dem, stable_);
@@ -210,114 +221,251 @@ std::string DemSystem::describe_particle(std::size_t i) const
   return buf;
 }
 
+// ---------------------------------------------------------------------------------------
+// Particle–particle contacts.
+//
+// The half list stores each pair once, row by row (rows in particle order), so a range of
+// rows is a contiguous range of pairs. Rows are cut into fixed blocks (independent of the
+// thread count). For each block:
+//   * the pair kernel computes every pair's contact: the force on i (kept in the pair's slot,
+//     the partner needs it too), the torque on i (into a small per-thread buffer: only the
+//     row needs it) and the torque on j (into the pair's slot);
+//   * while that is still in cache, each row of the block sums its pairs: force and torque
+//     of particle i from its own pairs, in pair order.
+// After a barrier each particle adds the pairs in which it is the partner (its column, in
+// ascending pair order). The order of every sum is fixed by the list alone, so the forces
+// have the same bits on any number of threads, with no atomics.
+//
+// The kernel's loop body is branch-free (a pair that does not touch goes through the same
+// arithmetic at a harmless stand-in geometry and its outputs are selected to zero), so it
+// vectorises; an AVX-512 or AVX2 clone is picked at load time where the CPU has one. Vector
+// and scalar code give the same bits: every operation is an IEEE add, multiply, divide or
+// square root in the same order, and fused multiply-adds are off (dem/CMakeLists.txt).
+namespace {
+struct PairKernelData
+{
+  // Particles (read).
+  const double *x, *y, *z, *vx, *vy, *vz, *wx, *wy, *wz, *radius, *mass, *inv_inertia;
+  const std::int32_t *species;
+  // Pairs (read).
+  const std::int32_t *owner, *partner;
+  const std::int32_t *image;
+  const double *shift_x, *shift_y, *shift_z; // by image code
+  // Coefficients by interaction type (species s, t at s * table_columns + t), one array per
+  // field so that the vector code can gather them. `uniform`: one type only (one species),
+  // then the coefficients are loop constants and nothing is gathered.
+  const double *effective_modulus, *effective_shear, *friction, *rolling_friction, *damping_normal,
+      *damping_tangential;
+  std::int64_t table_columns;
+  bool uniform;
+  double dt, overlap_guard;
+  // Pairs (read and write): history; (write) force on i, torque on j, touching flag.
+  double *hx, *hy, *hz;
+  double *fx, *fy, *fz, *tjx, *tjy, *tjz;
+  std::int32_t *touching;
+};
+
+// Torque on i of the pairs p_begin + k, k = 0 .. block size (a per-thread buffer).
+struct RowTorques
+{
+  double *x, *y, *z;
+};
+
+// The kernel body for pairs [p_begin, p_end). Returns 1 when some pair overlaps by more than
+// the guard fraction of the smaller radius.
+template <bool Uniform>
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+inline int pair_loop(const PairKernelData &D, const RowTorques &T, std::int64_t p_begin, std::int64_t p_end)
+{
+  // Local restrict copies: the outputs alias neither the inputs nor each other, and the
+  // compiler must not reload the pointers from D after every store.
+  const double *__restrict x = D.x, *__restrict y = D.y, *__restrict z = D.z;
+  const double *__restrict vx = D.vx, *__restrict vy = D.vy, *__restrict vz = D.vz;
+  const double *__restrict wx = D.wx, *__restrict wy = D.wy, *__restrict wz = D.wz;
+  const double *__restrict radius = D.radius, *__restrict mass = D.mass, *__restrict inv_inertia = D.inv_inertia;
+  const std::int32_t *__restrict species = D.species, *__restrict owner = D.owner, *__restrict partner = D.partner;
+  const std::int32_t *__restrict image = D.image;
+  const double *__restrict shift_x = D.shift_x, *__restrict shift_y = D.shift_y, *__restrict shift_z = D.shift_z;
+  const double *__restrict E_star = D.effective_modulus, *__restrict G_star = D.effective_shear;
+  const double *__restrict mu = D.friction, *__restrict mu_r = D.rolling_friction;
+  const double *__restrict alpha_n = D.damping_normal, *__restrict alpha_t = D.damping_tangential;
+  const std::int64_t columns = D.table_columns;
+  const double dt = D.dt, guard = D.overlap_guard;
+  double *__restrict hx = D.hx, *__restrict hy = D.hy, *__restrict hz = D.hz;
+  double *__restrict fx = D.fx, *__restrict fy = D.fy, *__restrict fz = D.fz;
+  double *__restrict tjx = D.tjx, *__restrict tjy = D.tjy, *__restrict tjz = D.tjz;
+  double *__restrict tix = T.x - p_begin, *__restrict tiy = T.y - p_begin, *__restrict tiz = T.z - p_begin;
+  std::int32_t *__restrict touching = D.touching;
+  ContactCoefficients uniform_k;
+  if (Uniform)
+    uniform_k = {E_star[0], G_star[0], mu[0], mu_r[0], alpha_n[0], alpha_t[0]};
+  int alarm = 0;
+#pragma omp simd reduction(| : alarm)
+  for (std::int64_t p = p_begin; p < p_end; ++p)
+  {
+    const std::int64_t i = owner[p], j = partner[p];
+    const int im = image[p];
+    const Vector3 d{x[j] - x[i] + shift_x[im], y[j] - y[i] + shift_y[im], z[j] - z[i] + shift_z[im]};
+    const double ri = radius[i], rj = radius[j], reach = ri + rj;
+    const double r2 = dot(d, d);
+    const bool touch = r2 < reach * reach;
+    // A pair that does not touch computes at unit distance and zero overlap (no NaN, no
+    // infinity); its outputs are zeroed below.
+    const double dist = std::sqrt(touch ? r2 : 1.0), inv_dist = 1.0 / dist;
+    ContactKinematics c;
+    c.n = inv_dist * d;
+    c.overlap = touch ? reach - dist : 0.0;
+    alarm |= (touch & (c.overlap > guard * std::min(ri, rj))) ? 1 : 0;
+    // Distances from the centres to the plane of the contact circle.
+    c.lever_i = 0.5 * (dist + (ri * ri - rj * rj) * inv_dist);
+    c.lever_j = dist - c.lever_i;
+    const Vector3 wi{wx[i], wy[i], wz[i]}, wj{wx[j], wy[j], wz[j]};
+    const Vector3 vij{vx[i] - vx[j], vy[i] - vy[j], vz[i] - vz[j]};
+    c.v_rel = vij + cross(c.lever_i * wi + c.lever_j * wj, c.n);
+    c.w_rel = wi - wj;
+    c.R_star = ri * rj / reach;
+    const double mi = mass[i], mj = mass[j];
+    c.m_star = mi * mj / (mi + mj);
+    c.radius_i = ri;
+    c.radius_j = rj;
+    c.inv_inertia_i = inv_inertia[i];
+    c.inv_inertia_j = inv_inertia[j];
+    ContactCoefficients k = uniform_k;
+    if (!Uniform)
+    {
+      const std::int64_t type = species[i] * columns + species[j];
+      k = {E_star[type], G_star[type], mu[type], mu_r[type], alpha_n[type], alpha_t[type]};
+    }
+    Vector3 xi_t{hx[p], hy[p], hz[p]};
+    const ContactOutcome o = evaluate_contact(k, c, xi_t, dt);
+    // A pair that stopped touching forgets its history.
+    const double keep = touch ? 1.0 : 0.0;
+    hx[p] = touch ? xi_t.x : 0.0;
+    hy[p] = touch ? xi_t.y : 0.0;
+    hz[p] = touch ? xi_t.z : 0.0;
+    fx[p] = keep * o.force_i.x;
+    fy[p] = keep * o.force_i.y;
+    fz[p] = keep * o.force_i.z;
+    tix[p] = keep * o.torque_i.x;
+    tiy[p] = keep * o.torque_i.y;
+    tiz[p] = keep * o.torque_i.z;
+    tjx[p] = keep * o.torque_j.x;
+    tjy[p] = keep * o.torque_j.y;
+    tjz[p] = keep * o.torque_j.z;
+    touching[p] = touch ? 1 : 0;
+  }
+  return alarm;
+}
+
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define MAGBRUSH_PAIR_KERNEL_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
+#else
+#define MAGBRUSH_PAIR_KERNEL_CLONES
+#endif
+
+MAGBRUSH_PAIR_KERNEL_CLONES
+int particle_pair_kernel(const PairKernelData &D, const RowTorques &T, std::int64_t p_begin, std::int64_t p_end)
+{
+  return D.uniform ? pair_loop<true>(D, T, p_begin, p_end) : pair_loop<false>(D, T, p_begin, p_end);
+}
+} // namespace
+
 void DemSystem::compute_particle_contacts()
 {
   PhaseTimer timer(times_.particle_contacts);
   const ParticleState &s = particles_;
   NeighborList &L = list_;
   const long n = static_cast<long>(s.size());
-  const double dt = dt_;
-  const double guard = case_.dem.max_overlap_fraction;
-  int overlap_alarm = 0;
-  // 1. Each pair computes its contact into its own slots (no races, no order dependence).
-#pragma omp parallel for schedule(dynamic, 64) reduction(| : overlap_alarm) if (n > 512)
-  for (long k = 0; k < n; ++k)
+  // Image shifts and coefficients as plain arrays, one per component / field.
+  double shift[3][27];
+  for (int code = 0; code < 27; ++code)
   {
-    const std::size_t i = static_cast<std::size_t>(k);
-    const double xi = s.x[i], yi = s.y[i], zi = s.z[i], ri = s.radius[i], mi = s.mass[i];
-    const Vector3 vi = s.velocity(i), wi = s.angular_velocity(i);
-    const int si = s.species[i];
-    for (std::int32_t pp = L.row_start[i]; pp < L.row_start[i + 1]; ++pp)
-    {
-      const std::size_t p = U(pp);
-      const std::size_t j = U(L.partner[p]);
-      const Vector3 sh = L.shift(p);
-      const Vector3 d{s.x[j] - xi + sh.x, s.y[j] - yi + sh.y, s.z[j] - zi + sh.z};
-      const double rj = s.radius[j], reach = ri + rj;
-      const double r2 = dot(d, d);
-      if (r2 >= reach * reach)
-      {
-        L.touching[p] = 0;
-        L.hist_x[p] = L.hist_y[p] = L.hist_z[p] = 0.0;
-        continue;
-      }
-      const double dist = std::sqrt(r2), inv_dist = 1.0 / dist;
-      ContactKinematics c;
-      c.n = inv_dist * d;
-      c.overlap = reach - dist;
-      if (c.overlap > guard * std::min(ri, rj))
-        overlap_alarm = 1;
-      // Distances from the centres to the plane of the contact circle.
-      c.lever_i = 0.5 * (dist + (ri * ri - rj * rj) * inv_dist);
-      c.lever_j = dist - c.lever_i;
-      const Vector3 wj = s.angular_velocity(j);
-      c.v_rel = vi - s.velocity(j) + cross(c.lever_i * wi + c.lever_j * wj, c.n);
-      c.w_rel = wi - wj;
-      c.R_star = ri * rj / reach;
-      const double mj = s.mass[j];
-      c.m_star = mi * mj / (mi + mj);
-      c.radius_i = ri;
-      c.radius_j = rj;
-      c.inv_inertia_i = s.inv_inertia[i];
-      c.inv_inertia_j = s.inv_inertia[j];
-      Vector3 xi_t{L.hist_x[p], L.hist_y[p], L.hist_z[p]};
-      const ContactOutcome o = evaluate_contact(table_.particle_pair(si, s.species[j]), c, xi_t, dt);
-      L.hist_x[p] = xi_t.x;
-      L.hist_y[p] = xi_t.y;
-      L.hist_z[p] = xi_t.z;
-      L.force_x[p] = o.force_i.x;
-      L.force_y[p] = o.force_i.y;
-      L.force_z[p] = o.force_i.z;
-      L.torque_i_x[p] = o.torque_i.x;
-      L.torque_i_y[p] = o.torque_i.y;
-      L.torque_i_z[p] = o.torque_i.z;
-      L.torque_j_x[p] = o.torque_j.x;
-      L.torque_j_y[p] = o.torque_j.y;
-      L.torque_j_z[p] = o.torque_j.z;
-      L.touching[p] = 1;
-    }
+    const Vector3 v = L.shifts()[code];
+    shift[0][code] = v.x;
+    shift[1][code] = v.y;
+    shift[2][code] = v.z;
   }
-  // 2. Each particle gathers its pairs in a fixed order: its own row, then its column.
+  const std::size_t types = table_.species() * table_.columns();
+  const double *coef = coefficient_fields_.data();
+  const PairKernelData D{s.x.data(), s.y.data(), s.z.data(), s.vx.data(), s.vy.data(), s.vz.data(),
+                         s.wx.data(), s.wy.data(), s.wz.data(), s.radius.data(), s.mass.data(),
+                         s.inv_inertia.data(), s.species.data(), L.owner.data(), L.partner.data(),
+                         L.image.data(), shift[0], shift[1], shift[2], coef, coef + types, coef + 2 * types,
+                         coef + 3 * types, coef + 4 * types, coef + 5 * types,
+                         static_cast<std::int64_t>(table_.columns()), table_.species() == 1, dt_,
+                         case_.dem.max_overlap_fraction, L.hist_x.data(), L.hist_y.data(), L.hist_z.data(),
+                         L.force_x.data(), L.force_y.data(), L.force_z.data(), L.torque_j_x.data(),
+                         L.torque_j_y.data(), L.torque_j_z.data(), L.touching.data()};
+  const std::int32_t *row_start = L.row_start.data();
+  int overlap_alarm = 0;
   ForceBuffers &f = forces_;
-#pragma omp parallel for schedule(static) if (n > 512)
-  for (long k = 0; k < n; ++k)
+  const long blocks = (n + contact_block_rows - 1) / contact_block_rows;
+  // One parallel region, two phases separated by the loop's barrier.
+#pragma omp parallel if (n > 512)
   {
-    const std::size_t i = static_cast<std::size_t>(k);
-    double fx = 0, fy = 0, fz = 0, tx = 0, ty = 0, tz = 0;
-    std::int32_t count = 0;
-    for (std::int32_t pp = L.row_start[i]; pp < L.row_start[i + 1]; ++pp)
+    std::vector<double> row_torques; // per thread: the torques on i of one block's pairs
+    // 1. Pairs and rows, block by block.
+#pragma omp for schedule(dynamic, 2) reduction(| : overlap_alarm)
+    for (long b = 0; b < blocks; ++b)
     {
-      const std::size_t p = U(pp);
-      if (!L.touching[p])
-        continue;
-      ++count;
-      fx += L.force_x[p];
-      fy += L.force_y[p];
-      fz += L.force_z[p];
-      tx += L.torque_i_x[p];
-      ty += L.torque_i_y[p];
-      tz += L.torque_i_z[p];
+      const long i0 = b * contact_block_rows, i1 = std::min(n, i0 + contact_block_rows);
+      const std::int64_t p0 = row_start[i0], p1 = row_start[i1];
+      row_torques.resize(3 * static_cast<std::size_t>(p1 - p0));
+      const RowTorques T{row_torques.data(), row_torques.data() + (p1 - p0), row_torques.data() + 2 * (p1 - p0)};
+      overlap_alarm |= particle_pair_kernel(D, T, p0, p1);
+      for (long i = i0; i < i1; ++i)
+      {
+        double fx = 0, fy = 0, fz = 0, tx = 0, ty = 0, tz = 0;
+        std::int32_t count = 0;
+        for (std::int64_t p = row_start[i]; p < row_start[i + 1]; ++p)
+        {
+          count += D.touching[p];
+          fx += D.fx[p];
+          fy += D.fy[p];
+          fz += D.fz[p];
+          tx += T.x[p - p0];
+          ty += T.y[p - p0];
+          tz += T.z[p - p0];
+        }
+        f.fx[U(static_cast<std::int32_t>(i))] = fx;
+        f.fy[U(static_cast<std::int32_t>(i))] = fy;
+        f.fz[U(static_cast<std::int32_t>(i))] = fz;
+        f.tx[U(static_cast<std::int32_t>(i))] = tx;
+        f.ty[U(static_cast<std::int32_t>(i))] = ty;
+        f.tz[U(static_cast<std::int32_t>(i))] = tz;
+        contact_count_[U(static_cast<std::int32_t>(i))] = count;
+      }
     }
-    for (std::int32_t q = L.col_start[i]; q < L.col_start[i + 1]; ++q)
+    // 2. Columns: each particle adds the pairs in which it is the partner, in ascending pair
+    //    order (−F on it, and the pair's torque on j).
+    const std::int32_t *col_start = L.col_start.data(), *col_pair = L.col_pair.data();
+#pragma omp for schedule(dynamic, 512)
+    for (long k = 0; k < n; ++k)
     {
-      const std::size_t p = U(L.col_pair[U(q)]);
-      if (!L.touching[p])
-        continue;
-      ++count;
-      fx -= L.force_x[p];
-      fy -= L.force_y[p];
-      fz -= L.force_z[p];
-      tx += L.torque_j_x[p];
-      ty += L.torque_j_y[p];
-      tz += L.torque_j_z[p];
+      const std::size_t i = static_cast<std::size_t>(k);
+      double fx = f.fx[i], fy = f.fy[i], fz = f.fz[i], tx = f.tx[i], ty = f.ty[i], tz = f.tz[i];
+      std::int32_t count = contact_count_[i];
+      for (std::int32_t q = col_start[i]; q < col_start[i + 1]; ++q)
+      {
+        const std::size_t p = U(col_pair[q]);
+        count += D.touching[p];
+        fx -= D.fx[p];
+        fy -= D.fy[p];
+        fz -= D.fz[p];
+        tx += D.tjx[p];
+        ty += D.tjy[p];
+        tz += D.tjz[p];
+      }
+      f.fx[i] = fx;
+      f.fy[i] = fy;
+      f.fz[i] = fz;
+      f.tx[i] = tx;
+      f.ty[i] = ty;
+      f.tz[i] = tz;
+      contact_count_[i] = count;
     }
-    f.fx[i] = fx;
-    f.fy[i] = fy;
-    f.fz[i] = fz;
-    f.tx[i] = tx;
-    f.ty[i] = ty;
-    f.tz[i] = tz;
-    contact_count_[i] = count;
   }
   if (overlap_alarm)
     check_overlaps();
@@ -646,10 +794,10 @@ std::size_t DemSystem::memory_bytes() const
 }
 
 // ---------------------------------------------------------------------------------------
-// Checkpoints: a flat binary file, "MBDEMCK1", then the clock and every dynamic array with
+// Checkpoints: a flat binary file, "MBDEMCK2" (2: 32-bit pair flags), then the clock and every dynamic array with
 // its length. Written to <path>.tmp and renamed, so a crash never leaves half a checkpoint.
 namespace {
-constexpr char checkpoint_magic[9] = "MBDEMCK1";
+constexpr char checkpoint_magic[9] = "MBDEMCK2";
 
 template <typename T>
 void put(std::ofstream &o, const T &v) { o.write(reinterpret_cast<const char *>(&v), sizeof(T)); }
@@ -728,7 +876,7 @@ void DemSystem::read_checkpoint(const std::string &path)
   char magic[8];
   in.read(magic, 8);
   if (!in || std::memcmp(magic, checkpoint_magic, 8) != 0)
-    throw std::runtime_error("'" + path + "' is not a magbrush DEM checkpoint (expected header MBDEMCK1)");
+    throw std::runtime_error("'" + path + "' is not a magbrush DEM checkpoint (expected header MBDEMCK2)");
   step_ = get<long>(in);
   time_ = get<double>(in);
   const double dt = get<double>(in);

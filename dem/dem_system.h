@@ -118,12 +118,16 @@ public:
 
   // Maximum number of walls one particle may touch at once.
   static constexpr int max_wall_contacts = 3;
+  // Rows (particles) per block of the contact kernel: fixed, so that the work split, and
+  // hence every floating-point sum, is the same on any number of threads.
+  static constexpr long contact_block_rows = 128;
 
 private:
   Case case_;
   DemWalls walls_;
   PeriodicBox box_;
   ContactTable table_;
+  std::vector<double> coefficient_fields_; // table_ as six arrays (E*, G*, μ, μ_r, α_n, α_t)
   StableTimeStep stable_;
   ParticleState particles_;
   ForceBuffers forces_;

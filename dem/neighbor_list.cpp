@@ -209,7 +209,7 @@ void NeighborList::build_pairs(const ParticleState &s, const PeriodicBox &box, d
               }
             const double reach = ri + s.radius[ju] + skin;
             if (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < reach * reach)
-              f(j, static_cast<std::uint8_t>((sh[0] + 1) + 3 * (sh[1] + 1) + 9 * (sh[2] + 1)));
+              f(j, static_cast<std::int32_t>((sh[0] + 1) + 3 * (sh[1] + 1) + 9 * (sh[2] + 1)));
           }
         }
   };
@@ -218,23 +218,24 @@ void NeighborList::build_pairs(const ParticleState &s, const PeriodicBox &box, d
   for (std::int32_t i = 0; i < N; ++i)
   {
     std::int32_t count = 0;
-    for_each_partner(i, [&](std::int32_t, std::uint8_t) { ++count; });
+    for_each_partner(i, [&](std::int32_t, std::int32_t) { ++count; });
     row_start[static_cast<std::size_t>(i) + 1] = count;
   }
   for (std::size_t i = 0; i < n; ++i)
     row_start[i + 1] += row_start[i];
   const std::size_t P = static_cast<std::size_t>(row_start[n]);
+  owner.resize(P);
   partner.resize(P);
   image.resize(P);
   touching.assign(P, 0);
-  for (auto *a : {&hist_x, &hist_y, &hist_z, &force_x, &force_y, &force_z, &torque_i_x, &torque_i_y,
-                  &torque_i_z, &torque_j_x, &torque_j_y, &torque_j_z})
+  for (auto *a : {&hist_x, &hist_y, &hist_z, &force_x, &force_y, &force_z, &torque_j_x, &torque_j_y, &torque_j_z})
     a->resize(P);
 #pragma omp parallel for schedule(dynamic, 256) if (N > 512)
   for (std::int32_t i = 0; i < N; ++i)
   {
     std::size_t p = static_cast<std::size_t>(row_start[static_cast<std::size_t>(i)]);
-    for_each_partner(i, [&](std::int32_t j, std::uint8_t code) {
+    for_each_partner(i, [&](std::int32_t j, std::int32_t code) {
+      owner[p] = i;
       partner[p] = j;
       image[p] = code;
       ++p;
@@ -268,7 +269,7 @@ void NeighborList::restore_history(const ParticleState &s)
     {
       const std::size_t q = static_cast<std::size_t>(p);
       double hx = 0.0, hy = 0.0, hz = 0.0;
-      std::uint8_t found = 0;
+      std::int32_t found = 0;
       if (have)
       {
         const std::int32_t b = s.id[static_cast<std::size_t>(partner[q])];
@@ -301,12 +302,10 @@ void NeighborList::restore_history(const ParticleState &s)
 std::size_t NeighborList::memory_bytes() const
 {
   std::size_t b = 0;
-  for (const auto *a : {&row_start, &partner, &col_start, &col_pair, &cell_of_, &cell_start_, &order_,
+  for (const auto *a : {&row_start, &owner, &partner, &image, &touching, &col_start, &col_pair, &cell_of_, &cell_start_, &order_,
                         &counts_, &old_start_, &old_partner_id_})
     b += a->capacity() * sizeof(std::int32_t);
-  b += image.capacity() + touching.capacity();
-  for (const auto *a : {&hist_x, &hist_y, &hist_z, &force_x, &force_y, &force_z, &torque_i_x, &torque_i_y,
-                        &torque_i_z, &torque_j_x, &torque_j_y, &torque_j_z, &old_hx_, &old_hy_, &old_hz_})
+  for (const auto *a : {&hist_x, &hist_y, &hist_z, &force_x, &force_y, &force_z, &torque_j_x, &torque_j_y, &torque_j_z, &old_hx_, &old_hy_, &old_hz_})
     b += a->capacity() * sizeof(double);
   return b;
 }

@@ -34,19 +34,22 @@ class NeighborList
 public:
   // --- pair data, indexed by pair p -------------------------------------------------------
   std::vector<std::int32_t> row_start; // N + 1
+  std::vector<std::int32_t> owner;     // i of pair p (the row it belongs to)
   std::vector<std::int32_t> partner;   // j of pair p
-  std::vector<std::uint8_t> image;     // periodic image code of j relative to i (see shift())
-  std::vector<std::uint8_t> touching;  // 1 while the pair overlaps
+  std::vector<std::int32_t> image;     // periodic image code of j relative to i (see shift())
+  std::vector<std::int32_t> touching;  // 1 while the pair overlaps
   std::vector<double> hist_x, hist_y, hist_z;                     // Mindlin ξ (on i)
   std::vector<double> force_x, force_y, force_z;                  // contact force on i
-  std::vector<double> torque_i_x, torque_i_y, torque_i_z;         // torque on i
-  std::vector<double> torque_j_x, torque_j_y, torque_j_z;         // torque on j
+  std::vector<double> torque_j_x, torque_j_y, torque_j_z;         // torque on j (the torque on
+                                                                  // i is summed by its row at once)
   // Transposed index: pairs in which particle k is the second member, ascending.
   std::vector<std::int32_t> col_start, col_pair;
 
   std::size_t pairs() const { return partner.size(); }
   // Shift to add to (x_j − x_i) for pair p.
   Vector3 shift(std::size_t p) const { return shifts_[image[p]]; }
+  // The 27 image shifts, indexed by image code.
+  const Vector3 *shifts() const { return shifts_.data(); }
 
   // Rebuilds the list. Before: keeps the touching pairs' history keyed by id; then re-sorts
   // all particle arrays in cell order through `permute` (a callback that applies an order

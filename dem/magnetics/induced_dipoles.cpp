@@ -2,8 +2,11 @@
 
 #include "dipole_physics.h"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -46,6 +49,20 @@ InducedDipoles::InducedDipoles(const MagneticSettings &settings, const std::arra
   for (double L : box_)
     if (L < 0.0)
       throw std::invalid_argument("magnetics: periodic box lengths must be ≥ 0 (0 = open).");
+  if (settings_.far_field == FarField::cell_multipole)
+  {
+    if (settings_.slab_tail_correction)
+      throw std::invalid_argument(
+        "magnetics: the slab tail correction is the mean field beyond a hard cutoff; the "
+        "cell-multipole far field has no cutoff (it sums every periodic image). Switch "
+        "slab_tail_correction off, or use far_field = none.");
+    if (settings_.far_passes < 1 || !(settings_.far_cell_diameters > 0.0))
+      throw std::invalid_argument("magnetics: the cell-multipole far field needs far_passes ≥ 1 "
+                                  "and a positive cell size; found " +
+                                  std::to_string(settings_.far_passes) + " and " +
+                                  std::to_string(settings_.far_cell_diameters) + ".");
+    far_ = std::make_unique<CellMultipoleField>(settings_.far_order, box_, settings_.far_near_reach);
+  }
   if (settings_.slab_tail_correction)
   {
     int open = 0;
@@ -92,19 +109,55 @@ MagneticStats InducedDipoles::compute(const BeadArrays &beads, const AppliedFiel
     Ms_[b] = beads.saturation_magnetisation ? beads.saturation_magnetisation[b] : 0.0;
   }
 
-  const double cutoff = cutoff_length(beads);
-  stats.cutoff = cutoff;
-  refresh_list_if_needed(beads, cutoff, stats);
+  double clock = omp_get_wtime();
+  auto lap = [&clock](double &phase) {
+    const double now = omp_get_wtime();
+    phase += now - clock;
+    clock = now;
+  };
+  double cutoff;
+  if (far_)
+  {
+    // No cutoff: the near pairs are those of neighbouring fine cells (rebuilt every call:
+    // beads change cells), everything else is the far field.
+    double sum = 0.0;
+    for (std::size_t b = 0; b < n; ++b)
+      sum += beads.radius[b];
+    const double mean_diameter = 2.0 * sum / n;
+    far_->build(n, beads.x, beads.y, beads.z, settings_.far_cell_diameters * mean_diameter);
+    list_.set_pairs(n, beads.x, beads.y, beads.z, box_, 0.0,
+                    std::vector<MagneticNeighbourList::Pair>(far_->near_pairs()));
+    stats.list_rebuilt = true;
+    stats.listed_pairs = list_.size();
+    stats.far_cells = far_->fine_cells();
+    stats.far_interactions = far_->interactions();
+    if (settings_.model == DipoleModel::corrected)
+      refresh_correction_list(beads);
+    cutoff = std::numeric_limits<double>::infinity();
+    stats.cutoff = 0.0;
+  }
+  else
+  {
+    cutoff = cutoff_length(beads);
+    stats.cutoff = cutoff;
+    refresh_list_if_needed(beads, cutoff, stats);
+  }
+  lap(stats.time_lists);
   evaluate_applied_field(beads, field);
   evaluate_pair_tensors(beads, cutoff, stats);
   if (settings_.slab_tail_correction)
     prepare_tail(beads, cutoff);
+  lap(stats.time_tensors);
   solve_dipoles(beads, stats);
   // Tables depend on the beads' β only: re-check when the list (hence the bead set) changed.
   if (settings_.model == DipoleModel::corrected && (stats.list_rebuilt || tables_.empty()))
     prepare_correction_tables();
+  clock = omp_get_wtime();
   evaluate_pair_forces(beads, stats);
+  if (far_ && settings_.model == DipoleModel::corrected)
+    evaluate_correction_forces(beads, stats);
   gather_forces(out);
+  lap(stats.time_forces);
 
   x_last_.resize(3 * n);
   for (std::size_t b = 0; b < n; ++b)
@@ -200,6 +253,9 @@ void InducedDipoles::gather_local_field(std::size_t b, const std::vector<double>
   if (normal_axis_ >= 0)
     for (int d = 0; d < 3; ++d)
       B[d] += tail_B_[3 * b + d];
+  if (far_)
+    for (int d = 0; d < 3; ++d)
+      B[d] += B_far_[3 * b + d];
   const auto &begin = list_.incident_begin();
   const auto &pair_of = list_.incident_pair();
   const auto &first = list_.incident_first();
@@ -228,10 +284,20 @@ void InducedDipoles::solve_dipoles(const BeadArrays &beads, MagneticStats &stats
       induced_moment(beads.radius[b], beta_[b], Ms_[b], &B0_[3 * b], &p_[3 * b]);
   }
 
+  auto far_pass = [&] {
+    const double t0 = omp_get_wtime();
+    B_far_.resize(3 * n);
+    gradB_far_.resize(9 * n);
+    far_->evaluate(p_.data(), B_far_.data(), gradB_far_.data());
+    ++stats.far_passes;
+    stats.time_far += omp_get_wtime() - t0;
+  };
   if (settings_.model == DipoleModel::point_dipole)
   {
     // Dipoles from the applied field only; the local field is needed only for the papers'
-    // torque diagnostic.
+    // torque diagnostic (and the far field for the forces).
+    if (far_)
+      far_pass();
     if (normal_axis_ >= 0)
       evaluate_tail(p_);
     if (settings_.torque == TorqueModel::paper)
@@ -242,12 +308,38 @@ void InducedDipoles::solve_dipoles(const BeadArrays &beads, MagneticStats &stats
     }
     else
       B_local_ = B0_;
+    if (far_ && settings_.torque != TorqueModel::paper)
+      for (std::size_t k = 0; k < 3 * n; ++k)
+        B_local_[k] += B_far_[k];
     stats.sweeps = 0;
     stats.residual = 0.0;
     stats.converged = true;
     return;
   }
 
+  if (far_)
+  {
+    // The far field is held fixed through the sweeps (only the near field changes from
+    // sweep to sweep) and re-evaluated from the latest dipoles far_passes times in all (one
+    // more from a cold start, whose first far field comes from the applied-field dipoles).
+    const int passes = settings_.far_passes + (warm_start ? 0 : 1);
+    for (int pass = 0; pass < passes; ++pass)
+    {
+      far_pass();
+      const double t0 = omp_get_wtime();
+      sweep_to_tolerance(beads, stats);
+      stats.time_sweeps += omp_get_wtime() - t0;
+    }
+    return;
+  }
+  const double t0 = omp_get_wtime();
+  sweep_to_tolerance(beads, stats);
+  stats.time_sweeps += omp_get_wtime() - t0;
+}
+
+void InducedDipoles::sweep_to_tolerance(const BeadArrays &beads, MagneticStats &stats)
+{
+  const std::size_t n = beads.n;
   // Jacobi sweeps: every bead's new dipole from the old dipoles of its neighbours. Order-free
   // within a sweep, hence parallel and thread-count independent. Plain Jacobi diverges when
   // the coupling matrix αT has an eigenvalue below −1 (e.g. a touching monolayer across the
@@ -257,6 +349,7 @@ void InducedDipoles::solve_dipoles(const BeadArrays &beads, MagneticStats &stats
   stats.converged = false;
   double omega = 1.0, previous_change = 0.0;
   int growth = 0;
+  const int first_sweep = stats.sweeps;
   for (int sweep = 1; sweep <= settings_.max_sweeps; ++sweep)
   {
     if (normal_axis_ >= 0)
@@ -282,7 +375,7 @@ void InducedDipoles::solve_dipoles(const BeadArrays &beads, MagneticStats &stats
       max_p2 = std::max(max_p2, p2);
     }
     p_.swap(p_next_);
-    stats.sweeps = sweep;
+    stats.sweeps = first_sweep + sweep;
     stats.residual = max_p2 > 0.0 ? std::sqrt(max_change2 / max_p2) : 0.0;
     if (stats.residual <= settings_.tolerance)
     {
@@ -401,7 +494,6 @@ void InducedDipoles::evaluate_pair_forces(const BeadArrays &beads, MagneticStats
   pair_force_.resize(3 * np);
   const bool corrected = settings_.model == DipoleModel::corrected;
   const TwoSphereTable *single_table = tables_.size() == 1 ? tables_.begin()->second.get() : nullptr;
-  const double s0 = settings_.switch_begin, s1 = settings_.switch_end;
   std::size_t corrected_pairs = 0;
 #pragma omp parallel for schedule(static) reduction(+ : corrected_pairs) if (np >= parallel_threshold)
   for (long k = 0; k < static_cast<long>(np); ++k)
@@ -415,23 +507,33 @@ void InducedDipoles::evaluate_pair_forces(const BeadArrays &beads, MagneticStats
     const std::uint32_t i = pairs[k].i, j = pairs[k].j;
     const double *r = &r_[3 * k];
     dipole_pair_force(r, &p_[3 * j], &p_[3 * i], F);
-    if (!corrected)
-      continue;
+    if (!corrected || far_)
+      continue; // (with the far field, the corrections have their own list)
+    if (add_correction(beads, i, j, r, tensor_[k], single_table, F))
+      ++corrected_pairs;
+  }
+  stats.corrected_pairs = corrected_pairs;
+}
 
+bool InducedDipoles::add_correction(const BeadArrays &beads, std::uint32_t i, std::uint32_t j,
+                                    const double r[3], const DipoleTensor &T,
+                                    const TwoSphereTable *single_table, double F[3]) const
+{
+  const double s0 = settings_.switch_begin, s1 = settings_.switch_end;
+  {
     // Exact two-sphere correction, Δf = f_exact − f_mutual, in the field the pair sits in:
     // the local field at each bead minus the partner's own contribution, averaged.
     const double a = 0.5 * (beads.radius[i] + beads.radius[j]);
     const double dist = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
     const double D = dist / a;
     if (D >= s1)
-      continue;
+      return false;
     const TwoSphereTable *table = single_table;
     if (!table)
       table = tables_.at(0.5 * (beta_[i] + beta_[j])).get();
     double Bi[3] = {B_local_[3 * i], B_local_[3 * i + 1], B_local_[3 * i + 2]};
     double Bj[3] = {B_local_[3 * j], B_local_[3 * j + 1], B_local_[3 * j + 2]};
-    const DipoleTensor minus = {-tensor_[k].xx, -tensor_[k].yy, -tensor_[k].zz,
-                                -tensor_[k].xy, -tensor_[k].xz, -tensor_[k].yz};
+    const DipoleTensor minus = {-T.xx, -T.yy, -T.zz, -T.xy, -T.xz, -T.yz};
     minus.add_field(&p_[3 * j], Bi);
     minus.add_field(&p_[3 * i], Bj);
     double H[3], e[3];
@@ -460,7 +562,51 @@ void InducedDipoles::evaluate_pair_forces(const BeadArrays &beads, MagneticStats
     // i.e. −f_t H_r H_t as a vector.
     for (int d = 0; d < 3; ++d)
       F[d] += scale * (radial * e[d] - c.transverse * Hr * Ht[d]);
-    ++corrected_pairs;
+    return true;
+  }
+}
+
+
+void InducedDipoles::refresh_correction_list(const BeadArrays &beads)
+{
+  // Pairs within switch_end mean radii of each other (+ skin): their centres may lie in
+  // non-neighbouring fine cells, so the correction has a list of its own.
+  double sum = 0.0, largest = 0.0;
+  for (std::size_t b = 0; b < beads.n; ++b)
+  {
+    sum += beads.radius[b];
+    largest = std::max(largest, beads.radius[b]);
+  }
+  const double skin = settings_.skin_fraction * 2.0 * sum / beads.n;
+  const double radius = settings_.switch_end * largest + skin;
+  const bool stale = !correction_list_.built() || correction_list_.particle_count() != beads.n ||
+                     correction_list_.box() != box_ ||
+                     std::abs(correction_list_.list_radius() - radius) > 1e-12 * radius ||
+                     correction_list_.max_displacement(beads.n, beads.x, beads.y, beads.z) > 0.5 * skin;
+  if (stale)
+    correction_list_.build(beads.n, beads.x, beads.y, beads.z, box_, radius);
+}
+
+void InducedDipoles::evaluate_correction_forces(const BeadArrays &beads, MagneticStats &stats)
+{
+  const auto &pairs = correction_list_.pairs();
+  const std::size_t np = pairs.size();
+  correction_force_.resize(3 * np);
+  const TwoSphereTable *single_table = tables_.size() == 1 ? tables_.begin()->second.get() : nullptr;
+  std::size_t corrected_pairs = 0;
+#pragma omp parallel for schedule(static) reduction(+ : corrected_pairs) if (np >= parallel_threshold)
+  for (long k = 0; k < static_cast<long>(np); ++k)
+  {
+    double *F = &correction_force_[3 * k];
+    F[0] = F[1] = F[2] = 0.0;
+    const auto &pair = pairs[k];
+    const double r[3] = {beads.x[pair.j] - beads.x[pair.i] + pair.shift[0],
+                         beads.y[pair.j] - beads.y[pair.i] + pair.shift[1],
+                         beads.z[pair.j] - beads.z[pair.i] + pair.shift[2]};
+    if (r[0] * r[0] + r[1] * r[1] + r[2] * r[2] == 0.0)
+      continue;
+    if (add_correction(beads, pair.i, pair.j, r, DipoleTensor::at(r), single_table, F))
+      ++corrected_pairs;
   }
   stats.corrected_pairs = corrected_pairs;
 }
@@ -474,6 +620,7 @@ void InducedDipoles::gather_forces(const ForceArrays &out)
   const auto &pair_of = list_.incident_pair();
   const auto &first = list_.incident_first();
   const bool paper_torque = settings_.torque == TorqueModel::paper;
+  const bool corrected = settings_.model == DipoleModel::corrected;
 #pragma omp parallel for schedule(static) if (n >= parallel_threshold)
   for (long b = 0; b < static_cast<long>(n); ++b)
   {
@@ -489,6 +636,13 @@ void InducedDipoles::gather_forces(const ForceArrays &out)
       const double *dB = &tail_dB_[3 * b];
       F[normal_axis_] += p[0] * dB[0] + p[1] * dB[1] + p[2] * dB[2];
     }
+    // Far field: (p·∇)B_far.
+    if (far_)
+    {
+      const double *gf = &gradB_far_[9 * b];
+      for (int a = 0; a < 3; ++a)
+        F[a] += p[0] * gf[3 * a] + p[1] * gf[3 * a + 1] + p[2] * gf[3 * a + 2];
+    }
     // Pair forces are stored as the force on the pair's j bead; its i bead gets the negative.
     for (std::size_t q = begin[b]; q < begin[b + 1]; ++q)
     {
@@ -496,6 +650,19 @@ void InducedDipoles::gather_forces(const ForceArrays &out)
       const double sign = first[q] ? -1.0 : 1.0;
       for (int a = 0; a < 3; ++a)
         F[a] += sign * Fp[a];
+    }
+    if (far_ && corrected)
+    {
+      const auto &cbegin = correction_list_.incident_begin();
+      const auto &cpair = correction_list_.incident_pair();
+      const auto &cfirst = correction_list_.incident_first();
+      for (std::size_t q = cbegin[b]; q < cbegin[b + 1]; ++q)
+      {
+        const double *Fp = &correction_force_[3 * cpair[q]];
+        const double sign = cfirst[q] ? -1.0 : 1.0;
+        for (int a = 0; a < 3; ++a)
+          F[a] += sign * Fp[a];
+      }
     }
     double *T = &torque_[3 * b];
     if (paper_torque)
@@ -547,6 +714,7 @@ void InducedDipoles::particles_reordered(const std::vector<std::int32_t> &order)
   permute(torque_);
   permute(x_last_);
   list_ = MagneticNeighbourList(); // pair indices refer to the old order
+  correction_list_ = MagneticNeighbourList();
 }
 
 bool InducedDipoles::needs_refresh(const BeadArrays &beads, double time) const

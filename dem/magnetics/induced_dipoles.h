@@ -22,6 +22,7 @@
 // add_held_forces() adds the forces of the last evaluation.
 #pragma once
 
+#include "cell_multipole_field.h"
 #include "dipole_physics.h"
 #include "magnetic_neighbour_list.h"
 #include "magnetic_settings.h"
@@ -72,7 +73,13 @@ struct MagneticStats
   std::size_t listed_pairs = 0; // pairs in the neighbour list (cutoff + skin)
   std::size_t corrected_pairs = 0; // pairs that received the exact two-sphere correction
   bool list_rebuilt = false;
-  double cutoff = 0.0;          // cutoff length used [m]
+  double cutoff = 0.0;          // cutoff length used [m] (0 with the cell-multipole far field)
+  int far_passes = 0;           // far-field evaluations (cell_multipole)
+  std::size_t far_cells = 0;    // occupied fine cells
+  std::size_t far_interactions = 0; // M2L translations per far-field evaluation
+  // Wall time of the phases [s]: neighbour lists / cells, applied field + pair tensors,
+  // far field, sweeps (near field), pair forces + gather.
+  double time_lists = 0, time_tensors = 0, time_far = 0, time_sweeps = 0, time_forces = 0;
 };
 
 class InducedDipoles
@@ -108,6 +115,8 @@ public:
   // interleaved (x, y, z) per bead.
   const std::vector<double> &dipoles() const { return p_; }
   const std::vector<double> &local_fields() const { return B_local_; }
+  // The far field [T] of the last compute (3 per bead; empty without cell_multipole).
+  const std::vector<double> &far_fields() const { return B_far_; }
 
 private:
   MagneticSettings settings_;
@@ -139,6 +148,15 @@ private:
   std::map<double, std::shared_ptr<const TwoSphereTable>> tables_;
   std::vector<const TwoSphereTable *> pair_table_;
 
+  // Cell-multipole far field: the near list (list_) holds the pairs in neighbouring fine
+  // cells, rebuilt at every compute; the far field and its gradient per bead; the
+  // `corrected` pairs (within switch_end, which may lie in non-neighbouring cells) come
+  // from their own short Verlet list, with their correction forces.
+  std::unique_ptr<CellMultipoleField> far_;
+  std::vector<double> B_far_, gradB_far_;
+  MagneticNeighbourList correction_list_;
+  std::vector<double> correction_force_;
+
   double cutoff_length(const BeadArrays &beads) const;
   void refresh_list_if_needed(const BeadArrays &beads, double cutoff, MagneticStats &stats);
   void evaluate_applied_field(const BeadArrays &beads, const AppliedFieldFunction &field);
@@ -147,6 +165,14 @@ private:
   void evaluate_tail(const std::vector<double> &p);
   void gather_local_field(std::size_t b, const std::vector<double> &p, double B[3]) const;
   void solve_dipoles(const BeadArrays &beads, MagneticStats &stats);
+  void sweep_to_tolerance(const BeadArrays &beads, MagneticStats &stats);
+  void refresh_correction_list(const BeadArrays &beads);
+  void evaluate_correction_forces(const BeadArrays &beads, MagneticStats &stats);
+  // Adds the exact-minus-mutual two-sphere force of pair (i, j), r = x_j − x_i, to F (the
+  // force on j); false when the pair is beyond switch_end.
+  bool add_correction(const BeadArrays &beads, std::uint32_t i, std::uint32_t j,
+                      const double r[3], const DipoleTensor &T, const TwoSphereTable *single,
+                      double F[3]) const;
   void prepare_correction_tables();
   void evaluate_pair_forces(const BeadArrays &beads, MagneticStats &stats);
   void gather_forces(const ForceArrays &out);

@@ -5,6 +5,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace magbrush::magnetics {
 
@@ -194,6 +195,22 @@ void MagneticNeighbourList::build(std::size_t n, const double *x, const double *
     });
   }
 
+  build_incidence(n, coord);
+}
+
+void MagneticNeighbourList::set_pairs(std::size_t n, const double *x, const double *y,
+                                      const double *z, const std::array<double, 3> &box,
+                                      double list_radius, std::vector<Pair> pairs)
+{
+  list_radius_ = list_radius;
+  box_ = box;
+  pairs_ = std::move(pairs);
+  const double *coord[3] = {x, y, z};
+  build_incidence(n, coord);
+}
+
+void MagneticNeighbourList::build_incidence(std::size_t n, const double *const coord[3])
+{
   // Incidence (CSR), in increasing pair order for every bead.
   incident_begin_.assign(n + 1, 0);
   for (const Pair &p : pairs_)

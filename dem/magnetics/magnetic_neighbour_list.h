@@ -37,6 +37,11 @@ public:
   void build(std::size_t n, const double *x, const double *y, const double *z,
              const std::array<double, 3> &box, double list_radius);
 
+  // Takes a ready pair set (e.g. the near pairs of the cell-multipole far field) and builds
+  // the incidence; positions are kept as the reference for max_displacement.
+  void set_pairs(std::size_t n, const double *x, const double *y, const double *z,
+                 const std::array<double, 3> &box, double list_radius, std::vector<Pair> pairs);
+
   // Largest displacement of any bead since the last build (no minimum image: a wrap counts
   // as a large move).
   double max_displacement(std::size_t n, const double *x, const double *y,
@@ -66,6 +71,8 @@ private:
   std::vector<std::size_t> incident_begin_;
   std::vector<std::uint32_t> incident_pair_;
   std::vector<std::uint8_t> incident_first_;
+
+  void build_incidence(std::size_t n, const double *const coord[3]);
 };
 
 } // namespace magbrush::magnetics

@@ -30,6 +30,21 @@ std::string to_string(DipoleModel model)
   return "?";
 }
 
+FarField parse_far_field(const std::string &name)
+{
+  if (name == "none")
+    return FarField::none;
+  if (name == "cell_multipole")
+    return FarField::cell_multipole;
+  throw std::invalid_argument("magnetic far field: expected none or cell_multipole; found '" +
+                              name + "'. Set dem.magnetic_far_field to one of these.");
+}
+
+std::string to_string(FarField far_field)
+{
+  return far_field == FarField::none ? "none" : "cell_multipole";
+}
+
 MagneticSettings MagneticSettings::from_case(const DemSettings &dem)
 {
   MagneticSettings s;
@@ -38,6 +53,9 @@ MagneticSettings MagneticSettings::from_case(const DemSettings &dem)
   s.tolerance = dem.magnetic_tolerance;
   s.refresh_interval = dem.magnetic_refresh;
   s.skin_fraction = dem.verlet_skin;
+  s.far_field = parse_far_field(dem.magnetic_far_field);
+  s.far_order = dem.magnetic_far_order;
+  s.far_cell_diameters = dem.magnetic_far_cell;
   return s;
 }
 

@@ -34,6 +34,17 @@ enum class TorqueModel
   paper  // add p_j × B_j (Kawamoto A8), B_j the local field at the bead
 };
 
+// How the dipole sums treat what lies beyond the near field.
+//  * none:           a hard cutoff (cutoff_diameters; Kawamoto: everything beyond is dropped),
+//                    optionally with the slab tail correction;
+//  * cell_multipole: no cutoff: exact pairs between beads in neighbouring fine cells, and the
+//                    whole rest of the domain (every periodic image) through the cell
+//                    multipole method (cell_multipole_field.h), O(N).
+enum class FarField { none, cell_multipole };
+
+FarField parse_far_field(const std::string &name); // throws std::invalid_argument
+std::string to_string(FarField far_field);
+
 struct MagneticSettings
 {
   DipoleModel model = DipoleModel::corrected;
@@ -77,7 +88,19 @@ struct MagneticSettings
   // Newton's third law holds up to round-off). Cost O(N log N) per sweep (prefix sums).
   bool slab_tail_correction = false;
 
-  // The settings a case asks for (model, cutoff, tolerance, refresh, skin).
+  // Far field (cell_multipole): fine cell size in mean diameters, Taylor order p, near reach
+  // in fine cells (2: the 125 cells around a bead's cell are exact pairs), and far-field
+  // evaluations per compute: the far field is held fixed through the Jacobi sweeps (the
+  // near field is updated every sweep) and evaluated far_passes times in all, each time
+  // from the latest dipoles (1 = once, from the previous call's dipoles: the far field lags
+  // one refresh); a cold start (no previous dipoles) does one pass more.
+  FarField far_field = FarField::none;
+  double far_cell_diameters = 1.5;
+  int far_order = 2;
+  int far_near_reach = 2;
+  int far_passes = 1;
+
+  // The settings a case asks for (model, far field, cutoff, tolerance, refresh, skin).
   static MagneticSettings from_case(const DemSettings &dem);
 };
 

@@ -25,13 +25,16 @@ struct BrushConfiguration
 
 inline BrushConfiguration make_brush(std::size_t chains, double box, double mean_radius,
                                      double radius_std, int min_height, int max_height,
-                                     double mu_r, unsigned seed, bool periodic_x = true)
+                                     double mu_r, unsigned seed, bool periodic_x = true,
+                                     double width_x = 0.0)
 {
+  // width_x (open x only): the strip's width; 0 = the periodic length.
+  const double width = (!periodic_x && width_x > 0.0) ? width_x : box;
   BrushConfiguration c;
   c.box = box;
   c.periodic_x = periodic_x;
   std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> lateral(0.0, box), unit(0.0, 1.0);
+  std::uniform_real_distribution<double> lateral(0.0, box), across(0.0, width), unit(0.0, 1.0);
   std::normal_distribution<double> radius(mean_radius, radius_std);
   std::uniform_int_distribution<int> height(min_height, max_height);
   auto overlaps = [&](double x, double y, double z, double r) {
@@ -51,7 +54,7 @@ inline BrushConfiguration make_brush(std::size_t chains, double box, double mean
   for (std::size_t chain = 0, attempts = 0; chain < chains && attempts < 100 * chains; ++attempts)
   {
     double r = std::clamp(radius(rng), r_lo, r_hi);
-    double x = lateral(rng), y = r + gap, z = lateral(rng);
+    double x = across(rng), y = r + gap, z = lateral(rng);
     if (overlaps(x, y, z, r))
       continue;
     ++chain;

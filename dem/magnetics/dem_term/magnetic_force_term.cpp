@@ -9,7 +9,8 @@ namespace {
 MagneticSettings with_slab_tail(MagneticSettings s, const std::array<double, 3> &box, bool slab_tail)
 {
   const int periodic = (box[0] > 0) + (box[1] > 0) + (box[2] > 0);
-  if (slab_tail && periodic == 2)
+  // The slab tail corrects a hard cutoff; the cell-multipole far field has none.
+  if (slab_tail && periodic == 2 && s.far_field == FarField::none)
     s.slab_tail_correction = true;
   return s;
 }
@@ -67,6 +68,8 @@ void MagneticForceTerm::select_carriers(const dem::ParticleState &state)
 void MagneticForceTerm::add_forces(const dem::ParticleState &state, dem::ForceBuffers &forces,
                                    double t)
 {
+  if (!enabled_)
+    return;
   if (must_refresh_ || state.size() != state_size_)
   {
     select_carriers(state);
@@ -118,7 +121,7 @@ void MagneticForceTerm::add_forces(const dem::ParticleState &state, dem::ForceBu
 void MagneticForceTerm::particles_reordered(const std::vector<std::int32_t> &order)
 {
   // Map the compact carrier order through the engine's permutation, so that the kept dipoles
-  // (the warm start) follow their beads; the forces are re-evaluated at the next step.
+  // (the warm start), the held forces and the staleness reference follow their beads.
   std::vector<std::int32_t> compact_of_full(order.size(), -1);
   for (std::size_t k = 0; k < carrier_.size(); ++k)
     compact_of_full[carrier_[k]] = static_cast<std::int32_t>(k);
@@ -136,18 +139,21 @@ void MagneticForceTerm::particles_reordered(const std::vector<std::int32_t> &ord
   if (compact_order.size() == carrier_.size())
   {
     dipoles_.particles_reordered(compact_order);
-    std::vector<double> r(radius_), m(mu_r_), s(Ms_);
-    for (std::size_t k = 0; k < compact_order.size(); ++k)
+    // The held forces follow their beads too: a re-sort is no reason to re-evaluate (the
+    // staleness check still sees how far every bead moved since the last evaluation).
+    for (auto *v : {&radius_, &mu_r_, &Ms_, &fx_, &fy_, &fz_, &tx_, &ty_, &tz_})
     {
-      radius_[k] = r[compact_order[k]];
-      mu_r_[k] = m[compact_order[k]];
-      Ms_[k] = s[compact_order[k]];
+      const std::vector<double> old(*v);
+      for (std::size_t k = 0; k < compact_order.size(); ++k)
+        (*v)[k] = old[compact_order[k]];
     }
     carrier_ = new_carrier;
   }
   else
+  {
     dipoles_.reset_dipoles();
-  must_refresh_ = true;
+    must_refresh_ = true;
+  }
 }
 
 } // namespace magbrush::magnetics

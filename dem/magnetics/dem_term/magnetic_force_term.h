@@ -35,6 +35,8 @@ public:
   void particles_reordered(const std::vector<std::int32_t> &order) override;
 
   const MagneticStats &last_stats() const { return stats_; }
+  // A disabled term adds nothing (benchmarks compare settings in one system).
+  void set_enabled(bool enabled) { enabled_ = enabled; }
   long evaluations() const { return evaluations_; }
   const InducedDipoles &dipoles() const { return dipoles_; }
 
@@ -56,6 +58,7 @@ private:
   std::vector<std::uint32_t> carrier_;
   std::vector<double> x_, y_, z_, radius_, mu_r_, Ms_, fx_, fy_, fz_, tx_, ty_, tz_;
   bool must_refresh_ = true;
+  bool enabled_ = true;
 
   void select_carriers(const dem::ParticleState &state);
 };

@@ -47,7 +47,8 @@ nip profiles of all points:
 Values carry units as in the case file (--vary populations.carrier.diameter=42um,50um,60um).
 Varying a population's diameter also scales its count by (d0/d)^3 and its diameter_std by
 d/d0, so that the supplied carrier volume (the layer) stays the same, as in the paper's
-42/50/60 um comparison; --no-keep-layer switches that off.
+42/50/60 um comparison, and a fixed dem.time_step by d/d0 (the stable step is proportional to
+the bead size); --no-keep-layer switches that off.
 Examples (Fig. 22-27):
   magbrush sweep cases/kawamoto_nip.yaml --vary populations.carrier.diameter=42um,50um,60um
   magbrush sweep cases/kawamoto_nip.yaml --vary populations.carrier.count=9000,12300,15000
@@ -245,6 +246,13 @@ int run_sweep(const std::vector<std::string> &args)
       char std_text[64];
       std::snprintf(std_text, sizeof std_text, "%.9g", p0->diameter_std / ratio);
       point_overrides.push_back("populations." + selector + ".diameter_std=" + std_text);
+      // The stable step scales with the bead size (Hertz contact time ∝ d): a case that fixes
+      // its step keeps the same fraction of the limit.
+      if (base.dem.time_step > 0.0)
+      {
+        std::snprintf(std_text, sizeof std_text, "%.9g", base.dem.time_step / ratio);
+        point_overrides.push_back("dem.time_step=" + std::string(std_text));
+      }
     }
     const fs::path point_dir = sweep_dir / label;
     point_overrides.push_back("output.directory=" + point_dir.string());

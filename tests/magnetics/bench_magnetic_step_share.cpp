@@ -41,14 +41,14 @@ void scene(const char *label, const std::string &file, long carriers, long steps
                             "dem.settle_time=0 s"});
   std::printf("\n%s: %ld carriers, %ld steps of %.3g s per phase, refresh %.3g s, %d threads\n\n",
               label, carriers, steps, c.dem.time_step, c.dem.magnetic_refresh, omp_get_max_threads());
-  std::printf("| phase | s/step | magnetic share (vs contact-only) | evaluations | s/evaluation | sweeps | far passes |\n");
-  std::printf("|---|---|---|---|---|---|---|\n");
+  std::printf("| phase | s/step | magnetic share (vs contact-only) | evaluations | s/evaluation | sweeps | far passes | last evaluation: lists / tensors / far / sweeps / forces [s] |\n");
+  std::printf("|---|---|---|---|---|---|---|---|\n");
   dem::DemSystem system(c);
   system.insert_particles();
   system.initialize();
   time_steps(system, 20); // first neighbour lists, caches
   const double contact = time_steps(system, steps);
-  std::printf("| contact only | %.3e | — | 0 | — | — | — |\n", contact);
+  std::printf("| contact only | %.3e | — | 0 | — | — | — | — |\n", contact);
   std::fflush(stdout);
 
   auto add = [&](const char *name, MagneticSettings s) {
@@ -63,10 +63,12 @@ void scene(const char *label, const std::string &file, long carriers, long steps
     const double with = time_steps(system, steps);
     const long evaluations = term->evaluations() - before;
     const double contact_now = contact; // measured above, same system
-    std::printf("| %s | %.3e | %+.0f %% | %ld | %.3f (cold %.3f) | %d | %d |\n", name, with,
-                100.0 * (with - contact_now) / contact_now, evaluations,
-                evaluations ? (with - contact_now) * steps / evaluations : 0.0, cold,
-                term->last_stats().sweeps, term->last_stats().far_passes);
+    const MagneticStats &st = term->last_stats();
+    std::printf("| %s | %.3e | %+.0f %% | %ld | %.3f (cold %.3f) | %d | %d | %.3f / %.3f / %.3f / %.3f / %.3f |\n",
+                name, with, 100.0 * (with - contact_now) / contact_now, evaluations,
+                evaluations ? (with - contact_now) * steps / evaluations : 0.0, cold, st.sweeps,
+                st.far_passes, st.time_lists, st.time_tensors, st.time_far, st.time_sweeps,
+                st.time_forces);
     std::fflush(stdout);
     return term;
   };

@@ -164,7 +164,7 @@ void CartesianTaylor::scaled_matrix(const double *A, double s, float *Af) const
     for (std::size_t b = 0; b < n_multipole_; ++b)
     {
       const int n = ex_[g + 1] + ey_[g + 1] + ez_[g + 1] + ex_[b + 1] + ey_[b + 1] + ez_[b + 1] + 1;
-      Af[g * n_multipole_ + b] = static_cast<float>(A[g * n_multipole_ + b] * std::pow(s, n));
+      Af[b * n_local_ + g] = static_cast<float>(A[g * n_multipole_ + b] * std::pow(s, n));
     }
 }
 

@@ -55,20 +55,20 @@ public:
   // Single precision (the translation matrices and moments rounded to float, each row
   // summed in float, added to the double local coefficients): relative rounding ~1e-7 per
   // translation against an expansion error of ~1e-3; twice the SIMD width.
-  // Lengths are scaled by s (the level's cell size) so that high-order tensors stay within
-  // float range: A'[γ][β] = A s^(|β|+|γ|+1), M'_β = M_β s^(−|β|), and the row sums are
-  // multiplied back by row_scale[γ] = s^(−|γ|−1).
-  void apply_translation(const float *A, const float *M, const double *row_scale, double *L) const
+  // Single precision: lengths are scaled by s (the level's cell size) so that high-order
+  // tensors stay within float range: A'[β][γ] = A s^(|β|+|γ|+1) stored transposed (β-major),
+  // M'_β = M_β s^(−|β|); a target cell sums all its translations into float coefficients
+  // L' (vectorised over γ), and L_γ += s^(−|γ|−1) L'_γ at the end (row_scales).
+  void accumulate_translation(const float *At, const float *M, float *Lf) const
   {
     const std::size_t nm = n_multipole_, nl = n_local_;
-    for (std::size_t g = 0; g < nl; ++g)
+    for (std::size_t b = 0; b < nm; ++b)
     {
-      const float *row = A + g * nm;
-      float sum = 0.0f;
-#pragma omp simd reduction(+ : sum)
-      for (std::size_t b = 0; b < nm; ++b)
-        sum += row[b] * M[b];
-      L[g] += row_scale[g] * sum;
+      const float m = M[b];
+      const float *column = At + b * nl;
+#pragma omp simd
+      for (std::size_t g = 0; g < nl; ++g)
+        Lf[g] += column[g] * m;
     }
   }
   void scaled_matrix(const double *A, double s, float *Af) const;

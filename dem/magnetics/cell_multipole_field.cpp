@@ -678,9 +678,14 @@ void CellMultipoleField::evaluate(const double *p, double *B, double *gradB)
         taylor_.shift_local(e, &up.L[l.parent[c] * nl], L);
       }
       if (single_precision_)
+      {
+        float Lf[1024];
+        std::fill(Lf, Lf + nl, 0.0f);
         for (std::uint32_t k = l.list_begin[c]; k < l.list_begin[c + 1]; ++k)
-          taylor_.apply_translation(l.list_matrix_f[k], &l.Mf[l.list_source[k] * nm],
-                                    l.row_scale.data(), L);
+          taylor_.accumulate_translation(l.list_matrix_f[k], &l.Mf[l.list_source[k] * nm], Lf);
+        for (std::size_t g = 0; g < nl; ++g)
+          L[g] += l.row_scale[g] * Lf[g];
+      }
       else
         for (std::uint32_t k = l.list_begin[c]; k < l.list_begin[c + 1]; ++k)
           taylor_.apply_translation(l.list_matrix[k], &l.M[l.list_source[k] * nm], L);

@@ -257,6 +257,13 @@ std::vector<ResolvedEntry> resolved_entries(const Case &c)
   e.q("dem.settle_time", "dem.settle_time", d.settle_time);
   e.q("dem.max_kinetic_energy_growth", "dem.max_kinetic_energy_growth", d.max_kinetic_energy_growth);
 
+  e.q("nip.average_from", "nip.average_from", c.nip.average_from);
+  e.q("nip.sample_interval", "nip.sample_interval", c.nip.sample_interval);
+  e.q("nip.bin_width", "nip.bin_width", c.nip.bin_width);
+  e.q("nip.half_width", "nip.half_width", c.nip.half_width);
+  e.q("nip.chain_bin_angle", "nip.chain_bin_angle", c.nip.chain_bin_angle);
+  e.q("nip.chain_half_angle", "nip.chain_half_angle", c.nip.chain_half_angle);
+
   const auto &m = c.compression;
   e.s("compression.plate", "compression.plate", m.plate);
   e.s("compression.stage", "compression.stage", m.stage);

@@ -208,6 +208,20 @@ struct DemSettings
                                           // factor between two guard checks (100 steps)
 };
 
+// The development-nip measurements (dem/measurements/nip_profile.h, chain_inclination.h,
+// nip_time_series.h): what they sample and how they bin. Taken when the scene has a sleeve and
+// a drum. Positions along the nip are x, the distance from the gap centre along the common
+// tangent of sleeve and drum (positive downstream, the way the sleeve surface moves).
+struct NipSettings
+{
+  double average_from = 0.0;        // time-average the profiles over t >= this [s]
+  double sample_interval = 2e-6;    // time between samples [s]
+  double bin_width = 0.25e-3;       // bin width along the nip (x) [m]
+  double half_width = 4e-3;         // profiles cover -half_width <= x <= half_width [m]
+  double chain_bin_angle = 2.0 * 3.14159265358979323846 / 180.0;   // chain bins in sleeve angle [rad]
+  double chain_half_angle = 30.0 * 3.14159265358979323846 / 180.0; // chain profile extent [rad]
+};
+
 // Kawamoto's compression test (dem/measurements/plate_compression.h): what the plate
 // measurement samples. It is taken when a box scene has both named planes.
 struct CompressionSettings
@@ -243,6 +257,7 @@ struct Case
   AppliedField applied_field;
   FieldSettings field;
   DemSettings dem;
+  NipSettings nip;                    // added by the nip measurements
   CompressionSettings compression; // added by the compression study
   OutputSettings output;
   std::string measured_flux_file;     // optional gaussmeter scan to overlay in the report

@@ -766,6 +766,7 @@ private:
     build_applied_field(c, top.child("applied_field"));
     build_field(c.field, top.child("field"));
     build_dem(c.dem, top.child("dem"));
+    build_nip(c.nip, top.child("nip"));
     build_compression(c.compression, top.child("compression"));
     const Scope o = top.child("output");
     c.output.directory = str(o, "directory");
@@ -987,6 +988,16 @@ private:
     f.grid_electric_spacing = q(s, "grid_electric_spacing");
     f.probe_radius = q(s, "probe_radius");
     f.output_dir = str(s, "output_dir");
+  }
+
+  void build_nip(NipSettings &n, const Scope &s)
+  {
+    n.average_from = q(s, "average_from");
+    n.sample_interval = q(s, "sample_interval");
+    n.bin_width = q(s, "bin_width");
+    n.half_width = q(s, "half_width");
+    n.chain_bin_angle = q(s, "chain_bin_angle");
+    n.chain_half_angle = q(s, "chain_half_angle");
   }
 
   void build_dem(DemSettings &d, const Scope &s)

@@ -271,6 +271,19 @@ std::vector<KeySpec> build_schema()
       number("dem.max_kinetic_energy_growth", "Stability guard: kinetic energy may not grow by more than this factor between checks.")
           .def("1000").min(1.0, false),
 
+      section("nip", "Development-nip measurements (a scene with sleeve and drum): profiles along the gap of the beads "
+                     "touching the drum, chain inclination, bead counts (docs/nip.md)."),
+      quantity("nip.average_from", D::time, "Time-average the nip profiles over the samples at t >= this (the steady state).")
+          .def("0 s").non_negative(),
+      quantity("nip.sample_interval", D::time, "Time between samples of the nip measurements.").def("2 us").positive(),
+      quantity("nip.bin_width", D::length, "Bin width along the nip (x: distance from the gap centre along the common tangent).")
+          .def("0.25 mm").positive(),
+      quantity("nip.half_width", D::length, "The drum profiles cover -half_width <= x <= half_width.").def("4 mm").positive(),
+      quantity("nip.chain_bin_angle", D::angle, "Bin width of the chain-inclination profile in sleeve angle.")
+          .def("2 deg").positive(),
+      quantity("nip.chain_half_angle", D::angle, "The chain-inclination profile covers sleeve angles within this of the gap centre.")
+          .def("30 deg").positive().max(180.0 * pi / 180.0),
+
       section("compression", "Kawamoto's compression test: the plate measurement of a box scene with a moving "
                              "plate and a stage (forces, touching beads, chain spacing, contact maps; docs/compression_study.md)."),
       text("compression.plate", "Name of the moving plane wall (the pseudo-photoreceptor plate).").def("plate"),

@@ -33,15 +33,17 @@ PlaneWallPrimitive primitive_of(const PlaneWall &p)
   return w;
 }
 
-const char *axis_name(int a) { return a == 0 ? "x" : a == 1 ? "y" : "z"; }
+const char *axis_name(int a)
+{
+  return a == 0 ? "x" : a == 1 ? "y" : "z";
+}
 
 // Registered at start-up: every box scene with a plate and a stage gets this measurement.
-const bool registered = register_measurement(
-    {"plate compression", [](const Case &c) -> std::unique_ptr<Measurement> {
-       if (!PlateCompression::applies(c))
-         return nullptr;
-       return std::make_unique<PlateCompression>(c);
-     }});
+const bool registered = register_measurement({"plate compression", [](const Case &c) -> std::unique_ptr<Measurement> {
+                                                if (!PlateCompression::applies(c))
+                                                  return nullptr;
+                                                return std::make_unique<PlateCompression>(c);
+                                              }});
 
 } // namespace
 
@@ -79,13 +81,15 @@ PlateCompression::PlateCompression(const Case &c) : settings_(c.compression)
     if (!(box[a] > 0.0))
       throw std::invalid_argument(std::string("plate compression: the box must be periodic along ") + axis_name(a) +
                                   " (in the plate plane) to define the pressure area; set dem.periodic_length" +
-                                  (a == 0 ? "_x" : a == 1 ? "_y" : "") + " (Kawamoto: 2 mm)");
+                                  (a == 0   ? "_x"
+                                   : a == 1 ? "_y"
+                                            : "") +
+                                  " (Kawamoto: 2 mm)");
   area_ = box[in_plane_[0]] * box[in_plane_[1]];
   if (!(settings_.average_window >= settings_.sample_interval))
-    throw std::invalid_argument("plate compression: compression.average_window (" +
-                                std::to_string(settings_.average_window) +
-                                " s) must be at least one compression.sample_interval (" +
-                                std::to_string(settings_.sample_interval) + " s)");
+    throw std::invalid_argument(
+        "plate compression: compression.average_window (" + std::to_string(settings_.average_window) +
+        " s) must be at least one compression.sample_interval (" + std::to_string(settings_.sample_interval) + " s)");
   samples_per_window_ = std::max(1L, std::lround(settings_.average_window / settings_.sample_interval));
   field_ = AppliedMagneticField::from_settings(c.applied_field);
   next_map_ = settings_.map_interval;
@@ -224,7 +228,8 @@ void PlateCompression::write(const std::string &directory) const
   std::snprintf(line, sizeof line,
                 "# plate compression: plate '%s', stage '%s', periodic area %.9g m^2, rows = means over %ld samples "
                 "every %.6g s\n",
-                settings_.plate.c_str(), settings_.stage.c_str(), area_, samples_per_window_, settings_.sample_interval);
+                settings_.plate.c_str(), settings_.stage.c_str(), area_, samples_per_window_,
+                settings_.sample_interval);
   text += line;
   std::snprintf(line, sizeof line,
                 "time_s,brush_length_m,B_T,Fn_N,Ft_%s_N,Ft_%s_N,Ft_N,pn_Pa,pt_Pa,touching,density_per_mm2,"

@@ -38,9 +38,9 @@ namespace magbrush::dem {
 struct PlateContactBead
 {
   std::int32_t id = 0;
-  double u = 0, v = 0;    // centre in the plate plane (coordinates along the two in-plane axes) [m]
-  double radius = 0;      // [m]
-  double fn = 0;          // normal force on the plate [N] (> 0 pushing it away)
+  double u = 0, v = 0;       // centre in the plate plane (coordinates along the two in-plane axes) [m]
+  double radius = 0;         // [m]
+  double fn = 0;             // normal force on the plate [N] (> 0 pushing it away)
   double ft_u = 0, ft_v = 0; // tangential force on the plate [N]
 };
 
@@ -53,13 +53,13 @@ struct PlateContactMap
 // One output row: means over an averaging window.
 struct PlateCompressionRow
 {
-  double time = 0;       // mean sample time [s]
-  double gap = 0;        // brush length [m]
-  double field = 0;      // applied |B| at the stage [T]
-  double fn = 0;         // normal force [N]
+  double time = 0;           // mean sample time [s]
+  double gap = 0;            // brush length [m]
+  double field = 0;          // applied |B| at the stage [T]
+  double fn = 0;             // normal force [N]
   double ft_u = 0, ft_v = 0; // tangential force components along the in-plane axes [N]
-  double ft = 0;         // |mean tangential force| [N]
-  double touching = 0;   // mean number of beads touching the plate
+  double ft = 0;             // |mean tangential force| [N]
+  double touching = 0;       // mean number of beads touching the plate
   long samples = 0;
 };
 
@@ -93,10 +93,10 @@ private:
   CompressionSettings settings_;
   PlaneWallPrimitive plate_, stage_;
   AppliedMagneticField field_;
-  int normal_axis_ = 2;          // the coordinate axis the plate normal lies along
+  int normal_axis_ = 2;                 // the coordinate axis the plate normal lies along
   std::array<int, 2> in_plane_{{0, 1}}; // the two in-plane axes (u, v)
-  double area_ = 0.0;            // periodic area l_u × l_v [m²]
-  std::size_t plate_wall_ = 0;   // index among the engine's walls (found at the first sample)
+  double area_ = 0.0;                   // periodic area l_u × l_v [m²]
+  std::size_t plate_wall_ = 0;          // index among the engine's walls (found at the first sample)
   bool wall_found_ = false;
 
   // The window being accumulated.
@@ -105,7 +105,7 @@ private:
   double next_map_ = 0.0;
   std::vector<PlateCompressionRow> rows_;
   std::vector<PlateContactMap> maps_;
-  PlateContactMap last_map_;     // the latest sample's map (written at the end)
+  PlateContactMap last_map_; // the latest sample's map (written at the end)
   std::vector<WallContactRecord> records_;
   long samples_per_window_ = 1;
 

@@ -42,21 +42,19 @@ std::string error_of(const std::string &text, const std::vector<std::string> &ov
 
 TEST(FieldSchedule, PiecewiseLinearAndHeldOutside)
 {
-  const AppliedMagneticField f = AppliedMagneticField::uniform_schedule(
-      {0, 0, 2}, {{1e-3, 0.0}, {2e-3, 0.13}, {3e-3, 0.13}, {3.5e-3, 0.03}});
+  const AppliedMagneticField f =
+      AppliedMagneticField::uniform_schedule({0, 0, 2}, {{1e-3, 0.0}, {2e-3, 0.13}, {3e-3, 0.13}, {3.5e-3, 0.03}});
   auto bz = [&](double t) { return f.field({0, 0, 0}, t)[2]; };
-  EXPECT_DOUBLE_EQ(bz(0.0), 0.0);          // before the first sample: its value
+  EXPECT_DOUBLE_EQ(bz(0.0), 0.0); // before the first sample: its value
   EXPECT_DOUBLE_EQ(bz(1e-3), 0.0);
-  EXPECT_NEAR(bz(1.5e-3), 0.065, 1e-15);   // linear
-  EXPECT_NEAR(bz(2.5e-3), 0.13, 1e-15);    // hold
-  EXPECT_NEAR(bz(3.25e-3), 0.08, 1e-15);   // linear down
-  EXPECT_NEAR(bz(10e-3), 0.03, 1e-15);     // after the last: held
+  EXPECT_NEAR(bz(1.5e-3), 0.065, 1e-15); // linear
+  EXPECT_NEAR(bz(2.5e-3), 0.13, 1e-15);  // hold
+  EXPECT_NEAR(bz(3.25e-3), 0.08, 1e-15); // linear down
+  EXPECT_NEAR(bz(10e-3), 0.03, 1e-15);   // after the last: held
   EXPECT_DOUBLE_EQ(f.field({0, 0, 0}, 2.2e-3)[0], 0.0);
   // A single sample is a constant field.
-  EXPECT_NEAR(AppliedMagneticField::uniform_schedule({1, 0, 0}, {{0.0, 0.05}}).field({0, 0, 0}, 1.0)[0], 0.05,
-              1e-15);
-  EXPECT_THROW(AppliedMagneticField::uniform_schedule({0, 0, 1}, {{1e-3, 0.1}, {1e-3, 0.2}}),
-               std::invalid_argument);
+  EXPECT_NEAR(AppliedMagneticField::uniform_schedule({1, 0, 0}, {{0.0, 0.05}}).field({0, 0, 0}, 1.0)[0], 0.05, 1e-15);
+  EXPECT_THROW(AppliedMagneticField::uniform_schedule({0, 0, 1}, {{1e-3, 0.1}, {1e-3, 0.2}}), std::invalid_argument);
   EXPECT_THROW(AppliedMagneticField::uniform_schedule({0, 0, 1}, {{0.0, 0.0}}), std::invalid_argument);
   EXPECT_THROW(AppliedMagneticField::uniform_schedule({0, 0, 1}, {{0.0, -0.1}}), std::invalid_argument);
 }
@@ -85,15 +83,17 @@ TEST(FieldSchedule, ParsedFromTheCaseWithUnits)
                                      "t.yaml", overrides);
   EXPECT_EQ(again.applied_field.schedule, c.applied_field.schedule);
   // The whole schedule can be replaced from the command line.
-  const Case swept = parse_case_text(box_with + "  magnitude: 130 mT\n", "t.yaml",
-                                     {"applied_field.magnitude=0 mT",
-                                      "applied_field.schedule=[{time: 0 s, magnitude: 20 mT}, {time: 1 ms, magnitude: 60 mT}]"});
+  const Case swept =
+      parse_case_text(box_with + "  magnitude: 130 mT\n", "t.yaml",
+                      {"applied_field.magnitude=0 mT",
+                       "applied_field.schedule=[{time: 0 s, magnitude: 20 mT}, {time: 1 ms, magnitude: 60 mT}]"});
   EXPECT_DOUBLE_EQ(swept.applied_field.uniform_magnitude, 0.06);
 }
 
 TEST(FieldSchedule, InconsistentInputIsRefusedWithTheKey)
 {
-  const std::string both = error_of(box_with + "  magnitude: 130 mT\n  schedule:\n    - {time: 0 s, magnitude: 1 mT}\n");
+  const std::string both =
+      error_of(box_with + "  magnitude: 130 mT\n  schedule:\n    - {time: 0 s, magnitude: 1 mT}\n");
   EXPECT_NE(both.find("applied_field.magnitude: give either a schedule or magnitude"), std::string::npos) << both;
   const std::string order = error_of(box_with + "  schedule:\n    - {time: 1 ms, magnitude: 1 mT}\n"
                                                 "    - {time: 0.5 ms, magnitude: 2 mT}\n");

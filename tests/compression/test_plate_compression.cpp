@@ -26,8 +26,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr double plate_height = 1.0e-3; // stage at z = 0, plate at z = 1 mm
-constexpr double lx = 1.0e-3, ly = 0.5e-3;  // periodic area 0.5 mm²
+constexpr double plate_height = 1.0e-3;    // stage at z = 0, plate at z = 1 mm
+constexpr double lx = 1.0e-3, ly = 0.5e-3; // periodic area 0.5 mm²
 
 // A box with a stage and a plate; the plate path is given as YAML.
 std::string scene(const std::string &plate_path, double bead_density)
@@ -47,7 +47,8 @@ std::string scene(const std::string &plate_path, double bead_density)
     << " kg/m^3, friction: 0.45}\n"
        "  wall: {youngs_modulus: 5e4 MPa, poisson_ratio: 0.3, friction: 0.35}\n"
        "populations:\n"
-       "  - {name: carrier, material: bead, diameter: 60 um, count: 1, insert_box: [[0, 0, 0.2 mm], [1 mm, 0.5 mm, 0.8 mm]]}\n"
+       "  - {name: carrier, material: bead, diameter: 60 um, count: 1, insert_box: [[0, 0, 0.2 mm], [1 mm, 0.5 mm, 0.8 "
+       "mm]]}\n"
        "applied_field:\n"
        "  kind: uniform\n"
        "  schedule:\n"
@@ -200,11 +201,11 @@ TEST(PlateCompression, PressedBeadsGiveHertzForcesDensityAndSpacing)
   const auto &r = rows[0];
   const double area_mm2 = lx * ly * 1e6, n = 5.0;
   EXPECT_NEAR(r[1], plate_height, 1e-12);
-  EXPECT_NEAR(r[7], r[3] / (lx * ly), 1e-6 * r[7]);               // pressure
-  EXPECT_NEAR(r[9], n, 1e-12);                                   // touching
-  EXPECT_NEAR(r[10], n / area_mm2, 1e-6);                         // 10 beads/mm²
-  EXPECT_NEAR(r[11], r[3] / n, 1e-6 * r[11]);                     // mean force per bead
-  EXPECT_NEAR(r[12], std::sqrt(lx * ly / n), 1e-9 * r[12]);       // l/√n
+  EXPECT_NEAR(r[7], r[3] / (lx * ly), 1e-6 * r[7]);         // pressure
+  EXPECT_NEAR(r[9], n, 1e-12);                              // touching
+  EXPECT_NEAR(r[10], n / area_mm2, 1e-6);                   // 10 beads/mm²
+  EXPECT_NEAR(r[11], r[3] / n, 1e-6 * r[11]);               // mean force per bead
+  EXPECT_NEAR(r[12], std::sqrt(lx * ly / n), 1e-9 * r[12]); // l/√n
   // The contact map at the end carries the exact per-bead forces.
   const auto map_rows = read_csv((dir / "contact_map_000.csv").string());
   ASSERT_EQ(map_rows.size(), beads.size());

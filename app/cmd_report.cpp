@@ -1,0 +1,259 @@
+// `magbrush report CASE`: the report of a finished run — plots like Kawamoto's Fig. 17–20 (slip,
+// pressures, their ratio, touching density, chain inclination along the nip), the sleeve flux
+// profile (over a measured scan when the case names one), a view of the brush in the nip from
+// the last snapshot, the time series, and index.md / index.html with the key numbers and the
+// links to the ParaView files.
+//
+// The steps, as run_report() reads:
+//   1. load the case (with --set overrides, exactly as the run did);
+//   2. check that the DEM outputs are there (clear error naming the missing file otherwise);
+//   3. write into <output.directory>/report/: the resolved case, the measured scan normalised
+//      to angle_deg,Bn_mT,Bt_mT (read by the same reader as `magbrush flux`);
+//   4. call tools/report.py (found next to the sources this binary was built from, or in
+//      $MAGBRUSH_TOOLS) with /usr/bin/python3 or $MAGBRUSH_PYTHON: it draws the PNGs and writes
+//      index.md and index.html, every file atomically.
+#include "subcommand.h"
+
+#include "case_format.h"
+#include "case_parser.h"
+#include "field_files.h"
+#include "flux_scan.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <sys/wait.h>
+#include <vector>
+
+namespace magbrush {
+namespace {
+
+namespace fs = std::filesystem;
+
+const char *report_help =
+    R"(Usage: magbrush report CASE [--set key=value ...] [-o DIR]
+
+Writes the report of a finished run of CASE into <output.directory>/report/ (or DIR):
+  nip_slip.png, nip_pressure.png, nip_ratio.png, nip_density.png, nip_force_per_bead.png,
+  chain_inclination.png   profiles along the nip (Kawamoto Fig. 17-20), when the scene has a drum
+  flux_profile.png        the computed sleeve flux (over output.measured_flux_file's scan if given)
+  brush_snapshot.png      the brush in the nip at the last snapshot, beads coloured by speed
+  time_series.png         kinetic energy, contacts, wall loads, bead budget
+  index.md, index.html    the key numbers (slip at the gap centre against the relative surface
+                          speed, peak normal pressure against B^2/2mu0, tangential/normal,
+                          touching density, beads in/out, run times per stage and force term)
+                          with the plots and links to the ParaView files
+Needs the DEM outputs (<output.directory>/dem/: run `magbrush dem CASE` or `magbrush run CASE`
+first) and python3 with matplotlib, numpy and h5py (Debian: python3-matplotlib python3-h5py);
+$MAGBRUSH_PYTHON picks the interpreter, $MAGBRUSH_TOOLS the folder holding report.py.
+Exit status: 0 done, 1 missing outputs or a failed plot script, 2 bad usage.
+)";
+
+std::string quoted(const std::string &s)
+{
+  std::string q = "'";
+  for (char ch : s)
+    q += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
+  return q + "'";
+}
+
+// tools/report.py of the source tree this binary was built from (__FILE__ is the absolute
+// source path CMake compiled), or $MAGBRUSH_TOOLS/report.py, or next to the executable.
+std::string find_report_script()
+{
+  std::vector<fs::path> candidates;
+  if (const char *env = std::getenv("MAGBRUSH_TOOLS"))
+    candidates.push_back(fs::path(env) / "report.py");
+  candidates.push_back(fs::path(__FILE__).parent_path().parent_path() / "tools" / "report.py");
+  const fs::path exe = executable_dir();
+  candidates.push_back(exe / ".." / ".." / "tools" / "report.py");
+  candidates.push_back(exe / ".." / "share" / "magbrush" / "tools" / "report.py");
+  for (const auto &c : candidates)
+  {
+    std::error_code ec;
+    if (fs::is_regular_file(c, ec))
+      return fs::weakly_canonical(c, ec).string();
+  }
+  return "";
+}
+
+std::string python_interpreter()
+{
+  if (const char *env = std::getenv("MAGBRUSH_PYTHON"))
+    return env;
+  if (fs::exists("/usr/bin/python3"))
+    return "/usr/bin/python3"; // the Debian one, with python3-matplotlib / python3-h5py
+  return "python3";
+}
+
+void write_text_atomically(const fs::path &path, const std::string &text)
+{
+  const fs::path tmp = path.string() + ".tmp";
+  {
+    std::ofstream o(tmp);
+    if (!o)
+      throw std::runtime_error("cannot write '" + tmp.string() + "': check that the folder is writable");
+    o << text;
+    if (!o)
+      throw std::runtime_error("writing '" + tmp.string() + "' failed (disk full?)");
+  }
+  fs::rename(tmp, path);
+}
+
+// The case's measured scan in the report's own simple format (angle_deg, Bn_mT, Bt_mT), so
+// that the plot script does not need to know the many scan dialects `magbrush flux` reads.
+std::string normalised_scan(const Case &c, const fs::path &report_dir)
+{
+  if (c.measured_flux_file.empty())
+    return "";
+  const FluxScan scan = read_flux_scan(c.measured_flux_file);
+  std::ostringstream o;
+  o << "# measured sleeve flux from " << c.measured_flux_file << " (units normalised by magbrush report)\n";
+  o << (scan.has_tangential() ? "angle_deg,Bn_mT,Bt_mT\n" : "angle_deg,Bn_mT\n");
+  char line[128];
+  for (std::size_t k = 0; k < scan.size(); ++k)
+  {
+    double a = std::fmod(scan.angle[k] * 180.0 / M_PI, 360.0);
+    if (a < 0)
+      a += 360.0;
+    if (scan.has_tangential())
+      std::snprintf(line, sizeof line, "%.6f,%.6f,%.6f\n", a, scan.Bn[k] * 1e3, scan.Bt[k] * 1e3);
+    else
+      std::snprintf(line, sizeof line, "%.6f,%.6f\n", a, scan.Bn[k] * 1e3);
+    o << line;
+  }
+  const fs::path out = report_dir / "measured_flux.csv";
+  write_text_atomically(out, o.str());
+  return out.string();
+}
+
+int run_report(const std::vector<std::string> &args)
+{
+  std::string case_path, output_dir;
+  std::vector<std::string> overrides;
+  for (std::size_t i = 1; i < args.size(); ++i)
+  {
+    const std::string &a = args[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= args.size())
+        throw std::invalid_argument(a + " needs a value (see magbrush report --help)");
+      return args[++i];
+    };
+    if (a == "--help" || a == "-h")
+    {
+      std::cout << report_help;
+      return 0;
+    }
+    else if (a == "--set")
+      overrides.push_back(value());
+    else if (a.rfind("--set=", 0) == 0)
+      overrides.push_back(a.substr(6));
+    else if (a == "-o" || a == "--output")
+      output_dir = value();
+    else if (a == "-np" || a == "--np" || a == "--threads" || a == "--restart")
+      ++i; // options of other stages passed along by `magbrush run`
+    else if (a == "--force" || a == "--no-vtu")
+      ; // field-solver options passed along by `magbrush run`
+    else if (!a.empty() && a[0] == '-')
+    {
+      std::cerr << "magbrush report: unknown option '" << a << "'\n" << report_help;
+      return 2;
+    }
+    else if (case_path.empty())
+      case_path = a;
+    else
+    {
+      std::cerr << "magbrush report: expected one case file, found a second: '" << a << "'\n";
+      return 2;
+    }
+  }
+  if (case_path.empty())
+  {
+    std::cerr << report_help;
+    return 2;
+  }
+
+  const Case c = load_case(case_path, overrides);
+  const fs::path results = c.output.directory;
+  const fs::path dem_dir = results / "dem";
+  const fs::path report_dir = output_dir.empty() ? results / "report" : fs::path(output_dir);
+  // The DEM outputs the report is made of.
+  for (const char *needed : {"time_series.csv", "particles.xdmf"})
+    if (!fs::exists(dem_dir / needed))
+    {
+      std::cerr << "magbrush report: no DEM results for case '" << c.name << "': expected " << (dem_dir / needed).string()
+                << ", which is missing.\n  Run the particles first: magbrush dem " << case_path
+                << " (or the whole pipeline: magbrush run " << case_path << ").\n";
+      return 1;
+    }
+  const bool nip = c.sleeve && c.drum.present && c.dem.periodic_length > 0.0;
+  if (nip && !fs::exists(dem_dir / "nip_profile.csv"))
+  {
+    std::cerr << "magbrush report: case '" << c.name << "' has a nip but " << (dem_dir / "nip_profile.csv").string()
+              << " is missing: the DEM run was made by an engine without the nip measurements, or stopped before "
+                 "its end. Rebuild (cmake --build build --target magbrush-dem) and rerun `magbrush dem "
+              << case_path << "`.\n";
+    return 1;
+  }
+  fs::create_directories(report_dir);
+  write_text_atomically(report_dir / "case_resolved.txt",
+                        "# case " + c.name + " as resolved for this report (" + case_path + ")\n" + format_case(c));
+  const std::string scan = normalised_scan(c, report_dir);
+
+  const std::string script = find_report_script();
+  if (script.empty())
+  {
+    std::cerr << "magbrush report: tools/report.py not found next to the sources of this build; set MAGBRUSH_TOOLS to "
+                 "the folder that holds it\n";
+    return 1;
+  }
+  std::ostringstream cmd;
+  char geometry[256];
+  const Vec2 drum_centre = c.drum.present && c.sleeve ? c.drum.center(c.sleeve->radius) : Vec2{0, 0};
+  std::snprintf(geometry, sizeof geometry,
+                " --sleeve-radius %.9g --drum-radius %.9g --drum-center %.9g,%.9g --sleeve-sense %d",
+                c.sleeve ? c.sleeve->radius : 0.0, c.drum.present ? c.drum.radius : 0.0, drum_centre[0],
+                drum_centre[1], c.sleeve && c.sleeve->rpm < 0.0 ? -1 : 1);
+  cmd << quoted(python_interpreter()) << " " << quoted(script) << " --case-name " << quoted(c.name) << " --dem-dir "
+      << quoted(dem_dir.string()) << " --field-prefix " << quoted(field::field_file(c, "")) << " --out "
+      << quoted(report_dir.string()) << " --run-times " << quoted((results / "run_times.csv").string()) << geometry;
+  if (!scan.empty())
+    cmd << " --measured-flux " << quoted(scan);
+  std::cout << "magbrush report: writing " << report_dir.string() << "/ ..." << std::endl;
+  const int raw = std::system(cmd.str().c_str());
+  const int status = raw == -1 ? -1 : (WIFEXITED(raw) ? WEXITSTATUS(raw) : -1);
+  if (status != 0)
+  {
+    std::cerr << "magbrush report: the plot script failed (exit " << status << "): " << cmd.str()
+              << "\n  It needs python3 with numpy, matplotlib and h5py (Debian: apt-get install python3-matplotlib "
+                 "python3-h5py), or set MAGBRUSH_PYTHON to an interpreter that has them.\n";
+    return 1;
+  }
+  std::cout << "magbrush report: " << (report_dir / "index.html").string() << " (and index.md)\n";
+  return 0;
+}
+
+int report_main(const std::vector<std::string> &args)
+{
+  try
+  {
+    return run_report(args);
+  }
+  catch (const std::invalid_argument &e)
+  {
+    std::cerr << "magbrush report: " << e.what() << "\n";
+    return 2;
+  }
+}
+
+const bool registered = register_subcommand(
+    {"report", "plots, key numbers and ParaView links of a finished run (index.html)", report_main, 50});
+
+} // namespace
+} // namespace magbrush

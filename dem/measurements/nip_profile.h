@@ -1,0 +1,111 @@
+// Profiles along the development nip of the beads touching the drum (Kawamoto Fig. 17–20),
+// time-averaged over the steady state (samples at t ≥ nip.average_from):
+//
+//  * slip speed: velocity of the bead's material at its contact point on the drum minus the
+//    velocity of the drum surface there, tangential component along the downstream tangent
+//    of the drum (the paper: equal to the relative surface speed 0.135 m/s at the gap centre);
+//  * normal and tangential pressure on the drum: Σ (force of the touching beads on the drum,
+//    normal component pushing into the drum / tangential component downstream) per bin, over
+//    the drum surface of the bin (arc length of the bin on the drum × slab depth);
+//  * density of the beads touching the drum [1/mm²] and the mean normal force per bead.
+//
+// Bins: centred on the gap centre, width nip.bin_width, along x (NipFrame: distance from the
+// gap centre along the common tangent, positive downstream); a contact is binned by the x of
+// its contact point on the drum surface. Each row also gives the drum arc length and angle
+// and the sleeve angle of its bin centre.
+//
+// Files (in the run's output folder): nip_profile.csv (one row per bin, units in the header)
+// and nip_summary.csv (key numbers: slip at the gap centre against the relative surface speed,
+// peak normal pressure against the magnetic pressure B²/2μ0 at the gap centre, tangential /
+// normal, touching density, samples and averaging window).
+#pragma once
+
+#include "dem_system.h"
+#include "measurement.h"
+#include "nip_frame.h"
+#include "vector3.h"
+
+#include "case_model.h"
+
+#include <string>
+#include <vector>
+
+namespace magbrush::dem {
+
+// One bead touching the drum at one sample: what the profile needs from the engine.
+struct DrumContact
+{
+  Vector3 position, velocity, angular_velocity; // bead centre, its velocity and spin
+  double radius = 0.0;
+  Vector3 force_on_wall;                          // the force the bead exerts on the drum [N]
+};
+
+// The per-contact quantities in the nip frame.
+struct DrumContactInFrame
+{
+  double x = 0.0;          // nip coordinate of the contact point on the drum [m]
+  double slip = 0.0;       // tangential slip speed, bead relative to drum, downstream > 0 [m/s]
+  double normal = 0.0;     // force pressing into the drum [N]
+  double tangential = 0.0; // force on the drum along the downstream tangent [N]
+};
+DrumContactInFrame resolve_drum_contact(const NipFrame &frame, const DrumContact &c);
+
+// Time-averaged value of one bin.
+struct NipBin
+{
+  double x = 0.0, x_lo = 0.0, x_hi = 0.0;   // centre and edges [m]
+  double area = 0.0;                         // drum surface of the bin in the slab [m²]
+  double touching = 0.0;                     // mean number of touching beads per sample
+  double density = 0.0;                      // touching beads per area [1/m²]
+  double normal_pressure = 0.0;              // [Pa]
+  double tangential_pressure = 0.0;          // [Pa]
+  double slip = 0.0, slip_std = 0.0;         // mean over touching beads and its spread [m/s] (NaN: none)
+  double normal_force_per_bead = 0.0;        // [N] (NaN: none)
+  long contacts = 0;                         // contact samples accumulated
+};
+
+class NipProfile : public Measurement
+{
+public:
+  explicit NipProfile(const Case &c);
+
+  const char *name() const override { return "nip profile"; }
+  double interval() const override { return settings_.sample_interval; }
+  void sample(const DemSystem &system) override;
+  void write(const std::string &directory) const override;
+
+  // The same accumulation from hand-made contacts (what sample() extracts from the engine).
+  void add_sample(double time, const std::vector<DrumContact> &contacts);
+
+  const NipFrame &frame() const { return frame_; }
+  long samples() const { return samples_; }
+  std::vector<NipBin> bins() const;
+  // Key numbers over the averaging window.
+  double slip_at_gap_centre() const;          // mean slip of the centre bin [m/s]
+  double tangential_over_normal() const;      // Σ F_t / Σ F_n over every bin
+  double peak_normal_pressure() const;        // [Pa]
+  // |B| of the applied field at the gap centre [T] when the case's magnetic grid could be read
+  // at construction (else NaN); the magnetic pressure scale is B²/2μ0.
+  double gap_centre_field() const { return gap_field_; }
+
+  std::string csv() const;
+  std::string summary_csv() const;
+
+private:
+  NipSettings settings_;
+  NipFrame frame_;
+  std::size_t drum_wall_ = 0;
+  int bins_half_ = 0;                 // bins k = −bins_half_ … +bins_half_
+  std::vector<double> fn_, ft_, slip_, slip2_;
+  std::vector<long> count_;
+  long samples_ = 0;
+  double t_first_ = -1.0, t_last_ = -1.0;
+  double gap_field_;
+  std::vector<WallContactRecord> records_; // reused between samples
+  std::vector<DrumContact> contacts_;
+
+  int bin_of(double x) const;         // −1: outside the profile
+  std::size_t find_drum_wall(const DemSystem &system) const;
+};
+
+} // namespace magbrush::dem

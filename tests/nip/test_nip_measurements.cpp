@@ -1,0 +1,328 @@
+// The nip measurements against results computed independently here: hand-placed beads on the
+// drum with known forces and velocities (exact bin values), hand-placed bead pairs with known
+// branch directions (exact inclinations), beads moved across the nip window (exact counts),
+// and one engine step with beads pressed on a turning drum (Hertz force, slip = −drum speed).
+#include "chain_inclination.h"
+#include "nip_frame.h"
+#include "nip_profile.h"
+#include "nip_time_series.h"
+
+#include "dem_system.h"
+
+#include "case_parser.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+using namespace magbrush;
+using namespace magbrush::dem;
+
+namespace {
+
+constexpr double pi = M_PI;
+
+// Kawamoto's prototype nip, turned so that the drum sits at `drum_angle` (the frame must not
+// assume the drum on +x).
+Case nip_case(double drum_angle = 0.0)
+{
+  Case c;
+  c.name = "nip_test";
+  c.source_file = "(test)";
+  Sleeve s;
+  s.radius = 12.5e-3;
+  s.rpm = 219.0;
+  c.sleeve = s;
+  c.drum.present = true;
+  c.drum.radius = 50e-3;
+  c.drum.rpm = -29.0;
+  c.drum.gap = 0.4e-3;
+  c.drum.angle = drum_angle;
+  for (const char *name : {"carrier", "sleeve", "drum"})
+  {
+    Material m;
+    m.name = name;
+    m.youngs_modulus = std::string(name) == "carrier" ? 1e9 : 5e10;
+    m.poisson_ratio = std::string(name) == "carrier" ? 0.35 : 0.3;
+    m.density = 2200;
+    m.friction = std::string(name) == "carrier" ? 0.45 : 0.35;
+    m.damping = 0.6;
+    c.materials.push_back(m);
+  }
+  Population p;
+  p.name = "carrier";
+  p.material = "carrier";
+  p.diameter_mean = 60e-6;
+  c.populations.push_back(p);
+  c.dem.periodic_length = 1e-3;
+  c.dem.gravity = {0, 0, 0};
+  c.dem.air_viscosity = 0.0;
+  c.nip.bin_width = 0.25e-3;
+  c.nip.half_width = 2e-3;
+  return c;
+}
+
+// A point at nip coordinate x on the drum surface, pushed `out` outward from it, in the frame.
+Vector3 on_drum(const NipFrame &f, double x, double out, double z = 0.5e-3)
+{
+  const double psi = std::asin(x / f.drum_radius);
+  // Drum surface point: C + Rd (−n cos ψ + t sin ψ).
+  const double ux = -f.nx * std::cos(psi) + f.tx * std::sin(psi), uy = -f.ny * std::cos(psi) + f.ty * std::sin(psi);
+  return {f.cx + (f.drum_radius + out) * ux, f.cy + (f.drum_radius + out) * uy, z};
+}
+
+} // namespace
+
+TEST(NipFrame, RelativeSpeedAndCoordinatesOfThePrototype)
+{
+  for (double angle : {0.0, 0.7})
+  {
+    const NipFrame f = NipFrame::from_case(nip_case(angle));
+    // π 25 mm 219 rpm/60 − π 100 mm 29 rpm/60 (both surfaces move the same way).
+    const double expected = pi * 25e-3 * 219.0 / 60.0 - pi * 100e-3 * 29.0 / 60.0;
+    EXPECT_NEAR(f.relative_surface_speed(), expected, 1e-12);
+    EXPECT_NEAR(expected, 0.1349, 1e-4);
+    // Gap centre at x = 0 and angles 0; a sleeve point at angle θ has x = Rs sin θ.
+    const double h = f.sleeve_radius + 0.5 * f.gap;
+    EXPECT_NEAR(f.x_along(h * f.nx, h * f.ny), 0.0, 1e-15);
+    const double th = 0.1;
+    const double px = f.sleeve_radius * (std::cos(th) * f.nx + std::sin(th) * f.tx);
+    const double py = f.sleeve_radius * (std::cos(th) * f.ny + std::sin(th) * f.ty);
+    EXPECT_NEAR(f.sleeve_angle(px, py), th, 1e-12);
+    EXPECT_NEAR(f.x_along(px, py), f.sleeve_radius * std::sin(th), 1e-15);
+    // Downstream is where the sleeve surface goes: ω ẑ × (Rs n) ∥ t.
+    EXPECT_NEAR(-f.ny * f.tx + f.nx * f.ty, 1.0, 1e-15);
+    const Vector3 q = on_drum(f, 1e-3, 0.0);
+    EXPECT_NEAR(f.x_along(q.x, q.y), 1e-3, 1e-15);
+    EXPECT_NEAR(f.drum_angle(q.x, q.y), std::asin(1e-3 / f.drum_radius), 1e-13);
+  }
+  Case no_drum = nip_case();
+  no_drum.drum.present = false;
+  EXPECT_FALSE(NipFrame::applies(no_drum));
+  EXPECT_THROW(NipFrame::from_case(no_drum), std::invalid_argument);
+}
+
+TEST(NipProfile, HandPlacedBeadsGiveExactBinValues)
+{
+  const Case c = nip_case(0.4);
+  NipProfile profile(c);
+  const NipFrame &f = profile.frame();
+  const double r = 30e-6, overlap = 0.2e-6, a = r - overlap; // lever arm centre → contact point
+  // Independent drum surface speed at the gap centre and its direction (downstream).
+  const double v_drum = -c.drum.omega() * c.drum.radius; // > 0: the drum moves downstream too
+  // Bead A at the gap centre: moving downstream at 0.2 m/s and spinning at w about +z.
+  // Its contact point moves at v + ω × (a n) (n: towards the drum) = v + w a (ẑ × n) = v + w a t.
+  DrumContact A;
+  A.position = on_drum(f, 0.0, r - overlap);
+  A.velocity = {0.2 * f.tx, 0.2 * f.ty, 0.0};
+  const double w = 1000.0;
+  A.angular_velocity = {0.0, 0.0, w};
+  A.radius = r;
+  // Force on the drum: 2 mN into the drum (−n_out = +n at the centre), 0.7 mN downstream.
+  A.force_on_wall = {2e-3 * f.nx + 0.7e-3 * f.tx, 2e-3 * f.ny + 0.7e-3 * f.ty, 0.0};
+  // Bead B at x = +1 mm (bin 4), at rest, pressing 1 mN along its own drum normal.
+  DrumContact B;
+  B.position = on_drum(f, 1e-3, r - overlap);
+  B.radius = r;
+  const double psi = std::asin(1e-3 / f.drum_radius);
+  const double nox = -f.nx * std::cos(psi) + f.tx * std::sin(psi), noy = -f.ny * std::cos(psi) + f.ty * std::sin(psi);
+  B.force_on_wall = {-1e-3 * nox, -1e-3 * noy, 0.0};
+  // Bead C outside the profile (x = 3 mm > half_width): ignored.
+  DrumContact C = B;
+  C.position = on_drum(f, 3e-3, r - overlap);
+
+  profile.add_sample(1e-3, {A, B, C});
+  profile.add_sample(2e-3, {A}); // second sample: only A
+  ASSERT_EQ(profile.samples(), 2);
+  const auto bins = profile.bins();
+  ASSERT_EQ(bins.size(), 17u); // −2 mm … +2 mm in 0.25 mm
+  const NipBin &b0 = bins[8], &b4 = bins[12];
+  EXPECT_NEAR(b0.x, 0.0, 1e-18);
+  EXPECT_NEAR(b4.x, 1e-3, 1e-15);
+  const double Rd = c.drum.radius, Lz = c.dem.periodic_length;
+  const double area0 = 2.0 * Rd * std::asin(0.125e-3 / Rd) * Lz;
+  const double area4 = Rd * (std::asin(1.125e-3 / Rd) - std::asin(0.875e-3 / Rd)) * Lz;
+  EXPECT_NEAR(b0.area / area0, 1.0, 1e-12);
+  EXPECT_NEAR(b4.area / area4, 1.0, 1e-12);
+  // A in both samples: mean force = its force; B in one of two: half of it.
+  EXPECT_NEAR(b0.normal_pressure, 2e-3 / area0, 1e-9 * 2e-3 / area0);
+  EXPECT_NEAR(b0.tangential_pressure, 0.7e-3 / area0, 1e-9 * 0.7e-3 / area0);
+  EXPECT_NEAR(b4.normal_pressure, 0.5e-3 / area4, 1e-9 * 0.5e-3 / area4);
+  EXPECT_NEAR(b4.tangential_pressure, 0.0, 1e-9 * 0.5e-3 / area4);
+  EXPECT_NEAR(b0.touching, 1.0, 1e-15);
+  EXPECT_NEAR(b4.touching, 0.5, 1e-15);
+  EXPECT_NEAR(b0.density, 1.0 / area0, 1e-9 / area0);
+  // Slip of A: 0.2 + w a − v_drum; of B: −(drum surface speed) at rest.
+  EXPECT_NEAR(b0.slip, 0.2 + w * a - v_drum, 1e-12);
+  EXPECT_NEAR(b0.slip_std, 0.0, 1e-7);
+  EXPECT_NEAR(b4.slip, -v_drum, 1e-12);
+  EXPECT_NEAR(profile.slip_at_gap_centre(), 0.2 + w * a - v_drum, 1e-12);
+  // Σ F_t / Σ F_n over both samples: (2 × 0.7) / (2 × 2 + 1) mN.
+  EXPECT_NEAR(profile.tangential_over_normal(), 1.4 / 5.0, 1e-12);
+  EXPECT_NEAR(profile.peak_normal_pressure(), 2e-3 / area0, 1e-9 * 2e-3 / area0);
+  // Empty bins have no slip (NaN), zero pressure.
+  EXPECT_TRUE(std::isnan(bins[0].slip));
+  EXPECT_EQ(bins[0].normal_pressure, 0.0);
+  // Before nip.average_from nothing is accumulated by the engine path; the CSV has units.
+  const std::string csv = profile.csv();
+  EXPECT_NE(csv.find("x_mm,"), std::string::npos);
+  EXPECT_NE(csv.find("normal_pressure_Pa"), std::string::npos);
+  EXPECT_NE(profile.summary_csv().find("slip_at_gap_centre"), std::string::npos);
+}
+
+TEST(ChainInclination, HandPlacedPairsGiveTheirBranchAngle)
+{
+  Case c = nip_case(0.0);
+  c.nip.chain_bin_angle = 2.0 * pi / 180.0;
+  c.nip.chain_half_angle = 20.0 * pi / 180.0;
+  ChainInclination chains(c);
+  const NipFrame f = NipFrame::from_case(c);
+  const double r = 30e-6, d = 2.0 * r * 0.999; // touching
+  std::vector<Vector3> x;
+  std::vector<double> radii;
+  // A pair with midpoint at sleeve angle θ, radius Rs + 0.2 mm, branch at β from the local
+  // normal (positive downstream): bin of θ must report β.
+  auto pair = [&](double theta, double beta, double z) {
+    const double rm = f.sleeve_radius + 0.2e-3;
+    const double ex = std::cos(theta), ey = std::sin(theta); // radial (drum on +x, CCW sleeve)
+    const double tx = -ey, ty = ex;                          // downstream tangent
+    const double bx = std::cos(beta) * ex + std::sin(beta) * tx, by = std::cos(beta) * ey + std::sin(beta) * ty;
+    const Vector3 m{rm * ex, rm * ey, z};
+    x.push_back({m.x - 0.5 * d * bx, m.y - 0.5 * d * by, z});
+    x.push_back({m.x + 0.5 * d * bx, m.y + 0.5 * d * by, z});
+    radii.push_back(r);
+    radii.push_back(r);
+  };
+  const double deg = pi / 180.0;
+  pair(-10 * deg, -25 * deg, 0.3e-3); // inlet, leaning back
+  pair(0.0, 0.0, 0.3e-3);             // gap centre, upright
+  pair(12 * deg, 35 * deg, 0.3e-3);   // outlet, leaning forward
+  // Bin at +6°: two pairs at ±20° → inclination 0, anisotropy cos 40°.
+  pair(6 * deg, 20 * deg, 0.2e-3);
+  pair(6 * deg, -20 * deg, 0.6e-3);
+  // Bin at −4°: two pairs at 10° and 100° → isotropic (anisotropy 0).
+  pair(-4 * deg, 10 * deg, 0.2e-3);
+  pair(-4 * deg, 100 * deg, 0.6e-3);
+  // A pair straddling the periodic boundary along z at −16°: touching through the image,
+  // branch nearly along z; in-plane part along the normal.
+  {
+    const double th = -16 * deg, rm = f.sleeve_radius + 0.2e-3;
+    x.push_back({rm * std::cos(th), rm * std::sin(th), 0.01e-3});
+    x.push_back({(rm + 5e-6) * std::cos(th), (rm + 5e-6) * std::sin(th), 1e-3 - 0.04e-3});
+    radii.push_back(r);
+    radii.push_back(r);
+  }
+  chains.add_sample(x, radii);
+  const auto bins = chains.bins();
+  auto at = [&](double theta_deg) { return bins[static_cast<std::size_t>(std::lround(theta_deg / 2.0) + 10)]; };
+  EXPECT_NEAR(at(-10).inclination, -25 * deg, 1e-12);
+  EXPECT_NEAR(at(0).inclination, 0.0, 1e-12);
+  EXPECT_NEAR(at(12).inclination, 35 * deg, 1e-12);
+  EXPECT_NEAR(at(-10).anisotropy, 1.0, 1e-12);
+  EXPECT_NEAR(at(6).inclination, 0.0, 1e-12);
+  EXPECT_NEAR(at(6).anisotropy, std::cos(40 * deg), 1e-12);
+  EXPECT_NEAR(at(-4).anisotropy, 0.0, 1e-12);
+  EXPECT_NEAR(at(6).contacts, 2.0, 0.0);
+  EXPECT_NEAR(at(-16).contacts, 1.0, 0.0); // found through the periodic image
+  EXPECT_NEAR(at(-16).inclination, 0.0, 1e-9);
+  EXPECT_TRUE(std::isnan(at(18).inclination)); // no contact there
+  // Pairs farther apart than the sum of radii are not contacts.
+  ChainInclination apart(c);
+  apart.add_sample({{12.7e-3, 0, 0.5e-3}, {12.7e-3 + 61e-6, 0, 0.5e-3}}, {r, r});
+  EXPECT_EQ(apart.bins()[10].contacts, 0.0);
+}
+
+TEST(NipTimeSeries, CountsBeadsCrossingTheWindowAndLostBeads)
+{
+  Case c = nip_case(0.0);
+  c.nip.chain_half_angle = 10.0 * pi / 180.0;
+  NipTimeSeries series(c);
+  const double rm = 12.6e-3, r = 30e-6, deg = pi / 180.0;
+  auto at = [&](double theta_deg) { return Vector3{rm * std::cos(theta_deg * deg), rm * std::sin(theta_deg * deg), 0.5e-3}; };
+  const std::vector<std::int32_t> ids = {0, 1, 2, 3};
+  const std::vector<double> radii(4, r);
+  // t0: bead 0 upstream, 1 in, 2 in, 3 in.
+  series.add_beads(0.0, ids, {at(-12), at(-5), at(5), at(0)}, radii);
+  // t1: 0 entered, 2 left, 3 went back upstream.
+  series.add_beads(1.0, ids, {at(-9), at(-4), at(11), at(-11)}, radii);
+  // t2: 3 re-enters, 1 flies off (lost: beyond the grid), 2 comes back in.
+  series.add_beads(2.0, ids, {at(-8), {0.1, 0.0, 0.0}, at(9), at(-9)}, radii);
+  const auto &rows = series.rows();
+  ASSERT_EQ(rows.size(), 3u);
+  EXPECT_EQ(rows[0].in_window, 3);
+  EXPECT_EQ(rows[1].in_window, 2); // 0, 1
+  EXPECT_EQ(rows[1].entered, 0); // +1 (bead 0) − 1 (bead 3 went back)
+  EXPECT_EQ(rows[1].left, 1);
+  EXPECT_EQ(rows[2].lost, 1);
+  EXPECT_EQ(rows[2].entered, 1);
+  EXPECT_EQ(rows[2].left, 0);
+  EXPECT_EQ(rows[2].in_window, 3); // 0, 2, 3
+  for (const auto &row : rows)
+  {
+    EXPECT_EQ(row.beads, 4);
+    if (row.lost == 0)
+    {
+      EXPECT_EQ(row.in_window, rows[0].in_window + row.entered - row.left);
+    }
+  }
+  // A non-finite bead is lost too.
+  series.add_beads(3.0, ids, {at(-8), {std::nan(""), 0.0, 0.0}, at(9), at(-9)}, radii);
+  EXPECT_EQ(series.rows().back().lost, 1);
+}
+
+TEST(NipProfile, OneEngineStepOnATurningDrum)
+{
+  // Beads pressed on the drum by a prescribed overlap, the drum turning: the profile must
+  // see the Hertz force (k_n δ^{3/2}, computed here from the materials) in the right bins
+  // and a slip equal to minus the drum surface speed (the beads are at rest).
+  Case c = nip_case(0.0);
+  c.sleeve->rpm = 0.0;
+  c.nip.sample_interval = 1e-9;
+  // A tiny step, so that the beads are still where they were put when the forces are read
+  // (the Hertz force accelerates a 60 µm bead at ~1e7 m/s²).
+  c.dem.time_step = 1e-11;
+  DemSystem system(c);
+  NipProfile profile(c);
+  const NipFrame &f = profile.frame();
+  const double r = 30e-6, overlap = 0.3e-6;
+  const Material &m = c.material("carrier");
+  for (double x : {-1e-3, 0.0, 0.5e-3, 1.5e-3})
+    system.particles().add(on_drum(f, x, r - overlap), r, m.density, 0, 0.0);
+  system.initialize();
+  system.step();
+  profile.sample(system);
+  // Hertz between a 1 GPa bead (ν 0.35) and a 50 GPa drum (ν 0.3), R* = r.
+  const Material &wall = c.material("drum");
+  const double e_star = 1.0 / ((1 - m.poisson_ratio * m.poisson_ratio) / m.youngs_modulus +
+                               (1 - wall.poisson_ratio * wall.poisson_ratio) / wall.youngs_modulus);
+  const double hertz = 4.0 / 3.0 * e_star * std::sqrt(r) * std::pow(overlap, 1.5);
+  const double v_drum = -c.drum.omega() * c.drum.radius;
+  const auto bins = profile.bins();
+  for (double x : {-1e-3, 0.0, 0.5e-3, 1.5e-3})
+  {
+    const NipBin &b = bins[static_cast<std::size_t>(std::lround(x / 0.25e-3) + 8)];
+    EXPECT_NEAR(b.normal_force_per_bead / hertz, 1.0, 2e-3) << "x = " << x;
+    EXPECT_NEAR(b.slip / -v_drum, 1.0, 1e-3) << "x = " << x;
+    // The drum drags the beads downstream: the beads drag it back (tangential < 0), at most μ F_n.
+    EXPECT_LT(b.tangential_pressure, 0.0);
+    EXPECT_LE(-b.tangential_pressure, 0.35 * b.normal_pressure * (1 + 1e-12));
+  }
+  EXPECT_EQ(bins[1].contacts, 0);
+}
+
+TEST(NipCaseKeys, DefaultsEqualTheContractStruct)
+{
+  const Case c = load_case(std::string(MAGBRUSH_SOURCE_DIR) + "/tests/case/valid/minimal_roller.yaml");
+  const NipSettings d;
+  EXPECT_DOUBLE_EQ(c.nip.average_from, d.average_from);
+  EXPECT_DOUBLE_EQ(c.nip.sample_interval, d.sample_interval);
+  EXPECT_DOUBLE_EQ(c.nip.bin_width, d.bin_width);
+  EXPECT_DOUBLE_EQ(c.nip.half_width, d.half_width);
+  EXPECT_NEAR(c.nip.chain_bin_angle, d.chain_bin_angle, 1e-15);
+  EXPECT_NEAR(c.nip.chain_half_angle, d.chain_half_angle, 1e-15);
+  const Case o = load_case(std::string(MAGBRUSH_SOURCE_DIR) + "/tests/case/valid/minimal_roller.yaml",
+                           {"nip.average_from=1ms", "nip.bin_width=0.1mm"});
+  EXPECT_NEAR(o.nip.average_from, 1e-3, 1e-18);
+  EXPECT_NEAR(o.nip.bin_width, 1e-4, 1e-18);
+}

@@ -1,0 +1,203 @@
+// The development nip end to end on a reduced scene (tests/nip/kawamoto_nip_reduced.yaml: a
+// 0.3 mm slab of 1,300 beads, the paper's magnetic cutoff), through `magbrush run` exactly as a
+// user runs it (field, DEM with the nip measurements, report), asserting Kawamoto's findings:
+//
+//  * the slip of the beads touching the drum at the gap centre equals the relative surface
+//    speed of sleeve and drum (0.135 m/s) within 5 %;
+//  * tangential / normal pressure on the drum = 0.35 ± 0.05 (the bead–drum friction);
+//  * the normal pressure is of the order of the magnetic pressure B²/2μ0 at the gap centre
+//    (its peak between 0.1× and 10×);
+//  * no bead is lost or created in the periodic slab, and the bead budget of the nip window
+//    balances (inside(t) = inside(0) + entered − left);
+//  * the report is written (index.html with the plots).
+//
+// Cost: about 1 min on 2 cores in Release (the DEM: 1.8 ms of simulated time, 45,000 steps).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <unistd.h>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string source_dir = MAGBRUSH_SOURCE_DIR;
+const std::string binary_dir = MAGBRUSH_BINARY_DIR;
+
+// Columns of a magbrush CSV by header name ('#' lines skipped).
+std::map<std::string, std::vector<std::string>> read_csv(const fs::path &path)
+{
+  std::ifstream in(path);
+  std::string line;
+  std::vector<std::string> header;
+  std::map<std::string, std::vector<std::string>> cols;
+  while (std::getline(in, line))
+  {
+    if (line.empty() || line[0] == '#')
+      continue;
+    std::vector<std::string> cells;
+    std::stringstream s(line);
+    for (std::string c; std::getline(s, c, ',');)
+      cells.push_back(c);
+    if (header.empty())
+    {
+      header = cells;
+      continue;
+    }
+    for (std::size_t k = 0; k < header.size() && k < cells.size(); ++k)
+      cols[header[k]].push_back(cells[k]);
+  }
+  return cols;
+}
+
+std::map<std::string, double> read_summary(const fs::path &path)
+{
+  std::map<std::string, double> v;
+  const auto cols = read_csv(path);
+  if (!cols.count("key"))
+    return v;
+  for (std::size_t k = 0; k < cols.at("key").size(); ++k)
+    v[cols.at("key")[k]] = std::atof(cols.at("value")[k].c_str());
+  return v;
+}
+
+// The pipeline's results, checked by the helpers below. ctest runs every gtest TEST in its own
+// process, so the whole check is ONE test: the pipeline runs once (about 35 s).
+struct ReducedNipRun
+{
+  fs::path dir;
+  int status = -1;
+  fs::path dem() const { return dir / "results" / "dem"; }
+};
+
+ReducedNipRun run_reduced_nip()
+{
+  ReducedNipRun r;
+  r.dir = fs::temp_directory_path() / ("magbrush_nip_regression_" + std::to_string(getpid()));
+  fs::remove_all(r.dir);
+  fs::create_directories(r.dir);
+  const std::string cmd = "cd '" + r.dir.string() + "' && OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 '" +
+                          binary_dir + "/bin/magbrush' run '" + source_dir +
+                          "/tests/nip/kawamoto_nip_reduced.yaml' --skip mesh --set output.directory=results "
+                          "> run.log 2>&1";
+  const int raw = std::system(cmd.c_str());
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  return r;
+}
+
+} // namespace
+
+void pipeline_runs_to_the_report(const ReducedNipRun &run)
+{
+  for (const char *f : {"nip_profile.csv", "nip_summary.csv", "chain_inclination.csv", "nip_time_series.csv",
+                        "particles.xdmf", "dem.log"})
+    EXPECT_TRUE(fs::exists(run.dem() / f)) << f;
+  for (const char *f : {"index.html", "index.md", "nip_slip.png", "nip_pressure.png", "brush_snapshot.png",
+                        "chain_inclination.png", "flux_profile.png", "time_series.png"})
+    EXPECT_TRUE(fs::exists(run.dir / "results" / "report" / f)) << f;
+  EXPECT_TRUE(fs::exists(run.dir / "results" / "run_times.csv"));
+}
+
+void slip_at_the_gap_centre_equals_the_relative_surface_speed(const ReducedNipRun &run)
+{
+  const auto s = read_summary(run.dem() / "nip_summary.csv");
+  const double relative = s.at("relative_surface_speed"), slip = s.at("slip_at_gap_centre");
+  std::printf("slip at the gap centre %.4f m/s, relative surface speed %.4f m/s (ratio %.3f), %.1f beads in the "
+              "centre bin per sample, %g samples\n",
+              slip, relative, slip / relative, s.at("beads_in_centre_bin"), s.at("samples"));
+  EXPECT_NEAR(relative, 0.1348, 1e-3);
+  EXPECT_NEAR(slip / relative, 1.0, 0.05);
+  // Kawamoto Fig. 17: low before the centre, high after it (the chains lean back, then spring).
+  const auto p = read_csv(run.dem() / "nip_profile.csv");
+  double before = 0, after = 0;
+  long nb = 0, na = 0;
+  for (std::size_t k = 0; k < p.at("x_mm").size(); ++k)
+  {
+    const double x = std::atof(p.at("x_mm")[k].c_str());
+    const long c = std::atol(p.at("contact_samples")[k].c_str());
+    const double v = std::atof(p.at("slip_speed_m_s")[k].c_str());
+    if (c == 0)
+      continue;
+    if (x <= -0.5 && x >= -1.5)
+      before += v * static_cast<double>(c), nb += c;
+    if (x >= 0.25 && x <= 0.75)
+      after += v * static_cast<double>(c), na += c;
+  }
+  ASSERT_GT(nb, 0);
+  ASSERT_GT(na, 0);
+  std::printf("slip 0.5-1.5 mm before the centre %.4f m/s, 0.25-0.75 mm after it %.4f m/s\n", before / nb, after / na);
+  EXPECT_LT(before / static_cast<double>(nb), slip);
+  EXPECT_GT(after / static_cast<double>(na), slip);
+}
+
+void tangential_over_normal_is_the_drum_friction(const ReducedNipRun &run)
+{
+  const auto s = read_summary(run.dem() / "nip_summary.csv");
+  std::printf("tangential / normal %.4f (bead-drum friction 0.35)\n", s.at("tangential_over_normal"));
+  EXPECT_NEAR(s.at("tangential_over_normal"), 0.35, 0.05);
+}
+
+void pressure_is_of_the_order_of_the_magnetic_pressure(const ReducedNipRun &run)
+{
+  const auto s = read_summary(run.dem() / "nip_summary.csv");
+  const double b = s.at("gap_centre_field"), pm = b * b / (2.0 * 4e-7 * M_PI);
+  const double peak = s.at("peak_normal_pressure");
+  std::printf("peak normal pressure %.1f Pa, at the gap centre %.1f Pa; |B| at the gap centre %.1f mT, B^2/2mu0 = %.1f "
+              "Pa; peak / (B^2/2mu0) = %.3f\n",
+              peak, s.at("normal_pressure_at_gap_centre"), b * 1e3, pm, peak / pm);
+  EXPECT_GT(b, 0.08); // the development pole: ~100 mT on the sleeve, a little less mid-gap
+  EXPECT_GT(peak, 0.1 * pm);
+  EXPECT_LT(peak, 10.0 * pm);
+}
+
+void no_bead_is_lost_or_created(const ReducedNipRun &run)
+{
+  const auto t = read_csv(run.dem() / "nip_time_series.csv");
+  ASSERT_FALSE(t.at("beads").empty());
+  const long beads0 = std::atol(t.at("beads").front().c_str()), inside0 = std::atol(t.at("in_window").front().c_str());
+  EXPECT_EQ(beads0, 1300);
+  for (std::size_t k = 0; k < t.at("beads").size(); ++k)
+  {
+    ASSERT_EQ(std::atol(t.at("beads")[k].c_str()), beads0) << "row " << k;
+    ASSERT_EQ(std::atol(t.at("lost")[k].c_str()), 0) << "row " << k;
+    ASSERT_EQ(std::atol(t.at("in_window")[k].c_str()),
+              inside0 + std::atol(t.at("entered")[k].c_str()) - std::atol(t.at("left")[k].c_str()))
+        << "row " << k;
+  }
+}
+
+TEST(ReducedNip, KawamotosFindingsEndToEnd)
+{
+  const ReducedNipRun run = run_reduced_nip();
+  ASSERT_EQ(run.status, 0) << "magbrush run failed; its log: " << (run.dir / "run.log").string();
+  {
+    SCOPED_TRACE("outputs and report");
+    pipeline_runs_to_the_report(run);
+  }
+  {
+    SCOPED_TRACE("slip");
+    slip_at_the_gap_centre_equals_the_relative_surface_speed(run);
+  }
+  {
+    SCOPED_TRACE("tangential / normal");
+    tangential_over_normal_is_the_drum_friction(run);
+  }
+  {
+    SCOPED_TRACE("pressure");
+    pressure_is_of_the_order_of_the_magnetic_pressure(run);
+  }
+  {
+    SCOPED_TRACE("bead budget");
+    no_bead_is_lost_or_created(run);
+  }
+  if (!::testing::Test::HasFailure())
+    fs::remove_all(run.dir);
+}

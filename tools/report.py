@@ -1,0 +1,490 @@
+#!/usr/bin/env python3
+"""The report of a finished magbrush run: PNG plots and index.md / index.html.
+
+Called by `magbrush report CASE` (which checks the inputs and finds this script):
+
+    report.py --case-name NAME --dem-dir RESULTS/dem --field-prefix fields/NAME_ --out RESULTS/report
+              [--run-times RESULTS/run_times.csv] [--measured-flux report/measured_flux.csv]
+              [--sleeve-radius R --drum-radius RD --drum-center X,Y]
+
+Reads (what exists): dem/nip_profile.csv, nip_summary.csv, chain_inclination.csv,
+nip_time_series.csv (the nip measurements), time_series.csv, the last snapshot in
+dem/snapshots/, dem/dem.log (time per phase and force term, written by `magbrush run`),
+<field-prefix>profile_sleeve.csv. Writes every file atomically (tmp + rename). Needs numpy,
+matplotlib (Agg) and h5py; exit status 3 when one is missing, 2 for unreadable inputs.
+"""
+import argparse
+import csv
+import glob
+import html
+import math
+import os
+import re
+import sys
+
+MU0 = 4e-7 * math.pi
+
+
+# ------------------------------------------------------------------------------------------
+# Reading
+
+def read_csv(path):
+    """Columns of a magbrush CSV by header name ('#' lines skipped); None when absent."""
+    if not path or not os.path.exists(path):
+        return None
+    with open(path, newline="") as f:
+        rows = [r for r in csv.reader(line for line in f if not line.startswith("#")) if r]
+    if not rows:
+        return None
+    header, data = rows[0], rows[1:]
+    cols = {}
+    for i, name in enumerate(header):
+        vals = []
+        for r in data:
+            try:
+                vals.append(float(r[i]))
+            except (ValueError, IndexError):
+                vals.append(r[i] if i < len(r) else "")
+        cols[name] = vals
+    return cols
+
+
+def read_summary(path):
+    """nip_summary.csv as {key: (value, unit)}."""
+    table = read_csv(path)
+    if not table:
+        return {}
+    return {k: (v, u) for k, v, u in zip(table["key"], table["value"], table["unit"])}
+
+
+def read_phase_times(log_path):
+    """The engine's 'time per phase' table from the DEM log: [(name, seconds, percent)]."""
+    if not log_path or not os.path.exists(log_path):
+        return []
+    rows, inside = [], False
+    with open(log_path, errors="replace") as f:
+        for line in f:
+            if line.startswith("time per phase"):
+                rows, inside = [], True
+                continue
+            if inside:
+                m = re.match(r"\s+(.+?)\s+([0-9.eE+-]+) s\s+([0-9.]+) %", line)
+                if not m:
+                    inside = False
+                    continue
+                rows.append((m.group(1), float(m.group(2)), float(m.group(3))))
+    return rows
+
+
+def read_log_line(log_path, prefix):
+    if not log_path or not os.path.exists(log_path):
+        return None
+    found = None
+    with open(log_path, errors="replace") as f:
+        for line in f:
+            if line.startswith(prefix):
+                found = line.strip()
+    return found
+
+
+def last_snapshot(dem_dir):
+    files = sorted(glob.glob(os.path.join(dem_dir, "snapshots", "particles_*.h5")))
+    return files[-1] if files else None
+
+
+# ------------------------------------------------------------------------------------------
+# Writing
+
+def save(fig, path):
+    tmp = path + ".tmp"
+    fig.savefig(tmp, format="png", dpi=110, bbox_inches="tight")
+    os.replace(tmp, path)
+
+
+def write_text(path, text):
+    tmp = path + ".tmp"
+    with open(tmp, "w") as f:
+        f.write(text)
+    os.replace(tmp, path)
+
+
+def fmt(v, digits=4):
+    if v is None or (isinstance(v, float) and not math.isfinite(v)):
+        return "n/a"
+    return f"{v:.{digits}g}"
+
+
+# ------------------------------------------------------------------------------------------
+# Plots
+
+def nip_plots(plt, profile, out, relative_speed):
+    """Kawamoto Fig. 17-20 from nip_profile.csv; returns the PNG names written."""
+    x = profile["x_mm"]
+    written = []
+
+    def one(name, ylabel, series, title, hline=None, hlabel=None):
+        fig, ax = plt.subplots(figsize=(7, 4))
+        for label, y, style in series:
+            ax.plot(x, y, style, label=label)
+        if hline is not None:
+            ax.axhline(hline, color="0.4", ls="--", lw=1, label=hlabel)
+        ax.axvline(0, color="0.7", lw=0.8)
+        ax.set_xlabel("x along the nip from the gap centre [mm] (positive downstream)")
+        ax.set_ylabel(ylabel)
+        ax.set_title(title)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+        save(fig, os.path.join(out, name))
+        plt.close(fig)
+        written.append(name)
+
+    one("nip_slip.png", "slip speed [m/s]", [("beads touching the drum (time average)", profile["slip_speed_m_s"], "o-")],
+        "Slip speed of the beads touching the drum (cf. Kawamoto Fig. 17)", relative_speed,
+        f"relative surface speed {relative_speed:.4g} m/s" if relative_speed is not None else None)
+    one("nip_pressure.png", "pressure on the drum [kPa]",
+        [("normal", [v / 1e3 for v in profile["normal_pressure_Pa"]], "o-"),
+         ("tangential", [v / 1e3 for v in profile["tangential_pressure_Pa"]], "s-")],
+        "Normal and tangential pressure on the drum (cf. Fig. 18)")
+    one("nip_ratio.png", "tangential / normal", [("tangential / normal pressure", profile["tangential_over_normal"], "o-")],
+        "Ratio of tangential to normal pressure", 0.35, "bead-drum friction coefficient 0.35")
+    one("nip_density.png", "touching beads [1/mm²]", [("beads touching the drum", profile["density_per_mm2"], "o-")],
+        "Density of the beads touching the drum (cf. Fig. 19)")
+    one("nip_force_per_bead.png", "normal force per touching bead [µN]",
+        [("mean normal force per bead", [v * 1e6 for v in profile["normal_force_per_bead_N"]], "o-")],
+        "Differential force: normal force per touching bead (cf. Fig. 20)")
+    return written
+
+
+def chain_plot(plt, chains, flux, out):
+    fig, ax = plt.subplots(figsize=(7, 4))
+    ax.plot(chains["theta_deg"], chains["inclination_deg"], "o-", label="chains (principal contact direction)")
+    if flux:
+        # Field-line inclination from the sleeve normal: atan(Bt/Bn), folded into (-90, 90].
+        ang = [a if a <= 180 else a - 360 for a in flux["angle_deg"]]
+        span = max(abs(t) for t in chains["theta_deg"]) if chains["theta_deg"] else 30
+        s = flux["sense"]
+        pts = sorted((s * (a - flux["drum_deg"]), s * math.degrees(math.atan(bt / bn)) if bn != 0 else 90.0)
+                     for a, bn, bt in zip(ang, flux["Bn"], flux["Bt"]) if abs(a - flux["drum_deg"]) <= span)
+        xs, ys = [], []
+        for k, q in enumerate(pts):
+            if k and abs(q[1] - pts[k - 1][1]) > 90:  # the field turns through the tangent: break the line
+                xs.append(float("nan"))
+                ys.append(float("nan"))
+            xs.append(q[0])
+            ys.append(q[1])
+        if pts:
+            ax.plot(xs, ys, "--", color="0.4", label="flux lines at the sleeve surface (atan Bt/Bn)")
+    ax.axvline(0, color="0.7", lw=0.8)
+    ax.axhline(0, color="0.7", lw=0.8)
+    ax.set_xlabel("sleeve angle from the gap centre [deg] (positive downstream)")
+    ax.set_ylabel("inclination from the sleeve normal [deg]\n(> 0: leaning downstream)")
+    ax.set_title("Chain inclination before and after the gap")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    save(fig, os.path.join(out, "chain_inclination.png"))
+    plt.close(fig)
+    return "chain_inclination.png"
+
+
+def flux_plot(plt, flux, measured, out, case_name):
+    fig, ax = plt.subplots(figsize=(8, 4))
+    ax.plot(flux["angle_deg"], [b * 1e3 for b in flux["Bn"]], "-", color="tab:blue", label="Bn computed")
+    ax.plot(flux["angle_deg"], [b * 1e3 for b in flux["Bt"]], "-", color="tab:orange", label="Bt computed")
+    if measured:
+        ax.plot(measured["angle_deg"], measured["Bn_mT"], ".", ms=3, color="tab:blue", label="Bn measured")
+        if "Bt_mT" in measured:
+            ax.plot(measured["angle_deg"], measured["Bt_mT"], ".", ms=3, color="tab:orange", label="Bt measured")
+    ax.axvline(flux["drum_deg"] % 360, color="0.5", ls="--", lw=1, label="drum (gap centre)")
+    ax.axhline(0, color="0.7", lw=0.6)
+    ax.set_xlabel("angle [deg] (counter-clockwise from +x)")
+    ax.set_ylabel("flux density at the sleeve surface [mT]")
+    ax.set_title(f"Sleeve flux profile, case {case_name}")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, ncol=3)
+    save(fig, os.path.join(out, "flux_profile.png"))
+    plt.close(fig)
+    return "flux_profile.png"
+
+
+def snapshot_plot(plt, h5py, np, snap, geometry, out):
+    """The brush in the nip, unrolled: arc length along the sleeve from the gap centre against
+    the height above the sleeve, one slice of the slab (two mean diameters deep) so that single
+    chains can be seen; beads drawn to scale, coloured by speed; the drum surface as a line."""
+    from matplotlib.collections import EllipseCollection
+    with h5py.File(snap, "r") as f:
+        pos = np.array(f["position"])
+        vel = np.array(f["velocity"])
+        rad = np.array(f["radius"]).ravel()
+        t = float(f.attrs["time"])
+    speed = np.linalg.norm(vel, axis=1)
+    rs, rd, (cx, cy), sense = geometry
+    if rs <= 0 or rd <= 0:
+        return None, t
+    d = math.hypot(cx, cy)
+    phi0 = math.atan2(cy, cx)
+    r = np.hypot(pos[:, 0], pos[:, 1])
+    theta = sense * (np.arctan2(pos[:, 1], pos[:, 0]) - phi0)
+    theta = (theta + np.pi) % (2 * np.pi) - np.pi
+    s_arc = rs * theta                     # arc length on the sleeve from the gap centre
+    h = r - rs                             # height above the sleeve surface
+    zc = 0.5 * (pos[:, 2].min() + pos[:, 2].max())
+    depth = 2.0 * 2.0 * rad.mean()
+    sel = (np.abs(pos[:, 2] - zc) < 0.5 * depth) & (np.abs(s_arc) < 4e-3) & (h < 1.5e-3)
+    fig, ax = plt.subplots(figsize=(11, 3.6))
+    offsets = np.column_stack([s_arc[sel] * 1e3, h[sel] * 1e3])
+    widths = 2 * rad[sel] * 1e3
+    coll = EllipseCollection(widths, widths, np.zeros_like(widths), units="xy", offsets=offsets,
+                             transOffset=ax.transData, cmap="viridis", edgecolors="k", linewidths=0.2)
+    coll.set_array(speed[sel])
+    ax.add_collection(coll)
+    fig.colorbar(coll, ax=ax, label="bead speed [m/s]", pad=0.01, shrink=0.7)
+    # Drum surface: along the ray at sleeve angle θ, the distance ρ where |ρ e(θ) − C| = Rd.
+    th = np.linspace(-4e-3 / rs, 4e-3 / rs, 400)
+    ex = np.cos(phi0 + sense * th)
+    ey = np.sin(phi0 + sense * th)
+    b = ex * cx + ey * cy
+    rho = b - np.sqrt(np.maximum(b * b - (d * d - rd * rd), 0.0))
+    ax.plot(rs * th * 1e3, (rho - rs) * 1e3, "-", color="tab:red", lw=1.5, label="drum surface")
+    ax.axhline(0, color="k", lw=1.5, label="sleeve surface")
+    ax.set_xlim(-4, 4)
+    ax.set_ylim(-0.05, 1.0)
+    ax.set_aspect("equal")
+    ax.set_xlabel("arc length along the sleeve from the gap centre [mm] (sleeve moves to the right)")
+    ax.set_ylabel("height above the sleeve [mm]")
+    ax.set_title(f"Brush in the nip at t = {t * 1e3:.3f} ms: a slice {depth * 1e6:.0f} µm deep of the slab "
+                 f"({int(sel.sum())} beads)", fontsize=9)
+    ax.legend(fontsize=8, loc="upper right")
+    save(fig, os.path.join(out, "brush_snapshot.png"))
+    plt.close(fig)
+    return "brush_snapshot.png", t
+
+
+def series_plot(plt, series, nip_series, out):
+    panels = 3 if nip_series else 2
+    fig, axes = plt.subplots(panels, 1, figsize=(8, 3 * panels), sharex=True)
+    t = [v * 1e3 for v in series["time"]]
+    axes[0].semilogy(t, [max(v, 1e-30) for v in series["kinetic_energy"]], label="kinetic (translational)")
+    axes[0].semilogy(t, [max(v, 1e-30) for v in series["rotational_energy"]], label="rotational")
+    axes[0].set_ylabel("energy [J]")
+    axes[0].legend(fontsize=8)
+    ax2 = axes[0].twinx()
+    ax2.plot(t, series["particle_contacts"], color="tab:green", lw=0.8, label="particle contacts")
+    ax2.set_ylabel("contacts", color="tab:green")
+    for key in series:
+        m = re.match(r"(.+)_F([xy])$", key)
+        if m:
+            axes[1].plot(t, series[key], lw=0.9, label=f"{m.group(1)} F{m.group(2)}")
+    axes[1].set_ylabel("wall load [N]")
+    axes[1].legend(fontsize=8, ncol=2)
+    if nip_series:
+        tn = [v * 1e3 for v in nip_series["time_s"]]
+        axes[2].plot(tn, nip_series["in_window"], label="beads in the nip window")
+        axes[2].plot(tn, nip_series["entered"], label="entered (upstream edge)")
+        axes[2].plot(tn, nip_series["left"], label="left (downstream edge)")
+        axes[2].plot(tn, nip_series["drum_touching"], label="touching the drum")
+        axes[2].set_ylabel("beads")
+        axes[2].legend(fontsize=8, ncol=2)
+    axes[-1].set_xlabel("time [ms] (t = 0: walls start turning)")
+    for ax in axes:
+        ax.grid(alpha=0.3)
+    save(fig, os.path.join(out, "time_series.png"))
+    plt.close(fig)
+    return "time_series.png"
+
+
+# ------------------------------------------------------------------------------------------
+# Key numbers and the index
+
+def key_numbers(summary, nip_series, series, flux):
+    """[(what, value, reference, verdict)] for the summary table."""
+    rows = []
+
+    def val(key):
+        v = summary.get(key, (float("nan"), ""))[0]
+        return v if isinstance(v, float) else float("nan")
+
+    if summary:
+        rel = val("relative_surface_speed")
+        slip = val("slip_at_gap_centre")
+        rows.append(("slip speed at the gap centre", f"{fmt(slip)} m/s (± {fmt(val('slip_std_at_gap_centre'), 2)})",
+                     f"relative surface speed {fmt(rel)} m/s (Kawamoto: equal)",
+                     f"{fmt(slip / rel if rel else float('nan'), 3)} of it"))
+        b = val("gap_centre_field")
+        if not math.isfinite(b) and flux:
+            # The field at the sleeve surface facing the drum, from the sleeve profile.
+            ang = flux["drum_deg"] % 360
+            k = min(range(len(flux["angle_deg"])), key=lambda i: abs(flux["angle_deg"][i] - ang))
+            b = math.hypot(flux["Bn"][k], flux["Bt"][k])
+        pm = b * b / (2 * MU0) if math.isfinite(b) else float("nan")
+        peak = val("peak_normal_pressure")
+        rows.append(("peak normal pressure on the drum", f"{fmt(peak / 1e3)} kPa",
+                     f"B²/2μ0 = {fmt(pm / 1e3)} kPa at |B| = {fmt(b * 1e3)} mT (gap centre)",
+                     f"{fmt(peak / pm if pm else float('nan'), 3)} × B²/2μ0"))
+        rows.append(("normal pressure at the gap centre", f"{fmt(val('normal_pressure_at_gap_centre') / 1e3)} kPa", "", ""))
+        rows.append(("tangential / normal (whole nip)", fmt(val("tangential_over_normal"), 3),
+                     "bead-drum friction coefficient 0.35 (Kawamoto: ≈ 0.35)", ""))
+        rows.append(("touching-bead density at the gap centre", f"{fmt(val('density_at_gap_centre'))} /mm²",
+                     "∝ 1/d² (Kawamoto Fig. 19)", ""))
+        rows.append(("normal force on the drum per length", f"{fmt(val('normal_force_per_length'))} N/m", "", ""))
+        rows.append(("averaged over", f"{int(val('samples'))} samples, t = {fmt(val('t_from') * 1e3)} .. "
+                     f"{fmt(val('t_to') * 1e3)} ms", "", ""))
+    if nip_series and nip_series["time_s"]:
+        first, last = 0, len(nip_series["time_s"]) - 1
+        beads0, beads1 = int(nip_series["beads"][first]), int(nip_series["beads"][last])
+        lost = int(nip_series["lost"][last])
+        rows.append(("beads in the slab, start / end", f"{beads0} / {beads1}, lost {lost}",
+                     "mass conservation: equal, none lost",
+                     "conserved" if beads0 == beads1 and lost == 0 else "NOT conserved"))
+        rows.append(("beads through the nip window", f"entered {int(nip_series['entered'][last])}, left "
+                     f"{int(nip_series['left'][last])}, inside {int(nip_series['in_window'][first])} → "
+                     f"{int(nip_series['in_window'][last])}", "inside(end) = inside(start) + entered − left", ""))
+    elif series:
+        rows.append(("simulated time", f"{fmt(series['time'][-1] * 1e3)} ms", "", ""))
+    return rows
+
+
+def build_index(args, images, rows, run_times, phases, snapshot_time, dem_done):
+    links = []
+    xdmf = os.path.join(args.dem_dir, "particles.xdmf")
+    if os.path.exists(xdmf):
+        links.append(("particles (ParaView, time series)", os.path.relpath(xdmf, args.out)))
+    for vtu in sorted(glob.glob(args.field_prefix + "*.pvtu")):
+        links.append(("field " + os.path.basename(vtu), os.path.relpath(vtu, args.out)))
+    for name in ("nip_profile.csv", "nip_summary.csv", "chain_inclination.csv", "nip_time_series.csv",
+                 "time_series.csv", "dem.log"):
+        p = os.path.join(args.dem_dir, name)
+        if os.path.exists(p):
+            links.append((name, os.path.relpath(p, args.out)))
+    prof = args.field_prefix + "profile_sleeve.csv"
+    if os.path.exists(prof):
+        links.append(("sleeve flux profile (CSV)", os.path.relpath(prof, args.out)))
+
+    md = [f"# magbrush report: {args.case_name}", ""]
+    md += ["## Key numbers", "", "| quantity | value | reference | |", "|---|---|---|---|"]
+    md += [f"| {a} | {b} | {c} | {d} |" for a, b, c, d in rows]
+    md.append("")
+    if run_times:
+        md += ["## Run time per stage", "", "| stage | wall time [s] |", "|---|---|"]
+        md += [f"| {s} | {t:.1f} |" for s, t in run_times]
+        md.append("")
+    if phases:
+        md += ["## DEM time per phase and force term", "", "| phase | wall time [s] | share |", "|---|---|---|"]
+        md += [f"| {n} | {t:.2f} | {p:.1f} % |" for n, t, p in phases]
+        md.append("")
+    if dem_done:
+        md += [f"DEM: `{dem_done}`", ""]
+    md += ["## Plots", ""]
+    md += [f"![{img}]({img})" for img in images]
+    md += ["", "## Files (ParaView: open the .xdmf / .pvtu)", ""]
+    md += [f"* [{a}]({b})" for a, b in links]
+    md.append("")
+
+    e = html.escape
+    h = ["<!DOCTYPE html>", "<html><head><meta charset='utf-8'>", f"<title>magbrush report: {e(args.case_name)}</title>",
+         "<style>body{font-family:sans-serif;max-width:1000px;margin:2em auto;} table{border-collapse:collapse;}"
+         " td,th{border:1px solid #bbb;padding:3px 8px;} img{max-width:100%;margin:6px 0;}</style></head><body>",
+         f"<h1>magbrush report: {e(args.case_name)}</h1>", "<h2>Key numbers</h2>",
+         "<table><tr><th>quantity</th><th>value</th><th>reference</th><th></th></tr>"]
+    h += [f"<tr><td>{e(a)}</td><td>{e(b)}</td><td>{e(c)}</td><td>{e(d)}</td></tr>" for a, b, c, d in rows]
+    h.append("</table>")
+    if run_times:
+        h += ["<h2>Run time per stage</h2><table><tr><th>stage</th><th>wall time [s]</th></tr>"]
+        h += [f"<tr><td>{e(s)}</td><td>{t:.1f}</td></tr>" for s, t in run_times]
+        h.append("</table>")
+    if phases:
+        h += ["<h2>DEM time per phase and force term</h2><table><tr><th>phase</th><th>wall time [s]</th>"
+              "<th>share</th></tr>"]
+        h += [f"<tr><td>{e(n)}</td><td>{t:.2f}</td><td>{p:.1f} %</td></tr>" for n, t, p in phases]
+        h.append("</table>")
+    if dem_done:
+        h.append(f"<p>DEM: <code>{e(dem_done)}</code></p>")
+    h.append("<h2>Plots</h2>")
+    h += [f"<p><a href='{e(img)}'><img src='{e(img)}' alt='{e(img)}'></a></p>" for img in images]
+    h.append("<h2>Files (ParaView: open the .xdmf / .pvtu)</h2><ul>")
+    h += [f"<li><a href='{e(b)}'>{e(a)}</a></li>" for a, b in links]
+    h.append("</ul></body></html>")
+    write_text(os.path.join(args.out, "index.md"), "\n".join(md))
+    write_text(os.path.join(args.out, "index.html"), "\n".join(h) + "\n")
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--case-name", required=True)
+    p.add_argument("--dem-dir", required=True)
+    p.add_argument("--field-prefix", required=True, help="fields/<case>_ (the field stage's file prefix)")
+    p.add_argument("--out", required=True)
+    p.add_argument("--run-times")
+    p.add_argument("--measured-flux")
+    p.add_argument("--sleeve-radius", type=float, default=0.0)
+    p.add_argument("--drum-radius", type=float, default=0.0)
+    p.add_argument("--drum-center", default="0,0")
+    p.add_argument("--sleeve-sense", type=float, default=1.0, help="+1: sleeve turns counter-clockwise, -1: clockwise")
+    args = p.parse_args()
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        import numpy as np
+        import h5py
+    except ImportError as e:
+        print(f"report.py: {e}: install python3-matplotlib, python3-numpy and python3-h5py", file=sys.stderr)
+        return 3
+    os.makedirs(args.out, exist_ok=True)
+    cx, cy = (float(v) for v in args.drum_center.split(","))
+    drum_deg = math.degrees(math.atan2(cy, cx)) if (cx or cy) else 0.0
+
+    try:
+        series = read_csv(os.path.join(args.dem_dir, "time_series.csv"))
+        profile = read_csv(os.path.join(args.dem_dir, "nip_profile.csv"))
+        summary = read_summary(os.path.join(args.dem_dir, "nip_summary.csv"))
+        chains = read_csv(os.path.join(args.dem_dir, "chain_inclination.csv"))
+        nip_series = read_csv(os.path.join(args.dem_dir, "nip_time_series.csv"))
+        flux_raw = read_csv(args.field_prefix + "profile_sleeve.csv")
+        measured = read_csv(args.measured_flux) if args.measured_flux else None
+        run_times_table = read_csv(args.run_times) if args.run_times else None
+    except (OSError, KeyError, IndexError) as e:
+        print(f"report.py: cannot read the run's outputs: {e}", file=sys.stderr)
+        return 2
+    if series is None:
+        print(f"report.py: {args.dem_dir}/time_series.csv is missing or empty", file=sys.stderr)
+        return 2
+
+    flux = None
+    if flux_raw:
+        # The chain plot turns the field direction into the nip frame: downstream is the way the
+        # sleeve turns (sense +1: counter-clockwise, the profile's positive Bt).
+        flux = {"angle_deg": flux_raw["angle_deg"], "Bn": flux_raw["Bn_T"], "Bt": flux_raw["Bt_T"],
+                "drum_deg": drum_deg, "sense": args.sleeve_sense}
+
+    images = []
+    relative_speed = summary.get("relative_surface_speed", (None, ""))[0] if summary else None
+    if profile:
+        images += nip_plots(plt, profile, args.out, relative_speed)
+    if chains:
+        images.append(chain_plot(plt, chains, flux, args.out))
+    if flux:
+        images.append(flux_plot(plt, flux, measured, args.out, args.case_name))
+    snap = last_snapshot(args.dem_dir)
+    snapshot_time = None
+    if snap:
+        name, snapshot_time = snapshot_plot(plt, h5py, np, snap,
+                                            (args.sleeve_radius, args.drum_radius, (cx, cy), args.sleeve_sense), args.out)
+        if name:
+            images.append(name)
+    images.append(series_plot(plt, series, nip_series, args.out))
+
+    run_times = []
+    if run_times_table:
+        run_times = list(zip(run_times_table["stage"], run_times_table["seconds"]))
+    log = os.path.join(args.dem_dir, "dem.log")
+    phases = read_phase_times(log)
+    dem_done = read_log_line(log, "done:")
+    rows = key_numbers(summary, nip_series, series, flux)
+    build_index(args, images, rows, run_times, phases, snapshot_time, dem_done)
+    for a, b, c, d in rows:
+        print(f"  {a:42s} {b}  {('[' + c + ']') if c else ''} {d}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -306,7 +306,7 @@ def key_numbers(summary, nip_series, series, flux):
     if summary:
         rel = val("relative_surface_speed")
         slip = val("slip_at_gap_centre")
-        rows.append(("slip speed at the gap centre", f"{fmt(slip)} m/s (± {fmt(val('slip_std_at_gap_centre'), 2)})",
+        rows.append(("slip speed at the gap centre", f"{fmt(slip)} m/s (bead spread {fmt(val('slip_std_at_gap_centre'), 2)})",
                      f"relative surface speed {fmt(rel)} m/s (Kawamoto: equal)",
                      f"{fmt(slip / rel if rel else float('nan'), 3)} of it"))
         b = val("gap_centre_field")
@@ -318,7 +318,7 @@ def key_numbers(summary, nip_series, series, flux):
         pm = b * b / (2 * MU0) if math.isfinite(b) else float("nan")
         peak = val("peak_normal_pressure")
         rows.append(("peak normal pressure on the drum", f"{fmt(peak / 1e3)} kPa",
-                     f"B²/2μ0 = {fmt(pm / 1e3)} kPa at |B| = {fmt(b * 1e3)} mT (gap centre)",
+                     f"B²/2μ0 = {fmt(pm / 1e3)} kPa at B = {fmt(b * 1e3)} mT (gap centre)",
                      f"{fmt(peak / pm if pm else float('nan'), 3)} × B²/2μ0"))
         rows.append(("normal pressure at the gap centre", f"{fmt(val('normal_pressure_at_gap_centre') / 1e3)} kPa", "", ""))
         rows.append(("tangential / normal (whole nip)", fmt(val("tangential_over_normal"), 3),

@@ -191,6 +191,7 @@ int main(int argc, char **argv)
       std::printf("%-36s %10ld %10.3g ms %12.1f %16.3g %18.3g\n", variants[k].name, costs[k].steps,
                   costs[k].simulated * 1e3, costs[k].wall,
                   costs[k].wall > 0 ? costs[k].simulated * 1e3 * 3600.0 / costs[k].wall : NAN, costs[k].rate);
+    std::printf("(the wall time includes the settling phase before t = 0; steps and simulated time count t >= 0 only)\n");
     std::printf("\n== time per phase and force term [s] (share) ==\n");
     for (std::size_t k = 0; k < costs.size(); ++k)
     {

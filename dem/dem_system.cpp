@@ -31,6 +31,27 @@ private:
 };
 } // namespace
 
+// Inside a parallel region: the master thread charges the wall time since its last mark to a
+// phase (the phases after the pair kernel have no barrier between them, so this is the
+// master's own share, which equals the others' on balanced static loops).
+class PhaseClock
+{
+public:
+  PhaseClock() : master_(omp_get_thread_num() == 0), last_(master_ ? omp_get_wtime() : 0.0) {}
+  void charge(double &slot)
+  {
+    if (!master_)
+      return;
+    const double now = omp_get_wtime();
+    slot += now - last_;
+    last_ = now;
+  }
+
+private:
+  bool master_;
+  double last_;
+};
+
 DemSystem::DemSystem(const Case &c) : DemSystem(c, build_wall_primitives(c)) {}
 
 DemSystem::DemSystem(const Case &c, const WallSet &walls) : case_(c), walls_(walls)
@@ -109,8 +130,14 @@ void DemSystem::initialize()
   setup_derived();
   rebuild_neighbor_list();
   // Forces at t = 0, so that the first half kick uses them.
-  compute_particle_contacts();
-  compute_wall_contacts();
+  walls_.prepare(time_, walls_frozen_);
+  StepFlags flags;
+#pragma omp parallel if (parallel())
+  {
+    PhaseClock clock;
+    contact_phases(flags, clock, false);
+  }
+  raise_contact_alarms(flags);
   for (std::size_t t = 0; t < terms_.size(); ++t)
     terms_[t]->add_forces(particles_, forces_, time_);
   initialized_ = true;
@@ -160,15 +187,16 @@ static inline void half_kick(ParticleState &s, const ForceBuffers &f, std::size_
   s.wz[i] += h * f.tz[i] * iI;
 }
 
-void DemSystem::kick_and_drift()
+// First half of velocity Verlet: v(t + dt/2) = v(t) + (dt/2) F(t)/m, x(t + dt) = x + dt v(t + dt/2).
+// Also the largest squared displacement since the last list build, reduced over the threads:
+// after the loop's barrier every thread sees the same value.
+void DemSystem::kick_and_drift_phase(double &max_drift2)
 {
-  PhaseTimer timer(times_.integrate);
   const long n = static_cast<long>(particles_.size());
   const double h = 0.5 * dt_, dt = dt_;
   ParticleState &s = particles_;
   const ForceBuffers &f = forces_;
-  double drift2 = 0.0;
-#pragma omp parallel for schedule(static) reduction(max : drift2) if (n > 512)
+#pragma omp for schedule(static) reduction(max : max_drift2)
   for (long k = 0; k < n; ++k)
   {
     const std::size_t i = static_cast<std::size_t>(k);
@@ -177,39 +205,44 @@ void DemSystem::kick_and_drift()
     s.y[i] += dt * s.vy[i];
     s.z[i] += dt * s.vz[i];
     const double dx = s.x[i] - x0_[i], dy = s.y[i] - y0_[i], dz = s.z[i] - z0_[i];
-    drift2 = std::max(drift2, dx * dx + dy * dy + dz * dz);
+    max_drift2 = std::max(max_drift2, dx * dx + dy * dy + dz * dz);
   }
-  max_drift2_ = drift2;
 }
 
-void DemSystem::final_kick()
+// Second half: v(t + dt) = v(t + dt/2) + (dt/2) F(t + dt)/m; flags a non-finite state.
+// Static schedule, no barrier: a thread kicks exactly the particles whose forces it summed.
+void DemSystem::final_kick_phase(int &not_finite)
 {
-  PhaseTimer timer(times_.integrate);
   const long n = static_cast<long>(particles_.size());
   const double h = 0.5 * dt_;
   ParticleState &s = particles_;
   const ForceBuffers &f = forces_;
-  int bad = 0;
-#pragma omp parallel for schedule(static) reduction(| : bad) if (n > 512)
+#pragma omp for schedule(static) reduction(| : not_finite) nowait
   for (long k = 0; k < n; ++k)
   {
     const std::size_t i = static_cast<std::size_t>(k);
     half_kick(s, f, i, h);
     if (!std::isfinite(s.vx[i] + s.vy[i] + s.vz[i] + s.wx[i] + s.wy[i] + s.wz[i] + s.x[i] + s.y[i] + s.z[i]))
-      bad = 1;
+      not_finite = 1;
   }
-  if (bad)
-    for (std::size_t i = 0; i < particles_.size(); ++i)
-      if (!std::isfinite(s.vx[i] + s.vy[i] + s.vz[i] + s.wx[i] + s.wy[i] + s.wz[i] + s.x[i] + s.y[i] + s.z[i]))
-      {
-        char msg[512];
-        std::snprintf(msg, sizeof msg,
-                      "stability guard: NaN/Inf at step %ld (t = %.6g s) in the state of %s. The time step "
-                      "(%.3g s) is probably too large for the stiffest contact or force term: reduce "
-                      "dem.time_step (or time_step_safety), or check the material stiffness and the force terms",
-                      step_, time_, describe_particle(i).c_str(), dt_);
-        throw StabilityError(msg);
-      }
+}
+
+void DemSystem::raise_state_alarm(const StepFlags &flags) const
+{
+  if (!flags.not_finite)
+    return;
+  const ParticleState &s = particles_;
+  for (std::size_t i = 0; i < s.size(); ++i)
+    if (!std::isfinite(s.vx[i] + s.vy[i] + s.vz[i] + s.wx[i] + s.wy[i] + s.wz[i] + s.x[i] + s.y[i] + s.z[i]))
+    {
+      char msg[512];
+      std::snprintf(msg, sizeof msg,
+                    "stability guard: NaN/Inf at step %ld (t = %.6g s) in the state of %s. The time step "
+                    "(%.3g s) is probably too large for the stiffest contact or force term: reduce "
+                    "dem.time_step (or time_step_safety), or check the material stiffness and the force terms",
+                    step_, time_, describe_particle(i).c_str(), dt_);
+      throw StabilityError(msg);
+    }
 }
 
 std::string DemSystem::describe_particle(std::size_t i) const
@@ -372,11 +405,12 @@ int particle_pair_kernel(const PairKernelData &D, const RowTorques &T, std::int6
 }
 } // namespace
 
-void DemSystem::compute_particle_contacts()
+// Phase 1 (all threads, work-shared; ends with the loop's barrier): pairs and rows, block by
+// block. Sets overlap_alarm when some pair overlaps beyond the guard.
+void DemSystem::pair_and_row_phase(int &overlap_alarm)
 {
-  PhaseTimer timer(times_.particle_contacts);
   const ParticleState &s = particles_;
-  NeighborList &L = list_;
+  const NeighborList &L = list_;
   const long n = static_cast<long>(s.size());
   // Image shifts and coefficients as plain arrays, one per component / field.
   double shift[3][27];
@@ -389,86 +423,115 @@ void DemSystem::compute_particle_contacts()
   }
   const std::size_t types = table_.species() * table_.columns();
   const double *coef = coefficient_fields_.data();
+  NeighborList &W = list_; // the pair slots written here
   const PairKernelData D{s.x.data(), s.y.data(), s.z.data(), s.vx.data(), s.vy.data(), s.vz.data(),
                          s.wx.data(), s.wy.data(), s.wz.data(), s.radius.data(), s.mass.data(),
                          s.inv_inertia.data(), s.species.data(), L.owner.data(), L.partner.data(),
                          L.image.data(), shift[0], shift[1], shift[2], coef, coef + types, coef + 2 * types,
                          coef + 3 * types, coef + 4 * types, coef + 5 * types,
                          static_cast<std::int64_t>(table_.columns()), table_.species() == 1, dt_,
-                         case_.dem.max_overlap_fraction, L.hist_x.data(), L.hist_y.data(), L.hist_z.data(),
-                         L.force_x.data(), L.force_y.data(), L.force_z.data(), L.torque_j_x.data(),
-                         L.torque_j_y.data(), L.torque_j_z.data(), L.touching.data()};
+                         case_.dem.max_overlap_fraction, W.hist_x.data(), W.hist_y.data(), W.hist_z.data(),
+                         W.force_x.data(), W.force_y.data(), W.force_z.data(), W.torque_j_x.data(),
+                         W.torque_j_y.data(), W.torque_j_z.data(), W.touching.data()};
   const std::int32_t *row_start = L.row_start.data();
-  int overlap_alarm = 0;
   ForceBuffers &f = forces_;
   const long blocks = (n + contact_block_rows - 1) / contact_block_rows;
-  // One parallel region, two phases separated by the loop's barrier.
-#pragma omp parallel if (n > 512)
-  {
-    std::vector<double> row_torques; // per thread: the torques on i of one block's pairs
-    // 1. Pairs and rows, block by block.
+  std::vector<double> row_torques; // this thread's: the torques on i of one block's pairs
 #pragma omp for schedule(dynamic, 2) reduction(| : overlap_alarm)
-    for (long b = 0; b < blocks; ++b)
+  for (long b = 0; b < blocks; ++b)
+  {
+    const long i0 = b * contact_block_rows, i1 = std::min(n, i0 + contact_block_rows);
+    const std::int64_t p0 = row_start[i0], p1 = row_start[i1];
+    row_torques.resize(3 * static_cast<std::size_t>(p1 - p0));
+    const RowTorques T{row_torques.data(), row_torques.data() + (p1 - p0), row_torques.data() + 2 * (p1 - p0)};
+    overlap_alarm |= particle_pair_kernel(D, T, p0, p1);
+    for (long i = i0; i < i1; ++i)
     {
-      const long i0 = b * contact_block_rows, i1 = std::min(n, i0 + contact_block_rows);
-      const std::int64_t p0 = row_start[i0], p1 = row_start[i1];
-      row_torques.resize(3 * static_cast<std::size_t>(p1 - p0));
-      const RowTorques T{row_torques.data(), row_torques.data() + (p1 - p0), row_torques.data() + 2 * (p1 - p0)};
-      overlap_alarm |= particle_pair_kernel(D, T, p0, p1);
-      for (long i = i0; i < i1; ++i)
+      double fx = 0, fy = 0, fz = 0, tx = 0, ty = 0, tz = 0;
+      std::int32_t count = 0;
+      for (std::int64_t p = row_start[i]; p < row_start[i + 1]; ++p)
       {
-        double fx = 0, fy = 0, fz = 0, tx = 0, ty = 0, tz = 0;
-        std::int32_t count = 0;
-        for (std::int64_t p = row_start[i]; p < row_start[i + 1]; ++p)
-        {
-          count += D.touching[p];
-          fx += D.fx[p];
-          fy += D.fy[p];
-          fz += D.fz[p];
-          tx += T.x[p - p0];
-          ty += T.y[p - p0];
-          tz += T.z[p - p0];
-        }
-        f.fx[U(static_cast<std::int32_t>(i))] = fx;
-        f.fy[U(static_cast<std::int32_t>(i))] = fy;
-        f.fz[U(static_cast<std::int32_t>(i))] = fz;
-        f.tx[U(static_cast<std::int32_t>(i))] = tx;
-        f.ty[U(static_cast<std::int32_t>(i))] = ty;
-        f.tz[U(static_cast<std::int32_t>(i))] = tz;
-        contact_count_[U(static_cast<std::int32_t>(i))] = count;
-      }
-    }
-    // 2. Columns: each particle adds the pairs in which it is the partner, in ascending pair
-    //    order (−F on it, and the pair's torque on j).
-    const std::int32_t *col_start = L.col_start.data(), *col_pair = L.col_pair.data();
-#pragma omp for schedule(dynamic, 512)
-    for (long k = 0; k < n; ++k)
-    {
-      const std::size_t i = static_cast<std::size_t>(k);
-      double fx = f.fx[i], fy = f.fy[i], fz = f.fz[i], tx = f.tx[i], ty = f.ty[i], tz = f.tz[i];
-      std::int32_t count = contact_count_[i];
-      for (std::int32_t q = col_start[i]; q < col_start[i + 1]; ++q)
-      {
-        const std::size_t p = U(col_pair[q]);
         count += D.touching[p];
-        fx -= D.fx[p];
-        fy -= D.fy[p];
-        fz -= D.fz[p];
-        tx += D.tjx[p];
-        ty += D.tjy[p];
-        tz += D.tjz[p];
+        fx += D.fx[p];
+        fy += D.fy[p];
+        fz += D.fz[p];
+        tx += T.x[p - p0];
+        ty += T.y[p - p0];
+        tz += T.z[p - p0];
       }
-      f.fx[i] = fx;
-      f.fy[i] = fy;
-      f.fz[i] = fz;
-      f.tx[i] = tx;
-      f.ty[i] = ty;
-      f.tz[i] = tz;
-      contact_count_[i] = count;
+      const std::size_t iu = static_cast<std::size_t>(i);
+      f.fx[iu] = fx;
+      f.fy[iu] = fy;
+      f.fz[iu] = fz;
+      f.tx[iu] = tx;
+      f.ty[iu] = ty;
+      f.tz[iu] = tz;
+      contact_count_[iu] = count;
     }
   }
-  if (overlap_alarm)
+}
+
+// Phase 2 (after phase 1's barrier; static schedule, no barrier): each particle adds the
+// pairs in which it is the partner, in ascending pair order: −F on it, the pair's torque on j.
+void DemSystem::column_phase()
+{
+  const NeighborList &L = list_;
+  const long n = static_cast<long>(particles_.size());
+  ForceBuffers &f = forces_;
+  const std::int32_t *col_start = L.col_start.data(), *col_pair = L.col_pair.data();
+#pragma omp for schedule(static) nowait
+  for (long k = 0; k < n; ++k)
+  {
+    const std::size_t i = static_cast<std::size_t>(k);
+    double fx = f.fx[i], fy = f.fy[i], fz = f.fz[i], tx = f.tx[i], ty = f.ty[i], tz = f.tz[i];
+    std::int32_t count = contact_count_[i];
+    for (std::int32_t q = col_start[i]; q < col_start[i + 1]; ++q)
+    {
+      const std::size_t p = U(col_pair[q]);
+      count += L.touching[p];
+      fx -= L.force_x[p];
+      fy -= L.force_y[p];
+      fz -= L.force_z[p];
+      tx += L.torque_j_x[p];
+      ty += L.torque_j_y[p];
+      tz += L.torque_j_z[p];
+    }
+    f.fx[i] = fx;
+    f.fy[i] = fy;
+    f.fz[i] = fz;
+    f.tx[i] = tx;
+    f.ty[i] = ty;
+    f.tz[i] = tz;
+    contact_count_[i] = count;
+  }
+}
+
+// Everything from the pair kernel to the wall contacts (and the final kick when no force term
+// runs in between), inside the caller's parallel region. The loops after the pair phase share
+// one static schedule without barriers: each thread carries its particles through all of them.
+void DemSystem::contact_phases(StepFlags &flags, PhaseClock &clock, bool with_final_kick)
+{
+  pair_and_row_phase(flags.overlap_alarm);
+  clock.charge(times_.particle_contacts);
+  column_phase();
+  clock.charge(times_.particle_contacts);
+  if (walls_.size() > 0)
+  {
+    wall_phase(flags.wall_alarm, flags.wall_crowded);
+    clock.charge(times_.wall_contacts);
+  }
+  if (with_final_kick)
+  {
+    final_kick_phase(flags.not_finite);
+    clock.charge(times_.integrate);
+  }
+}
+
+void DemSystem::raise_contact_alarms(const StepFlags &flags) const
+{
+  if (flags.overlap_alarm)
     check_overlaps();
+  raise_wall_alarms(flags.wall_alarm, flags.wall_crowded);
 }
 
 void DemSystem::check_overlaps() const
@@ -502,30 +565,26 @@ void DemSystem::check_overlaps() const
   throw StabilityError(msg);
 }
 
-void DemSystem::compute_wall_contacts()
+// Wall contacts of every particle (static schedule, no barrier; walls_.prepare() has run).
+// Records the largest index of a particle that overlaps a wall beyond the guard (alarm) or
+// touches too many walls (crowded); raise_wall_alarms() turns them into errors.
+void DemSystem::wall_phase(long &alarm, long &too_many)
 {
-  if (walls_.size() == 0)
-    return;
-  PhaseTimer timer(times_.wall_contacts);
   ParticleState &s = particles_;
   ForceBuffers &f = forces_;
   const long n = static_cast<long>(s.size());
   const std::size_t W = walls_.size();
   const double dt = dt_, guard = case_.dem.max_overlap_fraction;
-  walls_.prepare(time_, walls_frozen_);
-  long alarm = -1, too_many = -1;
-#pragma omp parallel if (n > 512)
-  {
-    // Per-thread scratch (constructed once, not per particle).
-    WallContactGeometry g[max_wall_contacts + 1];
-    int which[max_wall_contacts + 1];
-#pragma omp for schedule(dynamic, 256) reduction(max : alarm, too_many)
+  // This thread's scratch (constructed once, not per particle).
+  WallContactGeometry g[max_wall_contacts + 1];
+  int which[max_wall_contacts + 1];
+#pragma omp for schedule(static) reduction(max : alarm, too_many) nowait
   for (long k = 0; k < n; ++k)
   {
     const std::size_t i = static_cast<std::size_t>(k);
     const Vector3 p = s.position(i);
     const double r = s.radius[i];
-    // Pass 1: which walls touch this particle now.
+  // Pass 1: which walls touch this particle now.
     int m = 0;
     for (std::size_t w = 0; w < W; ++w)
     {
@@ -603,7 +662,11 @@ void DemSystem::compute_wall_contacts()
       wall_tz_[sl] = tq.z;
     }
   }
-  } // omp parallel
+}
+
+void DemSystem::raise_wall_alarms(long alarm, long too_many) const
+{
+  const double guard = case_.dem.max_overlap_fraction;
   if (too_many >= 0)
     throw StabilityError("wall contacts: " + describe_particle(U(static_cast<std::int32_t>(too_many))) +
                          " touches more than " + std::to_string(max_wall_contacts) +
@@ -658,23 +721,54 @@ void DemSystem::check_energy()
   guard_energy_ = ke;
 }
 
+// One velocity-Verlet step. The particle work runs in ONE parallel region (two when the
+// neighbour list must be rebuilt, two more when force terms must run before the final kick):
+// a fork and a join per region cost tens of microseconds when idle threads sleep, which is a
+// real share of a step of a few thousand particles.
 void DemSystem::step()
 {
   if (!initialized_)
     throw std::logic_error("DemSystem::step() before initialize()");
-  kick_and_drift();
   ++step_;
   time_ = static_cast<double>(step_) * dt_;
-  if (force_rebuild_ || max_drift2_ > 0.25 * skin_ * skin_)
-    rebuild_neighbor_list();
-  compute_particle_contacts(); // overwrites the force buffers (gather)
-  compute_wall_contacts();     // adds
-  for (std::size_t t = 0; t < terms_.size(); ++t)
+  walls_.prepare(time_, walls_frozen_);
+  // Without force terms, the final kick follows the contacts in the same region.
+  const bool kick_with_contacts = terms_.empty();
+  StepFlags flags;
+#pragma omp parallel if (parallel())
   {
-    PhaseTimer timer(times_.terms[t]);
-    terms_[t]->add_forces(particles_, forces_, time_);
+    PhaseClock clock;
+    kick_and_drift_phase(flags.max_drift2); // ends with a barrier: all threads see the same max
+    clock.charge(times_.integrate);
+    if (!list_is_stale(flags.max_drift2))
+      contact_phases(flags, clock, kick_with_contacts);
   }
-  final_kick();
+  max_drift2_ = flags.max_drift2;
+  if (list_is_stale(flags.max_drift2))
+  {
+    rebuild_neighbor_list();
+#pragma omp parallel if (parallel())
+    {
+      PhaseClock clock;
+      contact_phases(flags, clock, kick_with_contacts);
+    }
+  }
+  raise_contact_alarms(flags);
+  if (!kick_with_contacts)
+  {
+    for (std::size_t t = 0; t < terms_.size(); ++t)
+    {
+      PhaseTimer timer(times_.terms[t]);
+      terms_[t]->add_forces(particles_, forces_, time_);
+    }
+#pragma omp parallel if (parallel())
+    {
+      PhaseClock clock;
+      final_kick_phase(flags.not_finite);
+      clock.charge(times_.integrate);
+    }
+  }
+  raise_state_alarm(flags);
   if (step_ % 100 == 0)
     check_energy();
 }

@@ -26,6 +26,8 @@
 
 namespace magbrush::dem {
 
+class PhaseClock; // dem_system.cpp: per-phase timing inside a parallel region
+
 // Thrown by the stability guards: the message names step, particle, cause and likely fix.
 class StabilityError : public std::runtime_error
 {
@@ -151,13 +153,33 @@ private:
   double energy_floor_ = 0.0;
   PhaseTimes times_;
 
+  // What the phases of one step report, reduced over the threads; checked after the region.
+  struct StepFlags
+  {
+    double max_drift2 = 0.0;   // largest squared displacement since the list build
+    int overlap_alarm = 0;     // a particle pair overlaps beyond the guard
+    long wall_alarm = -1;      // a particle (index) overlaps a wall beyond the guard
+    long wall_crowded = -1;    // a particle (index) touches more than max_wall_contacts walls
+    int not_finite = 0;        // NaN/Inf in the state after the final kick
+  };
+
   void setup_derived();
   void rebuild_neighbor_list();
   void permute_particles(const std::vector<std::int32_t> &order);
-  void kick_and_drift();
-  void final_kick();
-  void compute_particle_contacts();
-  void compute_wall_contacts();
+  bool parallel() const { return particles_.size() > 512; } // below: one thread is faster
+  bool list_is_stale(double max_drift2) const { return force_rebuild_ || max_drift2 > 0.25 * skin_ * skin_; }
+  // The phases of a step. Each is called by every thread of an enclosing parallel region
+  // (work-shared loops inside); see step() for their order and barriers.
+  void kick_and_drift_phase(double &max_drift2);
+  void pair_and_row_phase(int &overlap_alarm);
+  void column_phase();
+  void wall_phase(long &alarm, long &too_many);
+  void final_kick_phase(int &not_finite);
+  void contact_phases(StepFlags &flags, PhaseClock &clock, bool with_final_kick);
+  // After the region: turn the flags into StabilityErrors with a useful message.
+  void raise_contact_alarms(const StepFlags &flags) const;
+  void raise_wall_alarms(long alarm, long too_many) const;
+  void raise_state_alarm(const StepFlags &flags) const;
   void check_overlaps() const;
   void check_energy();
   std::string describe_particle(std::size_t i) const;

@@ -205,6 +205,7 @@ run_lammps() { # n nproc -> rate, prints loop time
 
 echo "LAMMPS: $LMP_BIN ($LMP_VERSION); ours: $BENCH; $ROUNDS rounds of $STEPS steps"
 : > results.txt
+: > loads.txt
 for ((round = 1; round <= ROUNDS; ++round)); do
   # ours: both sizes, 1 and 2 threads in one process; rate and out% (HDF5 snapshot every 100 steps)
   OMP_NUM_THREADS=1 "$BENCH" "$STEPS" 2 > ours_$round.txt
@@ -215,7 +216,7 @@ for ((round = 1; round <= ROUNDS; ++round)); do
       echo "$round lammps $((n*n*n)) 2 $(run_lammps $n 2) 0 -" >> results.txt
     fi
   done
-  echo "round $round done" >&2
+  echo "round $round: load average $(cut -d' ' -f1-3 /proc/loadavg)" | tee -a loads.txt >&2
 done
 
 # ---- table ---------------------------------------------------------------------------------
@@ -256,6 +257,9 @@ print(" one HDF5 snapshot per 100 steps (out%), LAMMPS writes nothing in the tim
 print("raw (round code N threads p-steps/s out% contacts):")
 for row in rows:
     print("  " + " ".join(row))
+print("machine load (1, 5, 15 min) after each round:")
+for l in open("loads.txt"):
+    print("  " + l.strip())
 EOF
 
 # contacts and overlaps: LAMMPS (compute contact/atom at the end, overlaps from its final

@@ -14,7 +14,10 @@ carrier size and protocol, with --set overrides (the scene itself is defined onc
   field_sweep  (b)+(c) plate down to 0.6 mm and held; the field stepped down 130 -> 15 mT with a
                hold at each level (normal force against B at 0.6 mm); back to 130 mT and slid
                1.5 mm (tangential force at 0.6 mm);
-  half_speed   (a) at half the plate speed (the quasi-static check), for the largest diameter.
+  half_speed   (a) at half the plate speed (the quasi-static check), for the largest diameter;
+  stepped      (a) at rest (optional): the plate comes down in 0.1 mm steps at 0.1 m/s, each held
+               0.5 ms, the force read over the last half of each hold (the brush relaxes when
+               the plate stops: this is the equilibrium curve of the paper's manual stage).
 
 Carrier sizes (Kawamoto: equal mass per area): 42 um x 13,700, 50 um x 7,870, 60 um x 4,420
 beads, +-10 % spread, on 2 x 2 mm^2. `--box L` runs a smaller periodic square with the counts
@@ -70,6 +73,17 @@ def protocol(name, s):
         t_down = hold + 16.0 * s
         path = [(0, 0, 0), (hold, 0, 0), (t_down, 0, -0.8)]
         return [path_set(path), schedule_set(ramp)], t_down, [("descent", hold, t_down, "130")]
+    if name == "stepped":  # (a) at rest: 0.1 mm steps at 0.1 m/s, each held 0.5 ms
+        t = hold
+        path = [(0, 0, 0), (hold, 0, 0)]
+        phases = []
+        for k in range(1, 9):
+            t += 1.0 * s
+            path.append((t, 0, -0.1 * k))
+            t += 0.5 * s
+            path.append((t, 0, -0.1 * k))
+            phases.append(("step", t - 0.25 * s, t, "%.1f" % (PLATE_START_MM - 0.1 * k)))
+        return [path_set(path), schedule_set(ramp)], t, phases
     if name == "field_sweep":
         t_down = hold + 6.0 * s
         t = t_down + 0.5 * s
@@ -86,7 +100,7 @@ def protocol(name, s):
         path = [(0, 0, 0), (hold, 0, 0), (t_down, 0, -0.6), (t_slide, 0, -0.6), (t_end, 1.5, -0.6)]
         phases.append(("slide", t_slide + 4.0 * s, t_end, "0.6"))
         return [path_set(path), schedule_set(sched)], t_end, phases
-    raise ValueError("unknown protocol '%s' (compression, field_sweep, half_speed)" % name)
+    raise ValueError("unknown protocol '%s' (compression, field_sweep, half_speed, stepped)" % name)
 
 
 def parse_length_mm(text):
@@ -102,7 +116,7 @@ def main():
     p.add_argument("case", nargs="?", default=os.path.join(ROOT, "cases", "kawamoto_brush_compression.yaml"))
     p.add_argument("--diameters", type=int, nargs="+", default=[42, 50, 60], choices=sorted(COUNTS))
     p.add_argument("--protocols", nargs="+", default=["compression", "field_sweep", "half_speed"],
-                   choices=["compression", "field_sweep", "half_speed"])
+                   choices=["compression", "field_sweep", "half_speed", "stepped"])
     p.add_argument("--box", default="2mm", help="periodic square side (counts scale with its area)")
     p.add_argument("--time-scale", type=float, default=1.0, help="multiplies every protocol time")
     p.add_argument("--threads", type=int, default=0)
@@ -142,7 +156,14 @@ def main():
             for ph in phases:
                 rows.append([name, proto, d, count, "%g" % (box * box)] + list(ph))
     os.makedirs(out, exist_ok=True)
-    with open(os.path.join(out, "protocol.csv"), "w", newline="") as f:
+    # Keep the phases of earlier runs in this folder (studies can be run piecewise).
+    proto_csv = os.path.join(out, "protocol.csv")
+    ours = set(name for name, _ in runs)
+    if os.path.exists(proto_csv):
+        with open(proto_csv, newline="") as f:
+            old = [r for r in csv.reader(f)][1:]
+        rows = [r for r in old if r and r[0] not in ours] + rows
+    with open(proto_csv, "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["run", "protocol", "diameter_um", "beads", "area_mm2", "phase", "t_start_ms", "t_end_ms", "label"])
         w.writerows(rows)

@@ -8,7 +8,7 @@ runs/<run>/plate_compression.csv and contact maps, and writes into STUDY_DIR:
 
   force_vs_length.csv / .png   normal force [mN] against brush length at 130 mT (descent,
                                binned by 0.05 mm), tangential force at the slide's length
-                               (Kawamoto Fig. 5)
+                               (Kawamoto Fig. 5); force_at_rest.csv: the held steps of `stepped`
   force_vs_field.csv / .png    normal force against B at 0.6 mm, with the low-field exponent
                                of F ~ B^k (Fig. 6)
   tangential.csv               sliding: normal, tangential force and their ratio
@@ -103,8 +103,8 @@ def main():
     summary = []
 
     # ---- (a) normal force against brush length (descent, binned), (c) tangential at the slide
-    length_rows, tangential_rows, chain_rows = [], [], []
-    curves = {}
+    length_rows, tangential_rows, chain_rows, step_rows = [], [], [], []
+    curves, steps = {}, {}
     for name, r in sorted(runs.items()):
         d = r["data"]
         for ph, t0, t1, label in r["phases"]:
@@ -126,12 +126,22 @@ def main():
                                         n / r["area"], (fn * 1e3 / n) if n > 0 else 0.0,
                                         math.sqrt(r["area"] / n) * 1e3 if n > 0 else 0.0])
                 curves[name] = (r, pts)
+            elif ph == "step":
+                L = d["brush_length_m"][m].mean() * 1e3
+                fn = d["Fn_N"][m].mean() * 1e3
+                n = d["touching"][m].mean()
+                steps.setdefault(name, (r, []))[1].append((L, fn))
+                step_rows.append([name, r["d"], L, fn, fn / r["area"] * 1e3, n, n / r["area"],
+                                  (fn * 1e3 / n) if n > 0 else 0.0])
             elif ph == "slide":
                 fn, ft = d["Fn_N"][m].mean() * 1e3, d["Ft_N"][m].mean() * 1e3
                 tangential_rows.append([name, r["d"], float(label), fn, ft, ft / fn if fn > 0 else float("nan")])
     write_csv(os.path.join(study, "force_vs_length.csv"),
               ["run", "protocol", "diameter_um", "brush_length_mm", "Fn_mN", "pn_kPa", "touching", "density_per_mm2",
                "force_per_bead_uN", "chain_spacing_um"], length_rows)
+    write_csv(os.path.join(study, "force_at_rest.csv"),
+              ["run", "diameter_um", "brush_length_mm", "Fn_mN", "pn_kPa", "touching", "density_per_mm2",
+               "force_per_bead_uN"], step_rows)
     write_csv(os.path.join(study, "tangential.csv"),
               ["run", "diameter_um", "brush_length_mm", "Fn_mN", "Ft_mN", "Ft_over_Fn"], tangential_rows)
     for row in tangential_rows:
@@ -145,11 +155,14 @@ def main():
         x, y = zip(*pts)
         style = "--" if r["protocol"] == "half_speed" else "-"
         ax.plot(x, y, style, marker="o", ms=3, label="normal, %d um (%s)" % (r["d"], r["protocol"]))
+    for name, (r, pts) in sorted(steps.items()):
+        x, y = zip(*pts)
+        ax.plot(x, y, "D-", ms=5, lw=2, label="normal at rest (held steps), %d um" % r["d"])
     for row in tangential_rows:
-        ax.plot([row[2]], [row[4]], "s", ms=7, label="tangential, %d um" % row[1])
+        ax.plot([row[2]], [row[4]], "s", ms=7, label="tangential, %d um, %.1f mm" % (row[1], row[2]))
     ax.set_xlabel("brush length [mm]")
     ax.set_ylabel("force on the plate [mN]")
-    ax.set_title("Normal and tangential force vs brush length, 130 mT (Kawamoto Fig. 5)")
+    ax.set_title("Normal and tangential force vs brush length, 130 mT (Kawamoto Fig. 5)", fontsize=10)
     ax.invert_xaxis()
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7)
@@ -221,7 +234,7 @@ def main():
         ax.loglog(bb, ref * (bb / 130) ** 2, "k:", label="B^2")
         ax.set_xlabel("applied flux density B [mT]")
         ax.set_ylabel("normal force [mN]")
-        ax.set_title("Normal force vs B at a brush length of 0.6 mm (Kawamoto Fig. 6)")
+        ax.set_title("Normal force vs B at a brush length of 0.6 mm (Kawamoto Fig. 6)", fontsize=10)
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=7)
         fig.tight_layout()
@@ -268,7 +281,7 @@ def main():
         fig.savefig(os.path.join(study, "fig12_density_force.png"), dpi=130)
         ax2.set_xlabel("carrier diameter [um]")
         ax2.set_ylabel("chain spacing l/sqrt(n) [um]")
-        ax2.set_title("Chain spacing on the plate, 130 mT (Kawamoto Fig. 10)")
+        ax2.set_title("Chain spacing on the plate, 130 mT (Kawamoto Fig. 10)", fontsize=10)
         ax2.grid(alpha=0.3)
         ax2.legend(fontsize=8)
         fig2.tight_layout()

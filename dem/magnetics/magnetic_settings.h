@@ -68,7 +68,7 @@ struct MagneticSettings
   // refresh after refresh_interval [s] (0 = every step), or earlier as soon as some bead
   // moved more than staleness_fraction × its radius since the last evaluation.
   double refresh_interval = 0.0;
-  double staleness_fraction = 0.05;
+  double staleness_fraction = 0.025;
 
   // `corrected`: the exact-minus-dipole pair correction is applied fully for centre
   // distances below switch_begin (in mean pair radii, 2 = touching) and blended smoothly to
@@ -99,6 +99,7 @@ struct MagneticSettings
   int far_order = 2;
   int far_near_reach = 2;
   int far_passes = 1;
+  bool far_single_precision = true; // M2L translations in float (error table: harmless)
 
   // The settings a case asks for (model, far field, cutoff, tolerance, refresh, skin).
   static MagneticSettings from_case(const DemSettings &dem);

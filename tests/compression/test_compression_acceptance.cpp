@@ -66,14 +66,13 @@ Pooled pool(const std::vector<RunResult> &runs)
   return p;
 }
 
-class CompressionAcceptance : public ::testing::Test
+// ctest runs every TEST of a file as its own process: the runs are made once, in one TEST,
+// and each acceptance item is a check function below.
+Runs make_runs()
 {
-protected:
-  static Runs *runs;
-
-  static void SetUpTestSuite()
+  Runs result;
+  Runs *runs = &result;
   {
-    runs = new Runs;
     const fs::path dir = fs::temp_directory_path() / ("magbrush_compression_" + std::to_string(::getpid()));
     // One thread: the same bits on any machine, and no spinning OpenMP team on
     // a shared one.
@@ -96,18 +95,12 @@ protected:
       }
     fs::remove_all(dir);
   }
-  static void TearDownTestSuite()
-  {
-    delete runs;
-    runs = nullptr;
-  }
-};
-Runs *CompressionAcceptance::runs = nullptr;
+  return result;
+}
 
-} // namespace
-
-TEST_F(CompressionAcceptance, NormalForceRisesWithCompression)
+void check_NormalForceRisesWithCompression(const Runs *runs)
 {
+  SCOPED_TRACE("NormalForceRisesWithCompression");
   for (const auto *set : {&runs->d60, &runs->d42})
     for (const RunResult &run : *set)
     {
@@ -126,8 +119,9 @@ TEST_F(CompressionAcceptance, NormalForceRisesWithCompression)
     }
 }
 
-TEST_F(CompressionAcceptance, NormalForceGrowsAsBSquared)
+void check_NormalForceGrowsAsBSquared(const Runs *runs)
 {
+  SCOPED_TRACE("NormalForceGrowsAsBSquared");
   std::vector<double> b, f, b_low, f_low;
   for (const auto &h : field_holds())
   {
@@ -151,8 +145,9 @@ TEST_F(CompressionAcceptance, NormalForceGrowsAsBSquared)
   EXPECT_NEAR(k_all, 2.0, 0.35);
 }
 
-TEST_F(CompressionAcceptance, TangentialOverNormalIsThePlateFriction)
+void check_TangentialOverNormalIsThePlateFriction(const Runs *runs)
 {
+  SCOPED_TRACE("TangentialOverNormalIsThePlateFriction");
   const WindowMean m = mean_over(runs->big.rows, slide_steady);
   ASSERT_GT(m.rows, 0);
   std::printf("sliding at %.3f mm: F_n = %.4f mN, F_t = %.4f mN, F_t/F_n = %.3f\n", m.gap * 1e3, m.fn * 1e3, m.ft * 1e3,
@@ -160,8 +155,9 @@ TEST_F(CompressionAcceptance, TangentialOverNormalIsThePlateFriction)
   EXPECT_NEAR(m.ft / m.fn, 0.35, 0.05);
 }
 
-TEST_F(CompressionAcceptance, TouchingDensityAndForcePerBeadScaleWithDiameter)
+void check_TouchingDensityAndForcePerBeadScaleWithDiameter(const Runs *runs)
 {
+  SCOPED_TRACE("TouchingDensityAndForcePerBeadScaleWithDiameter");
   const Pooled a = pool(runs->d60), b = pool(runs->d42);
   const double d2 = (60.0 / 42.0) * (60.0 / 42.0);
   std::printf("at 0.6 mm, 130 mT (three insertions each): density %.1f / %.1f "
@@ -177,12 +173,25 @@ TEST_F(CompressionAcceptance, TouchingDensityAndForcePerBeadScaleWithDiameter)
   EXPECT_NEAR(a.per_bead() / b.per_bead() / d2, 1.0, 0.20);
 }
 
-TEST_F(CompressionAcceptance, PressureNearlyIndependentOfDiameter)
+void check_PressureNearlyIndependentOfDiameter(const Runs *runs)
 {
+  SCOPED_TRACE("PressureNearlyIndependentOfDiameter");
   const Pooled a = pool(runs->d60), b = pool(runs->d42);
   const double mean = 0.5 * (a.pressure() + b.pressure());
   std::printf("pressure at 0.6 mm, 130 mT: %.3f kPa (60 um), %.3f kPa (42 um)\n", a.pressure() * 1e-3,
               b.pressure() * 1e-3);
   EXPECT_NEAR(a.pressure() / mean, 1.0, 0.15);
   EXPECT_NEAR(b.pressure() / mean, 1.0, 0.15);
+}
+
+} // namespace
+
+TEST(CompressionAcceptance, ReproducesKawamotosFindingsOnAReducedScene)
+{
+  const Runs runs = make_runs();
+  check_NormalForceRisesWithCompression(&runs);
+  check_NormalForceGrowsAsBSquared(&runs);
+  check_TangentialOverNormalIsThePlateFriction(&runs);
+  check_TouchingDensityAndForcePerBeadScaleWithDiameter(&runs);
+  check_PressureNearlyIndependentOfDiameter(&runs);
 }

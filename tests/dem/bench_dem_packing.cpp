@@ -7,14 +7,26 @@
 // Prints particle-steps per second on 1 and 2 threads, the split of the step time between
 // neighbour list, contacts, integration and output (one HDF5 snapshot every 100 steps), the
 // parallel speed-up, and the memory per particle including the contact history.
-//   bench_dem_packing [steps [max_threads]]   (default 300 2)
+//   bench_dem_packing [steps [max_threads [repeats]]]   (default 300 2 1)
+// The machine may be shared: each row also gives the median rate over 10-step windows (a
+// preempted window does not pull it down), the 1-minute load average, and the CPU time of the
+// busiest thread. The "CPU speed-up" (1-thread CPU time / busiest thread's CPU time with more
+// threads) shows how evenly the work splits whatever the load; it leaves out the time threads
+// wait at the step's barriers, which only a quiet machine shows (the wall-time speed-up). With repeats > 1
+// every configuration runs `repeats` times (1 and 2 threads back to back, so that the
+// speed-up compares runs under the same load) and a summary gives medians and ranges.
 #include "dem_system.h"
 #include "snapshot_writer.h"
 
 #include <omp.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
+#include <fstream>
+#include <map>
+#include <vector>
 #include <cstdlib>
 #include <unistd.h>
 #include <filesystem>
@@ -51,8 +63,38 @@ Case packing_case(int per_side, double spacing)
   return c;
 }
 
+double load_average()
+{
+  double l = -1;
+  std::ifstream("/proc/loadavg") >> l;
+  return l;
+}
+
+double median(std::vector<double> v)
+{
+  std::sort(v.begin(), v.end());
+  const std::size_t m = v.size() / 2;
+  return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+}
+
+// CPU time consumed so far by each thread of the OpenMP team [s] (libgomp keeps its threads
+// between regions, so two readings bracket the work of each thread).
+std::vector<double> thread_cpu_times(int threads)
+{
+  std::vector<double> t(static_cast<std::size_t>(threads), 0.0);
+#pragma omp parallel num_threads(threads)
+  {
+    timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    t[static_cast<std::size_t>(omp_get_thread_num())] = static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+  }
+  return t;
+}
+
 struct Result
 {
+  double window_rate = 0, load = 0; // median over 10-step windows; load average at the end
+  double busiest_thread_cpu = 0;    // CPU seconds of the busiest thread in the timed loop
   double rate = 0, neighbor = 0, contact = 0, integrate = 0, output = 0, total = 0, bytes = 0, contacts = 0;
   long rebuilds = 0;
   double rebuild_ms = 0, rebuild_steps = 0; // cost of one list rebuild, in ms and in steps
@@ -86,7 +128,10 @@ Result run(int per_side, int threads, int steps)
   const auto dir = std::filesystem::temp_directory_path() / "magbrush_bench_dem";
   SnapshotWriter writer(dir.string());
   double output = 0.0;
+  std::vector<double> windows;
+  const std::vector<double> cpu0 = thread_cpu_times(threads);
   const double t0 = omp_get_wtime();
+  double w0 = t0;
   for (int k = 1; k <= steps; ++k)
   {
     sys.step();
@@ -96,9 +141,20 @@ Result run(int per_side, int threads, int steps)
       writer.write(sys);
       output += omp_get_wtime() - o0;
     }
+    if (k % 10 == 0)
+    {
+      const double w1 = omp_get_wtime();
+      windows.push_back(w1 - w0);
+      w0 = w1;
+    }
   }
   Result r;
   r.total = omp_get_wtime() - t0;
+  const std::vector<double> cpu1 = thread_cpu_times(threads);
+  for (std::size_t t = 0; t < cpu1.size(); ++t)
+    r.busiest_thread_cpu = std::max(r.busiest_thread_cpu, cpu1[t] - cpu0[t]);
+  r.window_rate = windows.empty() ? 0.0 : 10.0 * static_cast<double>(p.size()) / median(windows);
+  r.load = load_average();
   const PhaseTimes &after = sys.phase_times();
   r.neighbor = after.neighbor - before.neighbor;
   r.contact = after.particle_contacts - before.particle_contacts;
@@ -135,25 +191,61 @@ int main(int argc, char **argv)
   }
   const int steps = argc > 1 ? std::atoi(argv[1]) : 300;
   const int max_threads = argc > 2 ? std::atoi(argv[2]) : 2;
+  const int repeats = argc > 3 ? std::max(1, std::atoi(argv[3])) : 1;
   std::printf("DEM dense periodic packing: 60 um, 2200 kg/m3, E = 1 GPa, nu = 0.35, mu = 0.45, rolling "
-              "friction, damping; %d steps (+20 warm-up), snapshot every 100 steps\n\n",
-              steps);
-  std::printf("%8s %7s %12s %8s | %7s %7s %7s %7s | %8s %9s %8s %8s\n", "N", "threads", "p-steps/s", "speedup",
-              "neigh%", "cont%", "integ%", "out%", "B/part", "contacts", "rebuilds", "wall s");
-  std::printf("%8s %7s %12s %8s | %7s %7s %7s %7s | %8s %9s %8s %8s   %s\n", "", "", "", "", "", "", "", "", "", "",
-              "", "", "one rebuild: ms (steps)");
-  for (int per_side : {24, 38})
-  {
-    double single = 0;
-    for (int threads = 1; threads <= max_threads; ++threads)
+              "friction, damping; %d steps (+20 warm-up), snapshot every 100 steps; %d repeat(s)\n\n",
+              steps, repeats);
+  std::printf("%8s %7s %12s %8s | %7s %7s %7s %7s | %8s %9s %8s %8s   %-16s %12s %5s %9s\n", "N", "threads",
+              "p-steps/s", "speedup", "neigh%", "cont%", "integ%", "out%", "B/part", "contacts", "rebuilds",
+              "wall s", "one rebuild", "median 10-st", "load", "CPU s");
+  std::printf("%8s %7s %12s %8s | %7s %7s %7s %7s | %8s %9s %8s %8s   %-16s %12s %5s %9s\n", "", "", "", "", "", "", "",
+              "", "", "", "", "", "ms (steps)", "p-steps/s", "1 min", "busiest");
+  // rate[(N, threads)] and speed-up[(N, threads)] over the repeats
+  std::map<std::pair<int, int>, std::vector<double>> rates, window_rates, speedups, cpu_speedups, loads;
+  for (int rep = 0; rep < repeats; ++rep)
+    for (int per_side : {24, 38})
     {
-      const Result r = run(per_side, threads, steps);
-      if (threads == 1)
-        single = r.rate;
-      std::printf("%8d %7d %12.4g %8.2f | %7.1f %7.1f %7.1f %7.1f | %8.0f %9.2f %8ld %8.2f   %.2f (%.1f)\n",
-                  per_side * per_side * per_side, threads, r.rate, r.rate / single, 100 * r.neighbor / r.total,
-                  100 * r.contact / r.total, 100 * r.integrate / r.total, 100 * r.output / r.total, r.bytes,
-                  r.contacts, r.rebuilds, r.total, r.rebuild_ms, r.rebuild_steps);
+      double single = 0, single_cpu = 0;
+      for (int threads = 1; threads <= max_threads; ++threads)
+      {
+        const Result r = run(per_side, threads, steps);
+        if (threads == 1)
+        {
+          single = r.rate;
+          single_cpu = r.busiest_thread_cpu;
+        }
+        const int N = per_side * per_side * per_side;
+        rates[{N, threads}].push_back(r.rate);
+        window_rates[{N, threads}].push_back(r.window_rate);
+        speedups[{N, threads}].push_back(r.rate / single);
+        cpu_speedups[{N, threads}].push_back(single_cpu / r.busiest_thread_cpu);
+        loads[{N, threads}].push_back(r.load);
+        char rebuild[32];
+        std::snprintf(rebuild, sizeof rebuild, "%.2f (%.1f)", r.rebuild_ms, r.rebuild_steps);
+        std::printf("%8d %7d %12.4g %8.2f | %7.1f %7.1f %7.1f %7.1f | %8.0f %9.2f %8ld %8.2f   %-16s %12.4g %5.2f %9.3f\n",
+                    N, threads, r.rate, r.rate / single, 100 * r.neighbor / r.total, 100 * r.contact / r.total,
+                    100 * r.integrate / r.total, 100 * r.output / r.total, r.bytes, r.contacts, r.rebuilds,
+                    r.total, rebuild, r.window_rate, r.load, r.busiest_thread_cpu);
+      }
+    }
+  if (repeats > 1)
+  {
+    std::printf("\nsummary over %d repeats: median (min-max); speed-up = 2-thread / 1-thread rate of the same "
+                "repeat (back to back)\n",
+                repeats);
+    std::printf("%8s %7s %28s %28s %24s %24s %18s\n", "N", "threads", "p-steps/s", "median 10-step p-steps/s",
+                "speed-up", "CPU speed-up", "load 1 min");
+    for (const auto &[key, v] : rates)
+    {
+      const auto mm = [](const std::vector<double> &x, const char *fmt) {
+        char b[64];
+        std::snprintf(b, sizeof b, fmt, median(x), *std::min_element(x.begin(), x.end()),
+                      *std::max_element(x.begin(), x.end()));
+        return std::string(b);
+      };
+      std::printf("%8d %7d %28s %28s %24s %24s %18s\n", key.first, key.second, mm(v, "%.4g (%.3g-%.3g)").c_str(),
+                  mm(window_rates[key], "%.4g (%.3g-%.3g)").c_str(), mm(speedups[key], "%.2f (%.2f-%.2f)").c_str(),
+                  mm(cpu_speedups[key], "%.2f (%.2f-%.2f)").c_str(), mm(loads[key], "%.2f (%.2f-%.2f)").c_str());
     }
   }
   std::printf("\n(contacts = touching neighbours per particle; B/part = particle, force, neighbour-list, history "

@@ -1018,6 +1018,7 @@ private:
     d.magnetic_far_field = str(s, "magnetic_far_field");
     d.magnetic_far_order = static_cast<int>(integer(s, "magnetic_far_order"));
     d.magnetic_far_cell = q(s, "magnetic_far_cell");
+    d.magnetic_staleness = q(s, "magnetic_staleness");
     d.air_viscosity = q(s, "air_viscosity");
     d.gravity = vec3(s, "gravity");
     d.seed = static_cast<unsigned long>(integer(s, "seed"));

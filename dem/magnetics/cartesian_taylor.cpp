@@ -158,6 +158,28 @@ void CartesianTaylor::translation_matrix(const double *D, double *A) const
     A[term.out * n_multipole_ + term.in] = D[term.coeff];
 }
 
+void CartesianTaylor::scaled_matrix(const double *A, double s, float *Af) const
+{
+  for (std::size_t g = 0; g < n_local_; ++g)
+    for (std::size_t b = 0; b < n_multipole_; ++b)
+    {
+      const int n = ex_[g + 1] + ey_[g + 1] + ez_[g + 1] + ex_[b + 1] + ey_[b + 1] + ez_[b + 1] + 1;
+      Af[b * n_local_ + g] = static_cast<float>(A[g * n_multipole_ + b] * std::pow(s, n));
+    }
+}
+
+void CartesianTaylor::scaled_moments(const double *M, double s, float *Mf) const
+{
+  for (std::size_t b = 0; b < n_multipole_; ++b)
+    Mf[b] = static_cast<float>(M[b] * std::pow(s, -(ex_[b + 1] + ey_[b + 1] + ez_[b + 1])));
+}
+
+void CartesianTaylor::row_scales(double s, double *row_scale) const
+{
+  for (std::size_t g = 0; g < n_local_; ++g)
+    row_scale[g] = std::pow(s, -(ex_[g + 1] + ey_[g + 1] + ez_[g + 1] + 1));
+}
+
 void CartesianTaylor::shift_local(const double e[3], const double *L_parent, double *L_child) const
 {
   double w[1024];

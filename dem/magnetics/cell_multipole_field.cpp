@@ -14,7 +14,7 @@ namespace magbrush::magnetics {
 
 namespace {
 constexpr std::size_t parallel_threshold = 256; // cells or beads
-constexpr long one_axis_images = 400;           // ±images of the top level, 1 periodic axis
+constexpr long one_axis_images = 40;            // ±explicit images, 1 periodic axis (+ integral tail)
 constexpr long two_axis_image_radius = 64;      // disc radius in periods, 2 periodic axes
 
 long floor_div(long a, long b) { return a >= 0 ? a / b : -((-a - 1) / b) - 1; }
@@ -150,6 +150,11 @@ void CellMultipoleField::build(std::size_t n, const double *x, const double *y, 
     }
   }
 
+  wrap_shift_.resize(3 * n);
+  for (std::size_t b = 0; b < n; ++b)
+    for (int d = 0; d < 3; ++d)
+      wrap_shift_[3 * b + d] = xw_[3 * b + d] - coord[d][b];
+
   levels_.clear();
   levels_.emplace_back();
   Level &fine = levels_[0];
@@ -189,36 +194,53 @@ void CellMultipoleField::build(std::size_t n, const double *x, const double *y, 
   }
   bead_begin_.push_back(static_cast<std::uint32_t>(n));
 
-  // Coarser levels until the top: k cells across the periodic axes (level m), or, with no
-  // periodic axis, at most 4 cells across every axis.
+  // Coarser levels until the top. Periodic axes halve down to k cells (level m), then
+  // collapse by k into a single cell of one period ("columns", levels > m: a cell then holds
+  // its whole periodic column and all its images); open axes halve until at most 4 cells
+  // span them. Without periodic axes: plain halving until at most 4 cells span every axis.
+  column_level_ = periodic_axes_ > 0 ? m + 1 : std::numeric_limits<int>::max();
   for (int level = 0;; ++level)
   {
-    const Level &l = levels_[level];
-    bool top;
-    if (periodic_axes_ > 0)
-      top = level == m;
-    else
+    Level &l = levels_[level];
+    std::array<long, 3> lo{LONG_MAX, LONG_MAX, LONG_MAX}, hi{LONG_MIN, LONG_MIN, LONG_MIN};
+    for (const auto &I : l.index)
+      for (int d = 0; d < 3; ++d)
+      {
+        lo[d] = std::min(lo[d], I[d]);
+        hi[d] = std::max(hi[d], I[d]);
+      }
+    bool top = level >= column_level_ || periodic_axes_ == 0;
+    for (int d = 0; d < 3; ++d)
     {
-      std::array<long, 3> lo{LONG_MAX, LONG_MAX, LONG_MAX}, hi{LONG_MIN, LONG_MIN, LONG_MIN};
-      for (const auto &I : l.index)
-        for (int d = 0; d < 3; ++d)
-        {
-          lo[d] = std::min(lo[d], I[d]);
-          hi[d] = std::max(hi[d], I[d]);
-        }
-      top = l.index.empty() || (hi[0] - lo[0] < 4 && hi[1] - lo[1] < 4 && hi[2] - lo[2] < 4);
+      if (box_[d] > 0.0)
+        l.factor[d] = level < m ? 2 : (level == m ? k : 1);
+      else
+      {
+        l.factor[d] = (!l.index.empty() && hi[d] > lo[d]) ? 2 : 1;
+        if (!l.index.empty() && hi[d] - lo[d] >= 4)
+          top = false;
+      }
     }
-    if (top || level >= 24)
+    if (level < column_level_ && periodic_axes_ > 0)
+      top = false;
+    if (top || level >= 40)
+    {
+      l.factor = {1, 1, 1};
       break;
+    }
     Level next;
     for (int d = 0; d < 3; ++d)
     {
-      next.size[d] = 2.0 * l.size[d];
-      next.cells[d] = l.cells[d] / 2;
+      next.size[d] = l.factor[d] * l.size[d];
+      next.cells[d] = l.cells[d] / l.factor[d];
     }
+    const std::array<long, 3> f = l.factor;
+    auto parent_of = [&f](const std::array<long, 3> &I) {
+      return std::array<long, 3>{I[0] / f[0], I[1] / f[1], I[2] / f[2]};
+    };
     std::vector<std::uint64_t> parent_keys(l.keys.size());
     for (std::size_t c = 0; c < l.keys.size(); ++c)
-      parent_keys[c] = key_of({l.index[c][0] >> 1, l.index[c][1] >> 1, l.index[c][2] >> 1});
+      parent_keys[c] = key_of(parent_of(l.index[c]));
     next.keys = parent_keys;
     std::sort(next.keys.begin(), next.keys.end());
     next.keys.erase(std::unique(next.keys.begin(), next.keys.end()), next.keys.end());
@@ -248,6 +270,9 @@ void CellMultipoleField::build(std::size_t n, const double *x, const double *y, 
   }
   for (Level &l : levels_)
   {
+    l.scale = std::cbrt(l.size[0] * l.size[1] * l.size[2]);
+    l.row_scale.resize(taylor_.local_size());
+    taylor_.row_scales(l.scale, l.row_scale.data());
     l.M.assign(l.keys.size() * taylor_.multipole_size(), 0.0);
     l.L.assign(l.keys.size() * taylor_.local_size(), 0.0);
   }
@@ -255,21 +280,28 @@ void CellMultipoleField::build(std::size_t n, const double *x, const double *y, 
   // Translation tensors of the lower levels (depend on the cell size only).
   // The top level's size depends on the number of levels when nothing is periodic.
   if (h_ != cached_h_ || levels_.size() != cached_levels_)
-    top_D_.clear();
+  {
+    lattice_.clear();
+    lattice_f_.clear();
+  }
   bool tabulated = h_ == cached_h_;
   for (std::size_t level = 0; level + 1 < levels_.size(); ++level)
-    tabulated = tabulated && level < offset_D_.size() && !offset_D_[level].empty();
+    tabulated = tabulated && level < offset_D_.size() &&
+                (static_cast<int>(level) + 1 >= column_level_ || !offset_D_[level].empty());
   cached_levels_ = levels_.size();
   if (!tabulated)
   {
     cached_h_ = h_;
     offset_D_.assign(levels_.size(), {});
+    offset_Df_.assign(levels_.size(), {});
     const std::size_t nd = taylor_.derivative_size();
     const std::size_t na = taylor_.local_size() * taylor_.multipole_size();
     std::vector<double> D(nd);
     for (std::size_t level = 0; level + 1 < levels_.size(); ++level)
     {
       std::vector<double> &A = offset_D_[level];
+      if (static_cast<int>(level) + 1 >= column_level_)
+        continue; // lattice-summed translations from level m up
       A.assign(343 * na, 0.0);
       for (int o = 0; o < 343; ++o)
       {
@@ -281,91 +313,134 @@ void CellMultipoleField::build(std::size_t n, const double *x, const double *y, 
         taylor_.derivatives(R, D.data());
         taylor_.translation_matrix(D.data(), &A[o * na]);
       }
+      offset_Df_[level].resize(A.size());
+      for (int o = 0; o < 343; ++o)
+        taylor_.scaled_matrix(&A[o * na], levels_[level].scale, &offset_Df_[level][o * na]);
     }
   }
   build_interaction_lists();
   build_near_pairs(coord);
 }
 
+void CellMultipoleField::update_positions(const double *x, const double *y, const double *z)
+{
+  const double *coord[3] = {x, y, z};
+  for (std::size_t b = 0; b < n_; ++b)
+    for (int d = 0; d < 3; ++d)
+      xw_[3 * b + d] = coord[d][b] + wrap_shift_[3 * b + d];
+}
+
+bool CellMultipoleField::near(int level, const std::array<long, 3> &D) const
+{
+  // Columns (all periodic axes collapsed): neighbours along the open axes, any image.
+  // Resolved levels: 3D neighbours in unwrapped index space (images explicit).
+  const long reach = level == 0 ? near_reach_ : 1;
+  for (int d = 0; d < 3; ++d)
+    if (!(level >= column_level_ && box_[d] > 0.0) && std::abs(D[d]) > reach)
+      return false;
+  return true;
+}
+
 void CellMultipoleField::build_interaction_lists()
 {
   const int top = static_cast<int>(levels_.size()) - 1;
-  for (int level = 0; level < top; ++level)
+  const std::size_t na = taylor_.local_size() * taylor_.multipole_size();
+  for (int level = 0; level <= top; ++level)
   {
     Level &l = levels_[level];
-    const Level &up = levels_[level + 1];
     l.list_begin.assign(1, 0);
     l.list_source.clear();
-    l.list_offset.clear();
+    l.list_matrix.clear();
+    l.list_matrix_f.clear();
+    // Translation of source cell J (unwrapped index I + D) to target I: below level m a
+    // single image from the offset table; from level m up, the lattice sum over the images.
+    auto add = [&](const std::array<long, 3> &D, long source) {
+      l.list_source.push_back(static_cast<std::uint32_t>(source));
+      if (level + 1 < column_level_ && level < top)
+      {
+        const std::size_t o = ((D[0] + 3) + 7 * (D[1] + 3) + 49 * (D[2] + 3)) * na;
+        l.list_matrix.push_back(&offset_D_[level][o]);
+        l.list_matrix_f.push_back(&offset_Df_[level][o]);
+      }
+      else
+      {
+        l.list_matrix.push_back(lattice_matrix(level, D).data());
+        l.list_matrix_f.push_back(lattice_f_.at({level, D[0], D[1], D[2]}).data());
+      }
+    };
     for (std::size_t c = 0; c < l.keys.size(); ++c)
     {
       const auto &I = l.index[c];
+      if (level == top)
+      {
+        // Every occupied top cell that is not a neighbour (all images, lattice-summed).
+        for (std::size_t s = 0; s < l.keys.size(); ++s)
+        {
+          std::array<long, 3> D = {l.index[s][0] - I[0], l.index[s][1] - I[1], l.index[s][2] - I[2]};
+          if (periodic_axes_ == 0 && near(level, D))
+            continue;
+          if (periodic_axes_ > 0 && near(level, D))
+            continue; // columns: neighbours are refined below
+          add(D, static_cast<long>(s));
+        }
+        // Resolved top (no periodic axis): done. Periodic top with images of itself or of
+        // a neighbour: refined below as well.
+        l.list_begin.push_back(static_cast<std::uint32_t>(l.list_source.size()));
+        continue;
+      }
+      const Level &up = levels_[level + 1];
       const std::array<long, 3> P = up.index[l.parent[c]];
-      for (long oz = -1; oz <= 1; ++oz)
-        for (long oy = -1; oy <= 1; ++oy)
-          for (long ox = -1; ox <= 1; ++ox)
-            for (int bits = 0; bits < 8; ++bits)
-            {
-              const std::array<long, 3> J = {2 * (P[0] + ox) + (bits & 1),
-                                             2 * (P[1] + oy) + ((bits >> 1) & 1),
-                                             2 * (P[2] + oz) + ((bits >> 2) & 1)};
-              const std::array<long, 3> D = {J[0] - I[0], J[1] - I[1], J[2] - I[2]};
-              if (adjacent(D, level == 0 ? near_reach_ : 1))
-                continue;
-              std::array<long, 3> W = J;
-              if (!wrap(l, W))
-                continue;
-              const long s = find(l, W);
-              if (s < 0)
-                continue;
-              l.list_source.push_back(static_cast<std::uint32_t>(s));
-              l.list_offset.push_back(
-                static_cast<std::uint16_t>((D[0] + 3) + 7 * (D[1] + 3) + 49 * (D[2] + 3)));
-            }
+      // The parent's neighbours: columns along the open axes only; resolved cells in 3D.
+      std::array<long, 3> span{1, 1, 1};
+      if (level + 1 >= column_level_)
+        for (int d = 0; d < 3; ++d)
+          if (box_[d] > 0.0)
+            span[d] = 0;
+      for (long oz = -span[2]; oz <= span[2]; ++oz)
+        for (long oy = -span[1]; oy <= span[1]; ++oy)
+          for (long ox = -span[0]; ox <= span[0]; ++ox)
+          {
+            const long Q[3] = {P[0] + ox, P[1] + oy, P[2] + oz};
+            const std::array<long, 3> f = l.factor;
+            for (long cz = 0; cz < f[2]; ++cz)
+              for (long cy = 0; cy < f[1]; ++cy)
+                for (long cx = 0; cx < f[0]; ++cx)
+                {
+                  const std::array<long, 3> J = {Q[0] * f[0] + cx, Q[1] * f[1] + cy, Q[2] * f[2] + cz};
+                  const std::array<long, 3> D = {J[0] - I[0], J[1] - I[1], J[2] - I[2]};
+                  // Level m under a column parent: the images of J are summed in the
+                  // lattice matrix, minus the neighbours; J itself may be one of them.
+                  if (level + 1 < column_level_ && near(level, D))
+                    continue;
+                  if (level >= column_level_ && near(level, D))
+                    continue;
+                  std::array<long, 3> W = J;
+                  if (!wrap(l, W))
+                    continue;
+                  const long source = find(l, W);
+                  if (source < 0)
+                    continue;
+                  add(D, source);
+                }
+          }
       l.list_begin.push_back(static_cast<std::uint32_t>(l.list_source.size()));
     }
   }
-  // Top level: every occupied top cell with every other (and itself), all periodic images
-  // not adjacent, through the lattice-summed tensors.
-  Level &t = levels_[top];
-  t.list_begin.assign(1, 0);
-  t.list_source.clear();
-  top_tensor_.clear();
-  top_tensors_.clear();
-  std::map<const std::vector<double> *, std::uint32_t> slot;
-  for (std::size_t c = 0; c < t.keys.size(); ++c)
-  {
-    for (std::size_t s = 0; s < t.keys.size(); ++s)
-    {
-      const std::array<long, 3> D = {t.index[s][0] - t.index[c][0], t.index[s][1] - t.index[c][1],
-                                     t.index[s][2] - t.index[c][2]};
-      if (periodic_axes_ == 0 && adjacent(D, top == 0 ? near_reach_ : 1))
-        continue;
-      const std::vector<double> &tensor = top_tensor(D);
-      auto it = slot.find(&tensor);
-      if (it == slot.end())
-      {
-        it = slot.emplace(&tensor, static_cast<std::uint32_t>(top_tensors_.size())).first;
-        top_tensors_.push_back(&tensor);
-      }
-      t.list_source.push_back(static_cast<std::uint32_t>(s));
-      top_tensor_.push_back(it->second);
-    }
-    t.list_begin.push_back(static_cast<std::uint32_t>(t.list_source.size()));
-  }
 }
 
-const std::vector<double> &CellMultipoleField::top_tensor(const std::array<long, 3> &offset)
+const std::vector<double> &CellMultipoleField::lattice_matrix(int level, const std::array<long, 3> &offset)
 {
-  auto it = top_D_.find(offset);
-  if (it != top_D_.end())
+  const std::array<long, 4> key = {level, offset[0], offset[1], offset[2]};
+  auto it = lattice_.find(key);
+  if (it != lattice_.end())
     return it->second;
-  const Level &t = levels_.back();
+  const Level &t = levels_[level];
   const std::size_t nd = taylor_.derivative_size();
   std::vector<double> S(nd, 0.0), D(nd);
-  const long reach = levels_.size() == 1 ? near_reach_ : 1;
+  // Images that are neighbours at this level are refined below (resolved levels only; for
+  // columns the offset is never a neighbour).
   auto add_image = [&](const std::array<long, 3> &Delta) {
-    if (adjacent(Delta, reach))
+    if (level < column_level_ && near(level, Delta))
       return;
     const double R[3] = {-Delta[0] * t.size[0], -Delta[1] * t.size[1], -Delta[2] * t.size[2]};
     taylor_.derivatives(R, D.data());
@@ -382,14 +457,37 @@ const std::vector<double> &CellMultipoleField::top_tensor(const std::array<long,
     add_image(offset);
   else if (na == 1)
   {
-    // The image sum converges absolutely (every tensor used is of order ≥ 2, ~1/|m|³):
-    // truncating at ±400 periods leaves ~1e-6 of the nearest image.
-    for (long m = -one_axis_images; m <= one_axis_images; ++m)
+    // ±M images explicitly, the rest as the integral over the continuous line of images
+    // (Euler–Maclaurin with midpoint ends: the next term is ~f''/24, negligible at M = 40);
+    // every tensor used is of order ≥ 2, so the tail decays at least like 1/M².
+    const int ax = axes[0];
+    const long step = t.cells[ax];
+    const double period = box_[ax];
+    for (long j = -one_axis_images; j <= one_axis_images; ++j)
     {
       std::array<long, 3> Delta = offset;
-      Delta[axes[0]] += m * t.cells[axes[0]];
+      Delta[ax] += j * step;
       add_image(Delta);
     }
+    static const double node[8] = {0.0198550717512319, 0.1016667612931866, 0.2372337950418355,
+                                   0.4082826787521751, 0.5917173212478249, 0.7627662049581645,
+                                   0.8983332387068134, 0.9801449282487681};
+    static const double weight[8] = {0.0506142681451881, 0.1111905172266872, 0.1568533229389436,
+                                     0.1813418916891810, 0.1813418916891810, 0.1568533229389436,
+                                     0.1111905172266872, 0.0506142681451881};
+    const double Z0 = (one_axis_images + 0.5) * period;
+    const double R0[3] = {-offset[0] * t.size[0], -offset[1] * t.size[1], -offset[2] * t.size[2]};
+    for (int side : {-1, 1})
+      for (int q = 0; q < 8; ++q)
+      {
+        const double z = Z0 / node[q];
+        double R[3] = {R0[0], R0[1], R0[2]};
+        R[ax] += side * z;
+        taylor_.derivatives(R, D.data());
+        const double w = weight[q] * Z0 / (node[q] * node[q]) / period;
+        for (std::size_t a = 0; a < nd; ++a)
+          S[a] += w * D[a];
+      }
   }
   else
   {
@@ -432,9 +530,12 @@ const std::vector<double> &CellMultipoleField::top_tensor(const std::array<long,
     S[at(1, 2, 0)] += pi / A * q3;
     S[at(1, 0, 2)] += pi / A * q3;
   }
-  std::vector<double> A(taylor_.local_size() * taylor_.multipole_size());
-  taylor_.translation_matrix(S.data(), A.data());
-  return top_D_.emplace(offset, std::move(A)).first->second;
+  std::vector<double> matrix(taylor_.local_size() * taylor_.multipole_size());
+  taylor_.translation_matrix(S.data(), matrix.data());
+  std::vector<float> &scaled = lattice_f_[key];
+  scaled.resize(matrix.size());
+  taylor_.scaled_matrix(matrix.data(), t.scale, scaled.data());
+  return lattice_.emplace(key, std::move(matrix)).first->second;
 }
 
 void CellMultipoleField::build_near_pairs(const double *const coord[3])
@@ -503,11 +604,11 @@ std::size_t CellMultipoleField::interactions() const
   return count;
 }
 
+
 void CellMultipoleField::evaluate(const double *p, double *B, double *gradB)
 {
   const int top = static_cast<int>(levels_.size()) - 1;
   const std::size_t nm = taylor_.multipole_size(), nl = taylor_.local_size();
-  const std::size_t na = nl * nm;
 
   // 1. P2M.
   {
@@ -550,6 +651,13 @@ void CellMultipoleField::evaluate(const double *p, double *B, double *gradB)
       }
     }
   }
+  if (single_precision_)
+    for (Level &l : levels_)
+    {
+      l.Mf.resize(l.M.size());
+      for (std::size_t c = 0; c < l.keys.size(); ++c)
+        taylor_.scaled_moments(&l.M[c * nm], l.scale, &l.Mf[c * nm]);
+    }
   // 3–4. M2L at every level, L2L downwards.
   for (int level = top; level >= 0; --level)
   {
@@ -568,14 +676,19 @@ void CellMultipoleField::evaluate(const double *p, double *B, double *gradB)
         const double e[3] = {centre_c[0] - centre_p[0], centre_c[1] - centre_p[1],
                              centre_c[2] - centre_p[2]};
         taylor_.shift_local(e, &up.L[l.parent[c] * nl], L);
-        const double *A = offset_D_[level].data();
+      }
+      if (single_precision_)
+      {
+        float Lf[1024];
+        std::fill(Lf, Lf + nl, 0.0f);
         for (std::uint32_t k = l.list_begin[c]; k < l.list_begin[c + 1]; ++k)
-          taylor_.apply_translation(&A[l.list_offset[k] * na], &l.M[l.list_source[k] * nm], L);
+          taylor_.accumulate_translation(l.list_matrix_f[k], &l.Mf[l.list_source[k] * nm], Lf);
+        for (std::size_t g = 0; g < nl; ++g)
+          L[g] += l.row_scale[g] * Lf[g];
       }
       else
         for (std::uint32_t k = l.list_begin[c]; k < l.list_begin[c + 1]; ++k)
-          taylor_.apply_translation(top_tensors_[top_tensor_[k]]->data(),
-                                    &l.M[l.list_source[k] * nm], L);
+          taylor_.apply_translation(l.list_matrix[k], &l.M[l.list_source[k] * nm], L);
     }
   }
   // 5. L2P.

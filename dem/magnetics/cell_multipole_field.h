@@ -50,6 +50,12 @@ public:
   // cells exactly, k = 1 or 3), builds the levels, interaction lists and the near pair list.
   void build(std::size_t n, const double *x, const double *y, const double *z, double cell_size);
 
+  // The beads moved (by less than a fraction of a cell since build()): keep the cells, the
+  // lists and the near pairs (a bead stays in the cell it was sorted into, as in a Verlet
+  // list), and take the new positions for the expansions. Positions are raw, as in build();
+  // a bead wrapped by the caller since build() must trigger a build() instead.
+  void update_positions(const double *x, const double *y, const double *z);
+
   // Pairs of beads (and periodic images) in adjacent fine cells, each once, in a fixed order;
   // r = x_j − x_i + shift with the raw positions given to build().
   const std::vector<MagneticNeighbourList::Pair> &near_pairs() const { return near_pairs_; }
@@ -57,6 +63,9 @@ public:
   // B_far [T] (3 per bead) and ∇B_far [T/m] (9 per bead, gradB[9b + 3a + c] = ∂B_a/∂x_c)
   // of the dipoles p (3 per bead, A m²), excluding the near pairs. Overwrites B and gradB.
   void evaluate(const double *p, double *B, double *gradB);
+
+  // M2L in single precision (default) or double (for the error table).
+  void set_single_precision(bool single) { single_precision_ = single; }
 
   std::size_t fine_cells() const { return levels_.empty() ? 0 : levels_[0].keys.size(); }
   int levels() const { return static_cast<int>(levels_.size()); }
@@ -67,13 +76,18 @@ private:
   struct Level
   {
     std::array<double, 3> size;          // cell size per axis
-    std::array<long, 3> cells;           // periodic axes: cell count (2^k); open: unused
+    std::array<long, 3> cells;           // periodic axes: cell count (k·2^j); open: unused
+    std::array<long, 3> factor{{1, 1, 1}}; // cells of this level per cell of the next, per axis
     std::vector<std::uint64_t> keys;     // occupied cells, sorted
     std::vector<std::array<long, 3>> index;
     std::vector<std::uint32_t> parent;   // index into the next level
     std::vector<std::uint32_t> child_begin, children; // CSR into the previous level
     std::vector<std::uint32_t> list_begin, list_source; // interaction list (CSR)
-    std::vector<std::uint16_t> list_offset;             // offset id (lower levels)
+    std::vector<const double *> list_matrix;            // translation matrix per entry
+    std::vector<const float *> list_matrix_f;           // the same in single precision
+    std::vector<float> Mf;                              // moments in single precision (scaled)
+    double scale = 1.0;                                 // length scale of the float numbers
+    std::vector<double> row_scale;                      // s^(−|γ|−1) per local coefficient
     std::vector<double> M, L;            // moments and local coefficients per cell
   };
 
@@ -85,6 +99,7 @@ private:
   std::size_t n_ = 0;
   std::vector<Level> levels_;
   std::vector<double> xw_;                 // wrapped positions (3 per bead)
+  std::vector<double> wrap_shift_;         // xw − x at build() (multiples of the periods)
   std::vector<std::uint32_t> bead_order_;  // beads sorted by fine cell
   std::vector<std::uint32_t> bead_begin_;  // per fine cell, into bead_order_
   std::vector<std::uint32_t> bead_cell_;   // fine cell of every bead
@@ -94,11 +109,13 @@ private:
   // level, and the lattice-summed ones of the top level per offset (cached while h and the
   // number of levels are unchanged).
   std::vector<std::vector<double>> offset_D_;
-  std::map<std::array<long, 3>, std::vector<double>> top_D_;
+  std::map<std::array<long, 4>, std::vector<double>> lattice_; // (level, offset) → matrix
+  std::vector<std::vector<float>> offset_Df_;
+  std::map<std::array<long, 4>, std::vector<float>> lattice_f_;
+  bool single_precision_ = true;
+  int column_level_ = 0; // first level whose cells span the whole period (m + 1)
   std::array<double, 3> cached_h_{0, 0, 0};
   std::size_t cached_levels_ = 0;
-  std::vector<std::uint32_t> top_tensor_; // per top interaction: index into top_tensors_
-  std::vector<const std::vector<double> *> top_tensors_;
 
   std::uint64_t key_of(const std::array<long, 3> &I) const;
   long find(const Level &level, const std::array<long, 3> &I) const; // −1 if empty
@@ -107,7 +124,8 @@ private:
   void build_levels();
   void build_interaction_lists();
   void build_near_pairs(const double *const coord[3]);
-  const std::vector<double> &top_tensor(const std::array<long, 3> &offset);
+  bool near(int level, const std::array<long, 3> &D) const;
+  const std::vector<double> &lattice_matrix(int level, const std::array<long, 3> &offset);
 };
 
 } // namespace magbrush::magnetics

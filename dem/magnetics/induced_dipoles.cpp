@@ -62,6 +62,7 @@ InducedDipoles::InducedDipoles(const MagneticSettings &settings, const std::arra
                                   std::to_string(settings_.far_passes) + " and " +
                                   std::to_string(settings_.far_cell_diameters) + ".");
     far_ = std::make_unique<CellMultipoleField>(settings_.far_order, box_, settings_.far_near_reach);
+    far_->set_single_precision(settings_.far_single_precision);
   }
   if (settings_.slab_tail_correction)
   {
@@ -118,16 +119,25 @@ MagneticStats InducedDipoles::compute(const BeadArrays &beads, const AppliedFiel
   double cutoff;
   if (far_)
   {
-    // No cutoff: the near pairs are those of neighbouring fine cells (rebuilt every call:
-    // beads change cells), everything else is the far field.
+    // No cutoff: the near pairs are those of neighbouring fine cells. Like a Verlet list,
+    // the cells and the near pairs are kept until some bead moved more than half the skin
+    // (a bead wrapped by the caller counts as a large move); in between, the beads keep the
+    // cells they were sorted into and only their positions are updated.
     double sum = 0.0;
     for (std::size_t b = 0; b < n; ++b)
       sum += beads.radius[b];
     const double mean_diameter = 2.0 * sum / n;
-    far_->build(n, beads.x, beads.y, beads.z, settings_.far_cell_diameters * mean_diameter);
-    list_.set_pairs(n, beads.x, beads.y, beads.z, box_, 0.0,
-                    std::vector<MagneticNeighbourList::Pair>(far_->near_pairs()));
-    stats.list_rebuilt = true;
+    const double skin = settings_.skin_fraction * mean_diameter;
+    if (!list_.built() || list_.particle_count() != n ||
+        list_.max_displacement(n, beads.x, beads.y, beads.z) > 0.5 * skin)
+    {
+      far_->build(n, beads.x, beads.y, beads.z, settings_.far_cell_diameters * mean_diameter);
+      list_.set_pairs(n, beads.x, beads.y, beads.z, box_, 0.0,
+                      std::vector<MagneticNeighbourList::Pair>(far_->near_pairs()));
+      stats.list_rebuilt = true;
+    }
+    else
+      far_->update_positions(beads.x, beads.y, beads.z);
     stats.listed_pairs = list_.size();
     stats.far_cells = far_->fine_cells();
     stats.far_interactions = far_->interactions();
@@ -145,6 +155,8 @@ MagneticStats InducedDipoles::compute(const BeadArrays &beads, const AppliedFiel
   lap(stats.time_lists);
   evaluate_applied_field(beads, field);
   evaluate_pair_tensors(beads, cutoff, stats);
+  if (far_)
+    build_near_entries();
   if (settings_.slab_tail_correction)
     prepare_tail(beads, cutoff);
   lap(stats.time_tensors);
@@ -244,6 +256,33 @@ void InducedDipoles::evaluate_pair_tensors(const BeadArrays &beads, double cutof
   stats.pairs = count;
 }
 
+void InducedDipoles::build_near_entries()
+{
+  const auto &begin = list_.incident_begin();
+  const auto &pair_of = list_.incident_pair();
+  const auto &first = list_.incident_first();
+  const auto &pairs = list_.pairs();
+  const std::size_t n = begin.size() - 1;
+  near_begin_.assign(begin.begin(), begin.end());
+  near_other_.resize(begin[n]);
+  near_tensor_.resize(6 * begin[n]);
+#pragma omp parallel for schedule(static) if (n >= parallel_threshold)
+  for (long b = 0; b < static_cast<long>(n); ++b)
+    for (std::size_t q = begin[b]; q < begin[b + 1]; ++q)
+    {
+      const std::uint32_t k = pair_of[q];
+      near_other_[q] = first[q] ? pairs[k].j : pairs[k].i;
+      const DipoleTensor &T = tensor_[k]; // zero for an inactive (coincident) pair
+      double *t = &near_tensor_[6 * q];
+      t[0] = T.xx;
+      t[1] = T.yy;
+      t[2] = T.zz;
+      t[3] = T.xy;
+      t[4] = T.xz;
+      t[5] = T.yz;
+    }
+}
+
 void InducedDipoles::gather_local_field(std::size_t b, const std::vector<double> &p,
                                         double B[3]) const
 {
@@ -254,8 +293,24 @@ void InducedDipoles::gather_local_field(std::size_t b, const std::vector<double>
     for (int d = 0; d < 3; ++d)
       B[d] += tail_B_[3 * b + d];
   if (far_)
-    for (int d = 0; d < 3; ++d)
-      B[d] += B_far_[3 * b + d];
+  {
+    double sx = B_far_[3 * b], sy = B_far_[3 * b + 1], sz = B_far_[3 * b + 2];
+    const std::size_t q0 = near_begin_[b], q1 = near_begin_[b + 1];
+    const std::uint32_t *other = near_other_.data();
+    const double *t = near_tensor_.data();
+    for (std::size_t q = q0; q < q1; ++q)
+    {
+      const double *pk = &p[3 * other[q]];
+      const double *T = &t[6 * q];
+      sx += T[0] * pk[0] + T[3] * pk[1] + T[4] * pk[2];
+      sy += T[3] * pk[0] + T[1] * pk[1] + T[5] * pk[2];
+      sz += T[4] * pk[0] + T[5] * pk[1] + T[2] * pk[2];
+    }
+    B[0] += sx;
+    B[1] += sy;
+    B[2] += sz;
+    return;
+  }
   const auto &begin = list_.incident_begin();
   const auto &pair_of = list_.incident_pair();
   const auto &first = list_.incident_first();

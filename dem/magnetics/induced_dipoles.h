@@ -154,6 +154,12 @@ private:
   // from their own short Verlet list, with their correction forces.
   std::unique_ptr<CellMultipoleField> far_;
   std::vector<double> B_far_, gradB_far_;
+  // Per-bead neighbour entries of the near field for the sweeps (cell_multipole): the other
+  // bead and the pair tensor, contiguous per bead (CSR in near_begin_), so that a sweep
+  // streams through memory instead of chasing pair indices.
+  std::vector<std::size_t> near_begin_;
+  std::vector<std::uint32_t> near_other_;
+  std::vector<double> near_tensor_; // 6 per entry
   MagneticNeighbourList correction_list_;
   std::vector<double> correction_force_;
 
@@ -161,6 +167,7 @@ private:
   void refresh_list_if_needed(const BeadArrays &beads, double cutoff, MagneticStats &stats);
   void evaluate_applied_field(const BeadArrays &beads, const AppliedFieldFunction &field);
   void evaluate_pair_tensors(const BeadArrays &beads, double cutoff, MagneticStats &stats);
+  void build_near_entries();
   void prepare_tail(const BeadArrays &beads, double cutoff);
   void evaluate_tail(const std::vector<double> &p);
   void gather_local_field(std::size_t b, const std::vector<double> &p, double B[3]) const;

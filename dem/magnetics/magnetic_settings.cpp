@@ -56,6 +56,7 @@ MagneticSettings MagneticSettings::from_case(const DemSettings &dem)
   s.far_field = parse_far_field(dem.magnetic_far_field);
   s.far_order = dem.magnetic_far_order;
   s.far_cell_diameters = dem.magnetic_far_cell;
+  s.staleness_fraction = dem.magnetic_staleness;
   return s;
 }
 

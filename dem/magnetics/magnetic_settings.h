@@ -99,6 +99,7 @@ struct MagneticSettings
   int far_order = 2;
   int far_near_reach = 2;
   int far_passes = 1;
+  bool far_single_precision = true; // M2L translations in float (error table: harmless)
 
   // The settings a case asks for (model, far field, cutoff, tolerance, refresh, skin).
   static MagneticSettings from_case(const DemSettings &dem);

@@ -10,7 +10,7 @@
 // Errors: RMS over beads |F − F_ref| / RMS |F_ref|, and the total force on the beads touching
 // the plane (the brush's push on the stage/plate). Prints tables; asserts nothing.
 //
-//   bench_magnetic_far_field [chains_small] [chains_large]
+//   bench_magnetic_far_field [chains_small] [chains_large] [cost]   (cost: only table 4)
 #include "brush_configuration.h"
 #include "dipole_physics.h"
 #include "induced_dipoles.h"
@@ -22,6 +22,7 @@
 #include <cstdlib>
 #include <ctime>
 #include <random>
+#include <string>
 #include <vector>
 
 using namespace magbrush::magnetics;
@@ -211,6 +212,13 @@ void table(const char *title, const BrushConfiguration &c, const std::array<doub
                   f.cell, f.order, f.passes, f.passes > 1 ? "es" : "");
     row(name, far(f.order, f.cell, f.reach, f.passes, model));
   }
+  // The models at the default far field (against this table's reference).
+  for (DipoleModel m : {DipoleModel::point_dipole, DipoleModel::mutual_dipole, DipoleModel::corrected})
+  {
+    char name[96];
+    std::snprintf(name, sizeof name, "far default, model %s", to_string(m).c_str());
+    row(name, far(2, 1.5, 2, 1, m));
+  }
 }
 
 } // namespace
@@ -219,9 +227,11 @@ int main(int argc, char **argv)
 {
   const std::size_t chains = argc > 1 ? std::strtoul(argv[1], nullptr, 10) : 100;
   const std::size_t chains_large = argc > 2 ? std::strtoul(argv[2], nullptr, 10) : 1100;
+  const bool cost_only = argc > 3 && std::string(argv[3]) == "cost";
   std::printf("bench_magnetic_far_field: %d OpenMP threads\n", omp_get_max_threads());
 
   // 1. Open brush, brute-force reference (mutual_dipole: the brute force has no correction).
+  if (!cost_only)
   {
     const BrushConfiguration c = bench::make_brush(chains, 0.9e-3, 30e-6, 3e-6, 8, 16, 3.9, 7);
     const Forces ref = brute_force(c);
@@ -229,6 +239,7 @@ int main(int argc, char **argv)
           c, {0, 0, 0}, ref, DipoleModel::mutual_dipole, false);
   }
   // 2. z-periodic strip, corrected, reference: far field order 5.
+  if (!cost_only)
   {
     const BrushConfiguration c = bench::make_brush(chains, 0.9e-3, 30e-6, 3e-6, 8, 16, 3.9, 7, false);
     const std::array<double, 3> box = {0.0, 0.0, c.box};
@@ -237,6 +248,7 @@ int main(int argc, char **argv)
           c, box, ref, DipoleModel::corrected, false);
   }
   // 3. x/z-periodic brush (compression box), corrected, reference: far field order 5.
+  if (!cost_only)
   {
     const BrushConfiguration c = bench::make_brush(chains, 0.9e-3, 30e-6, 3e-6, 8, 16, 3.9, 7);
     const std::array<double, 3> box = {c.box, 0.0, c.box};
@@ -269,6 +281,13 @@ int main(int argc, char **argv)
       std::snprintf(name, sizeof name, "far: reach %d, cell %.1f d, order %d", f.reach, f.cell, f.order);
       row(name, far(f.order, f.cell, f.reach, 1, DipoleModel::corrected));
     }
+    MagneticSettings dbl = far(2, 1.5, 2, 1, DipoleModel::corrected);
+    dbl.far_single_precision = false;
+    row("far: reach 2, cell 1.5 d, order 2, M2L in double", dbl);
+    MagneticSettings pd = far(2, 1.5, 2, 1, DipoleModel::point_dipole);
+    row("far: reach 2, cell 1.5 d, order 2, point_dipole", pd);
+    MagneticSettings md = far(2, 1.5, 2, 1, DipoleModel::mutual_dipole);
+    row("far: reach 2, cell 1.5 d, order 2, mutual_dipole", md);
   }
   return 0;
 }

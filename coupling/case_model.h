@@ -193,7 +193,7 @@ struct DemSettings
   std::string magnetic_far_field = "cell_multipole";
   int magnetic_far_order = 2;        // Taylor order of the cell multipoles
   double magnetic_far_cell = 1.5;    // fine cell size in mean carrier diameters
-  double magnetic_staleness = 0.025; // refresh early when a bead moved this × its radius
+  double magnetic_staleness = 0.05;  // refresh early when a bead moved this × its radius
   double air_viscosity = 1.81e-5;    // η [Pa s] for Stokes drag (0 = no drag)
   Vec3 gravity{{0.0, -9.81, 0.0}};    // [m/s²]
   unsigned long seed = 1;

@@ -257,7 +257,7 @@ std::vector<KeySpec> build_schema()
              "Magnetic far field: cell_multipole (no cutoff: exact pairs within 2 fine cells, the whole rest of the domain and every periodic image by cell multipoles, docs/magnetics.md) or none (hard cutoff at magnetic_cutoff).")
           .def("cell_multipole"),
       integer("dem.magnetic_far_order", "Taylor order of the cell multipoles (error vs cost in docs/magnetics.md).").def("2").non_negative().max(6),
-      number("dem.magnetic_staleness", "Refresh the magnetic forces early when some carrier moved more than this fraction of its radius since the last refresh (0.025: held-force error ~1 % RMS, docs/magnetics.md).").def("0.025").positive(),
+      number("dem.magnetic_staleness", "Refresh the magnetic forces early when some carrier moved more than this fraction of its radius since the last refresh (held-force error ~0.37 x this, RMS, at the refresh; half of it on average, docs/magnetics.md).").def("0.05").positive(),
       number("dem.magnetic_far_cell", "Fine cell size of the magnetic far field in mean carrier diameters (1.5 with order 2: <= 0.7 % RMS force error in brushes, docs/magnetics.md).").def("1.5").positive().max(10.0),
       quantity("dem.air_viscosity", D::viscosity, "Air viscosity for Stokes drag (0 = no drag).").def("1.81e-5 Pa*s").non_negative(),
       vector3("dem.gravity", D::acceleration, "Gravitational acceleration.").def("[0, -9.81 m/s^2, 0]"),

@@ -68,7 +68,7 @@ struct MagneticSettings
   // refresh after refresh_interval [s] (0 = every step), or earlier as soon as some bead
   // moved more than staleness_fraction × its radius since the last evaluation.
   double refresh_interval = 0.0;
-  double staleness_fraction = 0.025;
+  double staleness_fraction = 0.05;
 
   // `corrected`: the exact-minus-dipole pair correction is applied fully for centre
   // distances below switch_begin (in mean pair radii, 2 = touching) and blended smoothly to

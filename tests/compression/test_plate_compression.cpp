@@ -273,3 +273,18 @@ TEST(PlateCompression, RowsCarryTheScheduledFieldAndThePlateGap)
   EXPECT_DOUBLE_EQ(m.rows()[0].touching, 0.0);
   EXPECT_DOUBLE_EQ(m.rows()[0].fn, 0.0);
 }
+
+TEST(PlateCompression, SchemaDefaultsAgreeWithTheContractStruct)
+{
+  // A case that gives no `compression` section gets the struct's defaults from the schema.
+  std::string text = scene(static_plate, 2200);
+  text = text.substr(0, text.find("compression:\n"));
+  const Case c = parse_case_text(text, "column.yaml");
+  const CompressionSettings d;
+  EXPECT_EQ(c.compression.plate, d.plate);
+  EXPECT_EQ(c.compression.stage, d.stage);
+  EXPECT_DOUBLE_EQ(c.compression.sample_interval, d.sample_interval);
+  EXPECT_DOUBLE_EQ(c.compression.average_window, d.average_window);
+  EXPECT_DOUBLE_EQ(c.compression.map_interval, d.map_interval);
+  EXPECT_TRUE(AppliedField{}.schedule.empty());
+}

@@ -88,7 +88,7 @@ void roller_table()
       const double seconds = now() - t0;
       std::vector<Vec2> points;
       for (const double a : angles)
-        points.push_back({sleeve.radius * std::cos(a), sleeve.radius * std::sin(a)});
+        points.push_back({{sleeve.radius * std::cos(a), sleeve.radius * std::sin(a)}});
       const auto B = solver.flux_density(points);
       double err = 0.0;
       for (std::size_t k = 0; k < B.size(); ++k)
@@ -114,7 +114,7 @@ void nip_table()
   auto exact_E = [&](double x, double y) {
     const std::complex<double> z(x, y), a(g.focus, 0.0);
     const std::complex<double> dw = 1.0 / (z + a) - 1.0 / (z - a);
-    return Vec2{-V / dtau * dw.real(), V / dtau * dw.imag()};
+    return Vec2{{-V / dtau * dw.real(), V / dtau * dw.imag()}};
   };
   const double x_drum = -g.center_left + R_drum, x_sleeve = g.center_right - R_sleeve;
   std::vector<Point<2>> points;

@@ -19,7 +19,7 @@ inline std::vector<Vec2> circle_points(double radius, int n, double phase = 0.0)
   for (int k = 0; k < n; ++k)
   {
     const double t = phase + 2.0 * 3.14159265358979323846 * k / n;
-    p[k] = {radius * std::cos(t), radius * std::sin(t)};
+    p[k] = {{radius * std::cos(t), radius * std::sin(t)}};
   }
   return p;
 }

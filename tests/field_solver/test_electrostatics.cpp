@@ -93,12 +93,12 @@ TEST(FieldElectrostatics, CosineLatentImage)
     if (y <= t)
     {
       const double c = phi0 / std::sinh(k * t);
-      return Vec2{c * k * std::sin(k * x) * std::sinh(k * y),
-                  -c * k * std::cos(k * x) * std::cosh(k * y)};
+      return Vec2{{c * k * std::sin(k * x) * std::sinh(k * y),
+                   -c * k * std::cos(k * x) * std::cosh(k * y)}};
     }
     const double c = phi0 / std::sinh(k * g);
-    return Vec2{c * k * std::sin(k * x) * std::sinh(k * (t + g - y)),
-                c * k * std::cos(k * x) * std::cosh(k * (t + g - y))};
+    return Vec2{{c * k * std::sin(k * x) * std::sinh(k * (t + g - y)),
+                 c * k * std::cos(k * x) * std::cosh(k * (t + g - y))}};
   };
 
   std::vector<Point<2>> surface, interior;
@@ -133,7 +133,7 @@ TEST(FieldElectrostatics, CosineLatentImage)
     const auto grad = problem.gradients_at(interior);
     std::vector<Vec2> E;
     for (const auto &gr : grad)
-      E.push_back({-gr[0], -gr[1]});
+      E.push_back({{-gr[0], -gr[1]}});
     E_errors.push_back(max_vector_error(E, E_exact, E_scale));
   }
   print_study("cosine latent image, surface potential, max |Δφ_s| / φ_s0", phi_errors);
@@ -169,7 +169,7 @@ TEST(FieldElectrostatics, TwoCylindersBipolar)
   auto exact_E = [&](double x, double y) {
     const std::complex<double> z(x, y), a(geometry.focus, 0.0);
     const std::complex<double> dw = 1.0 / (z + a) - 1.0 / (z - a);
-    return Vec2{-V / dtau * dw.real(), V / dtau * dw.imag()};
+    return Vec2{{-V / dtau * dw.real(), V / dtau * dw.imag()}};
   };
 
   // Across the gap on the line of centres, and around it.
@@ -209,7 +209,7 @@ TEST(FieldElectrostatics, TwoCylindersBipolar)
     const auto grad = problem.gradients_at(points);
     std::vector<Vec2> E;
     for (const auto &gr : grad)
-      E.push_back({-gr[0], -gr[1]});
+      E.push_back({{-gr[0], -gr[1]}});
     E_errors.push_back(max_vector_error(E, E_exact, E_gap));
     C_errors.push_back(std::abs(problem.energy_integral() - energy_exact) / energy_exact);
   }

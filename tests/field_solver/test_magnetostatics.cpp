@@ -51,7 +51,7 @@ std::vector<Vec2> ring_field(const MultipoleRing &ring, const std::vector<Vec2> 
   for (const auto &p : points)
   {
     const auto f = ring.field(p[0], p[1]);
-    B.push_back({f.Bx, f.By});
+    B.push_back({{f.Bx, f.By}});
   }
   return B;
 }
@@ -66,14 +66,14 @@ TEST(FieldMagnetostatics, UniformlyMagnetisedCylinder)
   RollerGeometry g;
   g.magnet_radius = R;
   g.sleeve_radius = 12e-3;
-  const Magnetisation uniform = [M0](double, double) { return Vec2{M0, 0.0}; };
+  const Magnetisation uniform = [M0](double, double) { return Vec2{{M0, 0.0}}; };
 
   std::vector<Vec2> points, exact;
   for (const double r : {0.3 * R, 0.8 * R})
     for (const auto &p : circle_points(r, 48, 0.1))
     {
       points.push_back(p);
-      exact.push_back({mu0 * M0 / 2.0, 0.0});
+      exact.push_back({{mu0 * M0 / 2.0, 0.0}});
     }
   for (const double r : {12e-3, 15e-3})
     for (const auto &p : circle_points(r, 48, 0.1))
@@ -81,7 +81,7 @@ TEST(FieldMagnetostatics, UniformlyMagnetisedCylinder)
       const double x = p[0], y = p[1], r4 = std::pow(x * x + y * y, 2);
       const double c = mu0 * M0 * R * R / 2.0;
       points.push_back(p);
-      exact.push_back({c * (x * x - y * y) / r4, c * 2.0 * x * y / r4});
+      exact.push_back({{c * (x * x - y * y) / r4, c * 2.0 * x * y / r4}});
     }
 
   const auto errors = refinement_study(g, uniform, 32, 3, points, exact, mu0 * M0 / 2.0);
@@ -109,7 +109,7 @@ TEST_P(FieldMultipoleRing, AirCore)
   const Magnetisation ring_M = [n, M0](double x, double y) {
     const double t = std::atan2(y, x), r = std::hypot(x, y);
     const double m = M0 * std::cos(n * t);
-    return Vec2{m * x / r, m * y / r};
+    return Vec2{{m * x / r, m * y / r}};
   };
 
   RingGeometry rg;
@@ -152,7 +152,7 @@ TEST_P(FieldMultipoleRing, IronShaft)
   const Magnetisation ring_M = [n, M0](double x, double y) {
     const double t = std::atan2(y, x), r = std::hypot(x, y);
     const double m = M0 * std::cos(n * t);
-    return Vec2{m * x / r, m * y / r};
+    return Vec2{{m * x / r, m * y / r}};
   };
   RingGeometry rg;
   rg.shaft_radius = Ri;

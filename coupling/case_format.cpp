@@ -110,11 +110,13 @@ std::vector<ResolvedEntry> resolved_entries(const Case &c)
     e.q("sleeve.radius", "sleeve.radius", c.sleeve->radius);
     e.q("sleeve.thickness", "sleeve.thickness", c.sleeve->thickness);
     e.q("sleeve.rpm", "sleeve.rpm", c.sleeve->omega());
+    e.q("sleeve.spin_up_time", "sleeve.spin_up_time", c.sleeve->spin_up_time);
   }
   if (c.drum.present)
   {
     e.q("drum.radius", "drum.radius", c.drum.radius);
     e.q("drum.rpm", "drum.rpm", c.drum.omega());
+    e.q("drum.spin_up_time", "drum.spin_up_time", c.drum.spin_up_time);
     e.q("drum.gap", "drum.gap", c.drum.gap);
     e.q("drum.angle", "drum.angle", c.drum.angle);
     e.q("drum.pc_thickness", "drum.pc_thickness", c.drum.pc_thickness);

@@ -49,6 +49,7 @@ struct Sleeve
   double radius = 0.0;     // outer radius [m]
   double thickness = 0.0;  // wall thickness [m] (non-magnetic, e.g. aluminium)
   double rpm = 0.0;        // signed rotation speed [rev/min]; > 0 counter-clockwise
+  double spin_up_time = 0.0; // linear ramp of the speed from rest from t = 0 [s] (0 = at once)
   double omega() const;    // angular velocity [rad/s]
   double surface_speed() const; // |ω| R [m/s]
 };
@@ -58,6 +59,7 @@ struct Drum
   bool present = false;
   double radius = 0.0;             // outer radius of the photoconductor surface [m]
   double rpm = 0.0;                // signed [rev/min]
+  double spin_up_time = 0.0;       // linear ramp of the speed from rest from t = 0 [s] (0 = at once)
   double gap = 0.0;                // development gap: sleeve surface to drum surface [m]
   double angle = 0.0;              // direction of the drum centre seen from the roller centre [rad]
   double pc_thickness = 0.0;       // photoconductor layer thickness [m]

@@ -741,6 +741,7 @@ private:
       sleeve.radius = radius_of(s);
       sleeve.thickness = q(s, "thickness");
       sleeve.rpm = q(s, "rpm") * 60.0 / (2.0 * pi);
+      sleeve.spin_up_time = q(s, "spin_up_time");
       c.sleeve = sleeve;
     }
     if (present.count("drum"))
@@ -749,6 +750,7 @@ private:
       c.drum.present = true;
       c.drum.radius = radius_of(s);
       c.drum.rpm = q(s, "rpm") * 60.0 / (2.0 * pi);
+      c.drum.spin_up_time = q(s, "spin_up_time");
       c.drum.gap = q(s, "gap");
       c.drum.angle = q(s, "angle");
       c.drum.pc_thickness = q(s, "pc_thickness");

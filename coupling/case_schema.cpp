@@ -104,6 +104,9 @@ std::vector<KeySpec> build_schema()
           .def("0 mm").non_negative().affects(A::both),
       quantity("sleeve.rpm", D::angular_velocity, "Rotation speed; > 0 counter-clockwise seen from +z.")
           .def("0 rpm"),
+      quantity("sleeve.spin_up_time", D::time,
+               "DEM: the sleeve starts from rest at t = 0 and reaches its speed linearly over this time (0 = at once).")
+          .def("0 s").non_negative(),
 
       section("drum", "The photoreceptor drum facing the sleeve across the development gap (give radius or diameter)."),
       quantity("drum.radius", D::length, "Outer radius of the photoconductor surface.")
@@ -112,6 +115,9 @@ std::vector<KeySpec> build_schema()
           .positive().affects(A::electric),
       quantity("drum.rpm", D::angular_velocity, "Rotation speed; > 0 counter-clockwise seen from +z.")
           .def("0 rpm"),
+      quantity("drum.spin_up_time", D::time,
+               "DEM: the drum starts from rest at t = 0 and reaches its speed linearly over this time (0 = at once).")
+          .def("0 s").non_negative(),
       quantity("drum.gap", D::length, "Development gap: sleeve surface to drum surface along the line of centres.")
           .required().affects(A::electric),
       quantity("drum.angle", D::angle, "Direction of the drum centre seen from the roller centre.")

@@ -170,6 +170,7 @@ WallSet build_wall_primitives(const Case &c)
     sleeve.center = {0.0, 0.0};
     sleeve.radius = c.sleeve->radius;
     sleeve.omega = c.sleeve->omega();
+    sleeve.spin_up_time = c.sleeve->spin_up_time;
     sleeve.particles_outside = true;
     sleeve.material = "sleeve";
     walls.cylinders.push_back(sleeve);
@@ -181,6 +182,7 @@ WallSet build_wall_primitives(const Case &c)
     drum.center = c.drum.center(c.sleeve->radius);
     drum.radius = c.drum.radius;
     drum.omega = c.drum.omega();
+    drum.spin_up_time = c.drum.spin_up_time;
     drum.particles_outside = true;
     drum.material = "drum";
     walls.cylinders.push_back(drum);

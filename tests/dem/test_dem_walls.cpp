@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 
@@ -174,4 +175,32 @@ TEST(DemWalls, WallContactRecordsCarryTheWeightOfRestingBeads)
     total += r.force_on_wall.z;
   }
   EXPECT_NEAR(sys.wall_loads()[0].force[2], total, 1e-12 * std::abs(total));
+}
+
+TEST(DemWalls, CylinderSpinsUpLinearly)
+{
+  // A sleeve with a 1 ms spin-up: surface speed ωR t/T before T, ωR after, at rest while the
+  // walls are frozen (settling).
+  WallSet ws;
+  CylinderWall sleeve;
+  sleeve.name = "sleeve";
+  sleeve.radius = 10e-3;
+  sleeve.omega = 20.0;
+  sleeve.spin_up_time = 1e-3;
+  sleeve.material = "sleeve";
+  ws.cylinders.push_back(sleeve);
+  DemWalls walls(ws);
+  WallContactGeometry g;
+  const Vector3 p{0, 10e-3 + 49e-6, 0};
+  for (const double t : {0.0, 0.25e-3, 0.5e-3, 1e-3, 3e-3})
+  {
+    walls.prepare(t, false);
+    ASSERT_TRUE(walls.contact(0, p, 50e-6, g));
+    const double expected = -20.0 * 10e-3 * std::min(t / 1e-3, 1.0);
+    EXPECT_NEAR(g.surface_velocity.x, expected, 1e-15) << "t = " << t;
+    EXPECT_NEAR(g.angular_velocity.z, 20.0 * std::min(t / 1e-3, 1.0), 1e-12) << "t = " << t;
+  }
+  walls.prepare(0.5e-3, true);
+  ASSERT_TRUE(walls.contact(0, p, 50e-6, g));
+  EXPECT_EQ(g.surface_velocity.x, 0.0);
 }

@@ -107,3 +107,16 @@ TEST(Walls, PolygonHelpers)
   EXPECT_TRUE(polygons_overlap(square, {{0.2, 0.2}, {0.4, 0.2}, {0.4, 0.4}})); // nested
   EXPECT_FALSE(polygons_overlap(square, {{2, 2}, {3, 2}, {3, 3}}));
 }
+
+TEST(Walls, SpinUpTimesReachTheCylinders)
+{
+  // The case's sleeve.spin_up_time / drum.spin_up_time become the cylinders' linear ramps
+  // (the DEM test DemWalls.CylinderSpinsUpLinearly checks the ramp itself).
+  Case c = kawamoto_nip();
+  c.sleeve->spin_up_time = 1e-3;
+  c.drum.spin_up_time = 2e-3;
+  const WallSet w = build_wall_primitives(c);
+  EXPECT_EQ(w.cylinder("sleeve")->spin_up_time, 1e-3);
+  EXPECT_EQ(w.cylinder("drum")->spin_up_time, 2e-3);
+  EXPECT_EQ(build_wall_primitives(kawamoto_nip()).cylinder("sleeve")->spin_up_time, 0.0);
+}

@@ -17,6 +17,8 @@
 // Default CASE: tests/nip/kawamoto_nip_reduced.yaml (0.3 mm slab, about 1 min per run with
 // the papers' magnetics). The full default scene: --case cases/kawamoto_nip.yaml (see
 // docs/nip.md for its measured times). Runs in build/bench_nip_runs/ (kept for inspection).
+#include "csv_columns.h"
+
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -35,32 +37,9 @@ namespace {
 
 const std::string source_dir = MAGBRUSH_SOURCE_DIR;
 
-using Table = std::map<std::string, std::vector<std::string>>;
+using Table = magbrush::testing::CsvColumns;
 
-Table read_csv(const fs::path &path)
-{
-  std::ifstream in(path);
-  std::string line;
-  std::vector<std::string> header;
-  Table cols;
-  while (std::getline(in, line))
-  {
-    if (line.empty() || line[0] == '#')
-      continue;
-    std::vector<std::string> cells;
-    std::stringstream s(line);
-    for (std::string c; std::getline(s, c, ',');)
-      cells.push_back(c);
-    if (header.empty())
-    {
-      header = cells;
-      continue;
-    }
-    for (std::size_t k = 0; k < header.size() && k < cells.size(); ++k)
-      cols[header[k]].push_back(cells[k]);
-  }
-  return cols;
-}
+Table read_csv(const fs::path &path) { return magbrush::testing::read_csv_columns(path); }
 
 double num(const std::string &s) { return std::atof(s.c_str()); }
 

@@ -12,6 +12,8 @@
 //  * the report is written (index.html with the plots).
 //
 // Cost: about 1 min on 2 cores in Release (the DEM: 1.8 ms of simulated time, 45,000 steps).
+#include "csv_columns.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -35,27 +37,7 @@ const std::string binary_dir = MAGBRUSH_BINARY_DIR;
 // Columns of a magbrush CSV by header name ('#' lines skipped).
 std::map<std::string, std::vector<std::string>> read_csv(const fs::path &path)
 {
-  std::ifstream in(path);
-  std::string line;
-  std::vector<std::string> header;
-  std::map<std::string, std::vector<std::string>> cols;
-  while (std::getline(in, line))
-  {
-    if (line.empty() || line[0] == '#')
-      continue;
-    std::vector<std::string> cells;
-    std::stringstream s(line);
-    for (std::string c; std::getline(s, c, ',');)
-      cells.push_back(c);
-    if (header.empty())
-    {
-      header = cells;
-      continue;
-    }
-    for (std::size_t k = 0; k < header.size() && k < cells.size(); ++k)
-      cols[header[k]].push_back(cells[k]);
-  }
-  return cols;
+  return magbrush::testing::read_csv_columns(path);
 }
 
 std::map<std::string, double> read_summary(const fs::path &path)

@@ -570,30 +570,7 @@ void CellMultipoleField::build_near_pairs(const double *const coord[3])
           }
         }
   };
-  const std::size_t n = n_;
-  std::vector<std::size_t> begin(n + 1, 0);
-#pragma omp parallel for schedule(dynamic, 64) if (n >= parallel_threshold)
-  for (long i = 0; i < static_cast<long>(n); ++i)
-  {
-    std::size_t count = 0;
-    for_each_neighbour(i, [&](std::uint32_t, const double *) { ++count; });
-    begin[i + 1] = count;
-  }
-  for (std::size_t i = 0; i < n; ++i)
-    begin[i + 1] += begin[i];
-  near_pairs_.resize(begin[n]);
-#pragma omp parallel for schedule(dynamic, 64) if (n >= parallel_threshold)
-  for (long i = 0; i < static_cast<long>(n); ++i)
-  {
-    std::size_t k = begin[i];
-    for_each_neighbour(i, [&](std::uint32_t j, const double *shift) {
-      auto &p = near_pairs_[k++];
-      p.i = static_cast<std::uint32_t>(i);
-      p.j = j;
-      for (int d = 0; d < 3; ++d) // raw-coordinate shift: r = x_j − x_i + S
-        p.shift[d] = shift[d] + (xw_[3 * j + d] - coord[d][j]) - (xw_[3 * i + d] - coord[d][i]);
-    });
-  }
+  MagneticNeighbourList::collect_pairs(n_, for_each_neighbour, xw_.data(), coord, parallel_threshold, near_pairs_);
 }
 
 std::size_t CellMultipoleField::interactions() const

@@ -170,30 +170,7 @@ void MagneticNeighbourList::build(std::size_t n, const double *x, const double *
         }
   };
 
-  // Pass 1: count; pass 2: fill at the prefix offsets. Both parallel over beads.
-  std::vector<std::size_t> begin(n + 1, 0);
-#pragma omp parallel for schedule(dynamic, 64) if (n >= 512)
-  for (long i = 0; i < static_cast<long>(n); ++i)
-  {
-    std::size_t count = 0;
-    for_each_neighbour(i, [&](std::uint32_t, const double *) { ++count; });
-    begin[i + 1] = count;
-  }
-  for (std::size_t i = 0; i < n; ++i)
-    begin[i + 1] += begin[i];
-  pairs_.resize(begin[n]);
-#pragma omp parallel for schedule(dynamic, 64) if (n >= 512)
-  for (long i = 0; i < static_cast<long>(n); ++i)
-  {
-    std::size_t k = begin[i];
-    for_each_neighbour(i, [&](std::uint32_t j, const double *shift) {
-      Pair &p = pairs_[k++];
-      p.i = static_cast<std::uint32_t>(i);
-      p.j = j;
-      for (int d = 0; d < 3; ++d) // raw-coordinate shift: r = x_j − x_i + S
-        p.shift[d] = shift[d] + (xw[3 * j + d] - coord[d][j]) - (xw[3 * i + d] - coord[d][i]);
-    });
-  }
+  collect_pairs(n, for_each_neighbour, xw.data(), coord, 512, pairs_);
 
   build_incidence(n, coord);
 }

@@ -42,6 +42,41 @@ public:
   void set_pairs(std::size_t n, const double *x, const double *y, const double *z,
                  const std::array<double, 3> &box, double list_radius, std::vector<Pair> pairs);
 
+  // Fills `pairs` in bead order from a neighbour enumerator in two parallel passes (count,
+  // then fill at the prefix offsets): the same pairs in the same order on any number of
+  // threads. for_each_neighbour(i, emit) calls emit(j, shift) for each partner j of bead i,
+  // `shift` (3 doubles) referring to the wrapped coordinates xw (x, y, z interleaved); the
+  // stored shift refers to the raw coordinates coord[d][·]: r = x_j − x_i + shift.
+  template <typename ForEachNeighbour>
+  static void collect_pairs(std::size_t n, ForEachNeighbour &&for_each_neighbour, const double *xw,
+                            const double *const coord[3], std::size_t parallel_threshold,
+                            std::vector<Pair> &pairs)
+  {
+    std::vector<std::size_t> begin(n + 1, 0);
+#pragma omp parallel for schedule(dynamic, 64) if (n >= parallel_threshold)
+    for (long i = 0; i < static_cast<long>(n); ++i)
+    {
+      std::size_t count = 0;
+      for_each_neighbour(i, [&](std::uint32_t, const double *) { ++count; });
+      begin[i + 1] = count;
+    }
+    for (std::size_t i = 0; i < n; ++i)
+      begin[i + 1] += begin[i];
+    pairs.resize(begin[n]);
+#pragma omp parallel for schedule(dynamic, 64) if (n >= parallel_threshold)
+    for (long i = 0; i < static_cast<long>(n); ++i)
+    {
+      std::size_t k = begin[i];
+      for_each_neighbour(i, [&](std::uint32_t j, const double *shift) {
+        Pair &p = pairs[k++];
+        p.i = static_cast<std::uint32_t>(i);
+        p.j = j;
+        for (int d = 0; d < 3; ++d)
+          p.shift[d] = shift[d] + (xw[3 * j + d] - coord[d][j]) - (xw[3 * i + d] - coord[d][i]);
+      });
+    }
+  }
+
   // Largest displacement of any bead since the last build (no minimum image: a wrap counts
   // as a large move).
   double max_displacement(std::size_t n, const double *x, const double *y,

@@ -56,7 +56,7 @@ bool DemSystem::team_has_state_alarm() const
   for (int t = 0; t < omp_get_num_threads(); ++t)
   {
     const StepFlags &f = thread_flags_[static_cast<std::size_t>(t)];
-    if (f.wall_alarm >= 0 || f.wall_crowded >= 0 || f.not_finite)
+    if (f.wall_overlap.particle >= 0 || f.wall_crowded.particle >= 0 || f.not_finite.particle >= 0)
       return true;
   }
   return false;
@@ -76,9 +76,12 @@ DemSystem::StepFlags DemSystem::team_alarms() const
   for (const StepFlags &f : thread_flags_)
   {
     all.overlap_alarm |= f.overlap_alarm;
-    all.wall_alarm = std::max(all.wall_alarm, f.wall_alarm);
-    all.wall_crowded = std::max(all.wall_crowded, f.wall_crowded);
-    all.not_finite |= f.not_finite;
+    if (f.wall_overlap.particle > all.wall_overlap.particle)
+      all.wall_overlap = f.wall_overlap;
+    if (f.wall_crowded.particle > all.wall_crowded.particle)
+      all.wall_crowded = f.wall_crowded;
+    if (f.not_finite.particle >= 0 && (all.not_finite.particle < 0 || f.not_finite.particle < all.not_finite.particle))
+      all.not_finite = f.not_finite;
   }
   return all;
 }

@@ -187,7 +187,7 @@ void DemSystem::kick_and_drift_phase(StepFlags &mine)
 // (and, in the next step, drifts them: the same static split).
 void DemSystem::final_kick_phase(StepFlags &mine)
 {
-  int not_finite = 0;
+  StepFlags::ParticleAlarm not_finite; // the first in this thread's share
   const long n = static_cast<long>(particles_.size());
   const double h = 0.5 * dt_;
   ParticleState &s = particles_;
@@ -198,35 +198,35 @@ void DemSystem::final_kick_phase(StepFlags &mine)
     const std::size_t i = static_cast<std::size_t>(k);
     half_kick(s, f, i, h);
     if (!std::isfinite(s.vx[i] + s.vy[i] + s.vz[i] + s.wx[i] + s.wy[i] + s.wz[i] + s.x[i] + s.y[i] + s.z[i]))
-      not_finite = 1;
+      if (not_finite.particle < 0)
+        not_finite.set(k, s.position(i));
   }
-  mine.not_finite |= not_finite;
+  if (mine.not_finite.particle < 0)
+    mine.not_finite = not_finite;
 }
 
 void DemSystem::raise_state_alarm(const StepFlags &flags) const
 {
-  if (!flags.not_finite)
+  if (flags.not_finite.particle < 0)
     return;
-  const ParticleState &s = particles_;
-  for (std::size_t i = 0; i < s.size(); ++i)
-    if (!std::isfinite(s.vx[i] + s.vy[i] + s.vz[i] + s.wx[i] + s.wy[i] + s.wz[i] + s.x[i] + s.y[i] + s.z[i]))
-    {
-      char msg[512];
-      std::snprintf(msg, sizeof msg,
-                    "stability guard: NaN/Inf at step %ld (t = %.6g s) in the state of %s. The time step "
-                    "(%.3g s) is probably too large for the stiffest contact or force term: reduce "
-                    "dem.time_step (or time_step_safety), or check the material stiffness and the force terms",
-                    step_, time_, describe_particle(i).c_str(), dt_);
-      throw StabilityError(msg);
-    }
+  char msg[512];
+  std::snprintf(msg, sizeof msg,
+                "stability guard: NaN/Inf at step %ld (t = %.6g s) in the state of %s. The time step "
+                "(%.3g s) is probably too large for the stiffest contact or force term: reduce "
+                "dem.time_step (or time_step_safety), or check the material stiffness and the force terms",
+                step_, time_,
+                describe_particle(static_cast<std::size_t>(flags.not_finite.particle), flags.not_finite.at).c_str(),
+                dt_);
+  throw StabilityError(msg);
 }
 
-std::string DemSystem::describe_particle(std::size_t i) const
+std::string DemSystem::describe_particle(std::size_t i) const { return describe_particle(i, particles_.position(i)); }
+
+std::string DemSystem::describe_particle(std::size_t i, const Vector3 &at) const
 {
   char buf[256];
   std::snprintf(buf, sizeof buf, "particle id %d (species %d, r = %.3g m, at (%.4g, %.4g, %.4g) m)",
-                particles_.id[i], particles_.species[i], particles_.radius[i], particles_.x[i],
-                particles_.y[i], particles_.z[i]);
+                particles_.id[i], particles_.species[i], particles_.radius[i], at.x, at.y, at.z);
   return buf;
 }
 
@@ -491,7 +491,7 @@ void DemSystem::raise_alarms(const StepFlags &flags) const
 {
   if (flags.overlap_alarm)
     check_overlaps();
-  raise_wall_alarms(flags.wall_alarm, flags.wall_crowded);
+  raise_wall_alarms(flags);
   raise_state_alarm(flags);
 }
 
@@ -624,28 +624,31 @@ void DemSystem::wall_phase(StepFlags &mine)
       wall_tz_[sl] = tq.z;
     }
   }
-  mine.wall_alarm = std::max(mine.wall_alarm, alarm);
-  mine.wall_crowded = std::max(mine.wall_crowded, too_many);
+  if (alarm > mine.wall_overlap.particle)
+    mine.wall_overlap.set(alarm, s.position(static_cast<std::size_t>(std::max(0L, alarm))));
+  if (too_many > mine.wall_crowded.particle)
+    mine.wall_crowded.set(too_many, s.position(static_cast<std::size_t>(std::max(0L, too_many))));
 }
 
-void DemSystem::raise_wall_alarms(long alarm, long too_many) const
+void DemSystem::raise_wall_alarms(const StepFlags &flags) const
 {
   const double guard = case_.dem.max_overlap_fraction;
-  if (too_many >= 0)
-    throw StabilityError("wall contacts: " + describe_particle(U(static_cast<std::int32_t>(too_many))) +
+  const auto &crowded = flags.wall_crowded, &overlap = flags.wall_overlap;
+  if (crowded.particle >= 0)
+    throw StabilityError("wall contacts: " + describe_particle(static_cast<std::size_t>(crowded.particle), crowded.at) +
                          " touches more than " + std::to_string(max_wall_contacts) +
                          " walls at once at step " + std::to_string(step_) +
                          "; the walls overlap or leave a gap smaller than a particle: check the geometry");
-  if (alarm >= 0)
+  if (overlap.particle >= 0)
   {
-    const std::size_t i = static_cast<std::size_t>(alarm);
     char msg[768];
     std::snprintf(msg, sizeof msg,
                   "stability guard: at step %ld (t = %.6g s) %s overlaps a wall by more than %.1f %% of its "
                   "radius (dem.max_overlap_fraction). The wall pushes too hard for the contact stiffness or "
                   "the time step (%.3g s) is too large: reduce dem.time_step, slow the wall, or increase the "
                   "stiffness",
-                  step_, time_, describe_particle(i).c_str(), 100.0 * guard, dt_);
+                  step_, time_, describe_particle(static_cast<std::size_t>(overlap.particle), overlap.at).c_str(),
+                  100.0 * guard, dt_);
     throw StabilityError(msg);
   }
 }

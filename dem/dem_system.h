@@ -165,11 +165,19 @@ private:
   {
     double max_drift2 = 0.0;   // largest squared displacement since the list build
     int overlap_alarm = 0;     // a particle pair overlaps beyond the guard
-    long wall_alarm = -1;      // a particle (index) overlaps a wall beyond the guard
-    long wall_crowded = -1;    // a particle (index) touches more than max_wall_contacts walls
-    int not_finite = 0;        // NaN/Inf in the state after the final kick
+    // A particle (index, −1: none) and where it was when the alarm was raised: the team
+    // notices wall and NaN alarms only at the next step's barrier, after another drift.
+    struct ParticleAlarm
+    {
+      long particle = -1;
+      Vector3 at;
+      void set(long i, const Vector3 &x) { particle = i, at = x; }
+    };
+    ParticleAlarm wall_overlap;  // overlaps a wall beyond the guard (the largest index)
+    ParticleAlarm wall_crowded;  // touches more than max_wall_contacts walls (the largest index)
+    ParticleAlarm not_finite;    // NaN/Inf in its state after the final kick (the smallest index)
     std::vector<double> row_torques; // scratch of the pair phase (kept: no allocation per step)
-    void clear_alarms() { overlap_alarm = 0, wall_alarm = -1, wall_crowded = -1, not_finite = 0; }
+    void clear_alarms() { overlap_alarm = 0, wall_overlap = {}, wall_crowded = {}, not_finite = {}; }
   };
   std::vector<StepFlags> thread_flags_; // one per thread of the team
   std::size_t team_terms_ = 0;           // leading force terms that run inside the team
@@ -202,11 +210,12 @@ private:
   StepFlags team_alarms() const;        // all threads' alarms combined (serial)
   // After the region: turn the flags into StabilityErrors with a useful message.
   void raise_alarms(const StepFlags &flags) const;
-  void raise_wall_alarms(long alarm, long too_many) const;
+  void raise_wall_alarms(const StepFlags &flags) const;
   void raise_state_alarm(const StepFlags &flags) const;
   void check_overlaps() const;
   void check_energy();
-  std::string describe_particle(std::size_t i) const;
+  std::string describe_particle(std::size_t i) const; // at its current position
+  std::string describe_particle(std::size_t i, const Vector3 &at) const;
 };
 
 } // namespace magbrush::dem

@@ -58,11 +58,8 @@ int run_dem(const std::vector<std::string> &args)
   for (auto &a : command)
     argv.push_back(const_cast<char *>(a.c_str()));
   argv.push_back(nullptr);
-  // Threads that wait at a barrier sleep instead of spinning: on a machine shared with other
-  // jobs (or with more threads than free cores) spinning slows the step tens of times, while
-  // on an idle machine passive waiting costs well under 1 % at the particle counts where the
-  // engine runs in parallel at all. A user's own OMP_WAIT_POLICY wins.
-  setenv("OMP_WAIT_POLICY", "PASSIVE", 0);
+  // How idle threads wait (a short spin, then sleep) is chosen by the engine itself
+  // (dem/openmp_waiting.h); a user's own OMP_WAIT_POLICY / GOMP_SPINCOUNT wins.
   std::cout.flush();
   const pid_t pid = fork();
   if (pid < 0)

@@ -2,6 +2,7 @@
 //
 //   magbrush-dem CASE [--set key=value ...] [--restart FILE] [--threads N] [--output DIR]
 #include "dem_run.h"
+#include "openmp_waiting.h"
 
 #include "applied_magnetic_field.h"
 #include "case_parser.h"
@@ -55,13 +56,10 @@ void add_magnetics(magbrush::dem::DemRun &run, const magbrush::Case &c)
 
 int main(int argc, char **argv)
 {
-  // OpenMP reads OMP_WAIT_POLICY before main(): if the user did not choose, restart once with
-  // passive waiting (spinning threads are tens of times slower on a shared machine).
-  if (!std::getenv("OMP_WAIT_POLICY"))
-  {
-    setenv("OMP_WAIT_POLICY", "PASSIVE", 1);
+  // The OpenMP runtime reads its wait policy once, at start-up: choose it (a spin as long
+  // as a wake-up, then sleep; openmp_waiting.h) and restart once so that it takes effect.
+  if (magbrush::dem::choose_openmp_waiting())
     execv("/proc/self/exe", argv);
-  }
   std::vector<std::string> args(argv + 1, argv + argc);
   std::string case_path;
   std::vector<std::string> overrides;

@@ -1,8 +1,10 @@
 // A whole DEM run with its outputs (see dem_run.h).
 #include "dem_run.h"
+#include "openmp_waiting.h"
 
 #include <omp.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -42,6 +44,8 @@ void DemRun::log_setup() const
   char line[512];
   log_ << "magbrush-dem: case '" << case_.name << "', " << s.particles().size() << " particles, "
        << s.walls().size() << " walls, " << omp_get_max_threads() << " OpenMP threads\n";
+  if (omp_get_max_threads() > 1)
+    log_ << "  idle threads: " << openmp_waiting_description() << "\n";
   for (std::size_t w = 0; w < s.walls().size(); ++w)
     log_ << "  wall " << w << ": " << s.walls().name(w) << " (material " << s.walls().material(w) << ")\n";
   const auto &b = s.box().length;
@@ -163,7 +167,19 @@ void DemRun::run()
   {
     while (s.step_count() < end_step)
     {
-      s.step();
+      // Run in one go up to the next step where something is recorded (the team of threads
+      // stays together in between), at most 1000 steps so that the progress line stays live.
+      long next = std::min(end_step, s.step_count() + 1000);
+      auto upto_multiple = [&next, &s](long every) {
+        if (every > 0)
+          next = std::min(next, (s.step_count() / every + 1) * every);
+      };
+      upto_multiple(series_every);
+      upto_multiple(out_every);
+      upto_multiple(ckpt_every);
+      for (long every : sample_every)
+        upto_multiple(every);
+      s.advance(next - s.step_count());
       const long k = s.step_count();
       if (k % series_every == 0)
         series.record(s);

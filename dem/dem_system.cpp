@@ -3,6 +3,7 @@
 
 #include "contact_law.h"
 #include "insertion.h"
+#include "phase_clock.h"
 
 #include <omp.h>
 
@@ -17,40 +18,7 @@ namespace magbrush::dem {
 
 namespace {
 std::size_t U(std::int32_t v) { return static_cast<std::size_t>(v); }
-
-// Scoped wall-clock accumulation into one PhaseTimes slot.
-class PhaseTimer
-{
-public:
-  explicit PhaseTimer(double &slot) : slot_(slot), start_(omp_get_wtime()) {}
-  ~PhaseTimer() { slot_ += omp_get_wtime() - start_; }
-
-private:
-  double &slot_;
-  double start_;
-};
 } // namespace
-
-// Inside a parallel region: the master thread charges the wall time since its last mark to a
-// phase (the phases after the pair kernel have no barrier between them, so this is the
-// master's own share, which equals the others' on balanced static loops).
-class PhaseClock
-{
-public:
-  PhaseClock() : master_(omp_get_thread_num() == 0), last_(master_ ? omp_get_wtime() : 0.0) {}
-  void charge(double &slot)
-  {
-    if (!master_)
-      return;
-    const double now = omp_get_wtime();
-    slot += now - last_;
-    last_ = now;
-  }
-
-private:
-  bool master_;
-  double last_;
-};
 
 DemSystem::DemSystem(const Case &c) : DemSystem(c, build_wall_primitives(c)) {}
 
@@ -131,13 +99,16 @@ void DemSystem::initialize()
   rebuild_neighbor_list();
   // Forces at t = 0, so that the first half kick uses them.
   walls_.prepare(time_, walls_frozen_);
-  StepFlags flags;
+  thread_flags_.assign(static_cast<std::size_t>(std::max(1, omp_get_max_threads())), StepFlags{});
 #pragma omp parallel if (parallel())
   {
-    PhaseClock clock;
-    contact_phases(flags, clock, false);
+    StepFlags &mine = my_flags();
+    pair_and_row_phase(mine);
+    column_phase();
+    if (walls_.size() > 0)
+      wall_phase(mine);
   }
-  raise_contact_alarms(flags);
+  raise_alarms(team_alarms());
   for (std::size_t t = 0; t < terms_.size(); ++t)
     terms_[t]->add_forces(particles_, forces_, time_);
   initialized_ = true;
@@ -170,7 +141,6 @@ void DemSystem::rebuild_neighbor_list()
   x0_ = particles_.x;
   y0_ = particles_.y;
   z0_ = particles_.z;
-  max_drift2_ = 0.0;
   force_rebuild_ = false;
   ++rebuilds_;
 }
@@ -188,15 +158,16 @@ static inline void half_kick(ParticleState &s, const ForceBuffers &f, std::size_
 }
 
 // First half of velocity Verlet: v(t + dt/2) = v(t) + (dt/2) F(t)/m, x(t + dt) = x + dt v(t + dt/2).
-// Also the largest squared displacement since the last list build, reduced over the threads:
-// after the loop's barrier every thread sees the same value.
-void DemSystem::kick_and_drift_phase(double &max_drift2)
+// Also this thread's largest squared displacement since the last list build; after the
+// barrier every thread reads every thread's (max_drift2_of_team).
+void DemSystem::kick_and_drift_phase(StepFlags &mine)
 {
+  double max_drift2 = 0.0;
   const long n = static_cast<long>(particles_.size());
   const double h = 0.5 * dt_, dt = dt_;
   ParticleState &s = particles_;
   const ForceBuffers &f = forces_;
-#pragma omp for schedule(static) reduction(max : max_drift2)
+#pragma omp for schedule(static) nowait
   for (long k = 0; k < n; ++k)
   {
     const std::size_t i = static_cast<std::size_t>(k);
@@ -207,50 +178,55 @@ void DemSystem::kick_and_drift_phase(double &max_drift2)
     const double dx = s.x[i] - x0_[i], dy = s.y[i] - y0_[i], dz = s.z[i] - z0_[i];
     max_drift2 = std::max(max_drift2, dx * dx + dy * dy + dz * dz);
   }
+  mine.max_drift2 = max_drift2;
+#pragma omp barrier
 }
 
 // Second half: v(t + dt) = v(t + dt/2) + (dt/2) F(t + dt)/m; flags a non-finite state.
-// Static schedule, no barrier: a thread kicks exactly the particles whose forces it summed.
-void DemSystem::final_kick_phase(int &not_finite)
+// Static schedule, no barrier: a thread kicks exactly the particles whose forces it summed
+// (and, in the next step, drifts them: the same static split).
+void DemSystem::final_kick_phase(StepFlags &mine)
 {
+  StepFlags::ParticleAlarm not_finite; // the first in this thread's share
   const long n = static_cast<long>(particles_.size());
   const double h = 0.5 * dt_;
   ParticleState &s = particles_;
   const ForceBuffers &f = forces_;
-#pragma omp for schedule(static) reduction(| : not_finite) nowait
+#pragma omp for schedule(static) nowait
   for (long k = 0; k < n; ++k)
   {
     const std::size_t i = static_cast<std::size_t>(k);
     half_kick(s, f, i, h);
     if (!std::isfinite(s.vx[i] + s.vy[i] + s.vz[i] + s.wx[i] + s.wy[i] + s.wz[i] + s.x[i] + s.y[i] + s.z[i]))
-      not_finite = 1;
+      if (not_finite.particle < 0)
+        not_finite.set(k, s.position(i));
   }
+  if (mine.not_finite.particle < 0)
+    mine.not_finite = not_finite;
 }
 
 void DemSystem::raise_state_alarm(const StepFlags &flags) const
 {
-  if (!flags.not_finite)
+  if (flags.not_finite.particle < 0)
     return;
-  const ParticleState &s = particles_;
-  for (std::size_t i = 0; i < s.size(); ++i)
-    if (!std::isfinite(s.vx[i] + s.vy[i] + s.vz[i] + s.wx[i] + s.wy[i] + s.wz[i] + s.x[i] + s.y[i] + s.z[i]))
-    {
-      char msg[512];
-      std::snprintf(msg, sizeof msg,
-                    "stability guard: NaN/Inf at step %ld (t = %.6g s) in the state of %s. The time step "
-                    "(%.3g s) is probably too large for the stiffest contact or force term: reduce "
-                    "dem.time_step (or time_step_safety), or check the material stiffness and the force terms",
-                    step_, time_, describe_particle(i).c_str(), dt_);
-      throw StabilityError(msg);
-    }
+  char msg[512];
+  std::snprintf(msg, sizeof msg,
+                "stability guard: NaN/Inf at step %ld (t = %.6g s) in the state of %s. The time step "
+                "(%.3g s) is probably too large for the stiffest contact or force term: reduce "
+                "dem.time_step (or time_step_safety), or check the material stiffness and the force terms",
+                step_, time_,
+                describe_particle(static_cast<std::size_t>(flags.not_finite.particle), flags.not_finite.at).c_str(),
+                dt_);
+  throw StabilityError(msg);
 }
 
-std::string DemSystem::describe_particle(std::size_t i) const
+std::string DemSystem::describe_particle(std::size_t i) const { return describe_particle(i, particles_.position(i)); }
+
+std::string DemSystem::describe_particle(std::size_t i, const Vector3 &at) const
 {
   char buf[256];
   std::snprintf(buf, sizeof buf, "particle id %d (species %d, r = %.3g m, at (%.4g, %.4g, %.4g) m)",
-                particles_.id[i], particles_.species[i], particles_.radius[i], particles_.x[i],
-                particles_.y[i], particles_.z[i]);
+                particles_.id[i], particles_.species[i], particles_.radius[i], at.x, at.y, at.z);
   return buf;
 }
 
@@ -405,10 +381,11 @@ int particle_pair_kernel(const PairKernelData &D, const RowTorques &T, std::int6
 }
 } // namespace
 
-// Phase 1 (all threads, work-shared; ends with the loop's barrier): pairs and rows, block by
-// block. Sets overlap_alarm when some pair overlaps beyond the guard.
-void DemSystem::pair_and_row_phase(int &overlap_alarm)
+// Phase 1 (all threads, work-shared; ends with a barrier): pairs and rows, block by block.
+// Sets this thread's overlap alarm when one of its pairs overlaps beyond the guard.
+void DemSystem::pair_and_row_phase(StepFlags &mine)
 {
+  int overlap_alarm = 0;
   const ParticleState &s = particles_;
   const NeighborList &L = list_;
   const long n = static_cast<long>(s.size());
@@ -436,8 +413,8 @@ void DemSystem::pair_and_row_phase(int &overlap_alarm)
   const std::int32_t *row_start = L.row_start.data();
   ForceBuffers &f = forces_;
   const long blocks = (n + contact_block_rows - 1) / contact_block_rows;
-  std::vector<double> row_torques; // this thread's: the torques on i of one block's pairs
-#pragma omp for schedule(dynamic, 2) reduction(| : overlap_alarm)
+  std::vector<double> &row_torques = mine.row_torques; // the torques on i of one block's pairs
+#pragma omp for schedule(dynamic, 2) nowait
   for (long b = 0; b < blocks; ++b)
   {
     const long i0 = b * contact_block_rows, i1 = std::min(n, i0 + contact_block_rows);
@@ -469,6 +446,8 @@ void DemSystem::pair_and_row_phase(int &overlap_alarm)
       contact_count_[iu] = count;
     }
   }
+  mine.overlap_alarm |= overlap_alarm;
+#pragma omp barrier
 }
 
 // Phase 2 (after phase 1's barrier; static schedule, no barrier): each particle adds the
@@ -506,32 +485,14 @@ void DemSystem::column_phase()
   }
 }
 
-// Everything from the pair kernel to the wall contacts (and the final kick when no force term
-// runs in between), inside the caller's parallel region. The loops after the pair phase share
-// one static schedule without barriers: each thread carries its particles through all of them.
-void DemSystem::contact_phases(StepFlags &flags, PhaseClock &clock, bool with_final_kick)
-{
-  pair_and_row_phase(flags.overlap_alarm);
-  clock.charge(times_.particle_contacts);
-  column_phase();
-  clock.charge(times_.particle_contacts);
-  if (walls_.size() > 0)
-  {
-    wall_phase(flags.wall_alarm, flags.wall_crowded);
-    clock.charge(times_.wall_contacts);
-  }
-  if (with_final_kick)
-  {
-    final_kick_phase(flags.not_finite);
-    clock.charge(times_.integrate);
-  }
-}
-
-void DemSystem::raise_contact_alarms(const StepFlags &flags) const
+// Overlap first (the worst pair is searched in the state where it happened), then the walls,
+// then the state.
+void DemSystem::raise_alarms(const StepFlags &flags) const
 {
   if (flags.overlap_alarm)
     check_overlaps();
-  raise_wall_alarms(flags.wall_alarm, flags.wall_crowded);
+  raise_wall_alarms(flags);
+  raise_state_alarm(flags);
 }
 
 void DemSystem::check_overlaps() const
@@ -568,8 +529,9 @@ void DemSystem::check_overlaps() const
 // Wall contacts of every particle (static schedule, no barrier; walls_.prepare() has run).
 // Records the largest index of a particle that overlaps a wall beyond the guard (alarm) or
 // touches too many walls (crowded); raise_wall_alarms() turns them into errors.
-void DemSystem::wall_phase(long &alarm, long &too_many)
+void DemSystem::wall_phase(StepFlags &mine)
 {
+  long alarm = -1, too_many = -1;
   ParticleState &s = particles_;
   ForceBuffers &f = forces_;
   const long n = static_cast<long>(s.size());
@@ -578,7 +540,7 @@ void DemSystem::wall_phase(long &alarm, long &too_many)
   // This thread's scratch (constructed once, not per particle).
   WallContactGeometry g[max_wall_contacts + 1];
   int which[max_wall_contacts + 1];
-#pragma omp for schedule(static) reduction(max : alarm, too_many) nowait
+#pragma omp for schedule(static) nowait
   for (long k = 0; k < n; ++k)
   {
     const std::size_t i = static_cast<std::size_t>(k);
@@ -662,26 +624,31 @@ void DemSystem::wall_phase(long &alarm, long &too_many)
       wall_tz_[sl] = tq.z;
     }
   }
+  if (alarm > mine.wall_overlap.particle)
+    mine.wall_overlap.set(alarm, s.position(static_cast<std::size_t>(std::max(0L, alarm))));
+  if (too_many > mine.wall_crowded.particle)
+    mine.wall_crowded.set(too_many, s.position(static_cast<std::size_t>(std::max(0L, too_many))));
 }
 
-void DemSystem::raise_wall_alarms(long alarm, long too_many) const
+void DemSystem::raise_wall_alarms(const StepFlags &flags) const
 {
   const double guard = case_.dem.max_overlap_fraction;
-  if (too_many >= 0)
-    throw StabilityError("wall contacts: " + describe_particle(U(static_cast<std::int32_t>(too_many))) +
+  const auto &crowded = flags.wall_crowded, &overlap = flags.wall_overlap;
+  if (crowded.particle >= 0)
+    throw StabilityError("wall contacts: " + describe_particle(static_cast<std::size_t>(crowded.particle), crowded.at) +
                          " touches more than " + std::to_string(max_wall_contacts) +
                          " walls at once at step " + std::to_string(step_) +
                          "; the walls overlap or leave a gap smaller than a particle: check the geometry");
-  if (alarm >= 0)
+  if (overlap.particle >= 0)
   {
-    const std::size_t i = static_cast<std::size_t>(alarm);
     char msg[768];
     std::snprintf(msg, sizeof msg,
                   "stability guard: at step %ld (t = %.6g s) %s overlaps a wall by more than %.1f %% of its "
                   "radius (dem.max_overlap_fraction). The wall pushes too hard for the contact stiffness or "
                   "the time step (%.3g s) is too large: reduce dem.time_step, slow the wall, or increase the "
                   "stiffness",
-                  step_, time_, describe_particle(i).c_str(), 100.0 * guard, dt_);
+                  step_, time_, describe_particle(static_cast<std::size_t>(overlap.particle), overlap.at).c_str(),
+                  100.0 * guard, dt_);
     throw StabilityError(msg);
   }
 }
@@ -719,77 +686,6 @@ void DemSystem::check_energy()
     throw StabilityError(msg);
   }
   guard_energy_ = ke;
-}
-
-// One velocity-Verlet step. The particle work runs in ONE parallel region (two when the
-// neighbour list must be rebuilt, two more when force terms must run before the final kick):
-// a fork and a join per region cost tens of microseconds when idle threads sleep, which is a
-// real share of a step of a few thousand particles.
-void DemSystem::step()
-{
-  if (!initialized_)
-    throw std::logic_error("DemSystem::step() before initialize()");
-  ++step_;
-  time_ = static_cast<double>(step_) * dt_;
-  walls_.prepare(time_, walls_frozen_);
-  // Without force terms, the final kick follows the contacts in the same region.
-  const bool kick_with_contacts = terms_.empty();
-  StepFlags flags;
-#pragma omp parallel if (parallel())
-  {
-    PhaseClock clock;
-    kick_and_drift_phase(flags.max_drift2); // ends with a barrier: all threads see the same max
-    clock.charge(times_.integrate);
-    if (!list_is_stale(flags.max_drift2))
-      contact_phases(flags, clock, kick_with_contacts);
-  }
-  max_drift2_ = flags.max_drift2;
-  if (list_is_stale(flags.max_drift2))
-  {
-    rebuild_neighbor_list();
-#pragma omp parallel if (parallel())
-    {
-      PhaseClock clock;
-      contact_phases(flags, clock, kick_with_contacts);
-    }
-  }
-  raise_contact_alarms(flags);
-  if (!kick_with_contacts)
-  {
-    for (std::size_t t = 0; t < terms_.size(); ++t)
-    {
-      PhaseTimer timer(times_.terms[t]);
-      terms_[t]->add_forces(particles_, forces_, time_);
-    }
-#pragma omp parallel if (parallel())
-    {
-      PhaseClock clock;
-      final_kick_phase(flags.not_finite);
-      clock.charge(times_.integrate);
-    }
-  }
-  raise_state_alarm(flags);
-  if (step_ % 100 == 0)
-    check_energy();
-}
-
-void DemSystem::settle(double duration)
-{
-  if (duration <= 0.0)
-    return;
-  // The settling phase happens before t = 0: the clock runs from −duration up to 0, so that
-  // everything prescribed in time (the field ramp, wall paths) starts once the particles are at
-  // rest, as in Kawamoto's procedure (fall, come to rest, then apply the field gradually).
-  walls_frozen_ = true;
-  const long steps = static_cast<long>(std::ceil(duration / dt_));
-  step_ = -steps;
-  time_ = static_cast<double>(step_) * dt_;
-  for (long k = 0; k < steps; ++k)
-    step();
-  walls_frozen_ = false;
-  step_ = 0;
-  time_ = 0.0;
-  guard_energy_ = -1.0;
 }
 
 double DemSystem::kinetic_energy() const

@@ -3,6 +3,7 @@
 //
 //   step():  half kick → drift → (rebuild the neighbour list if stale) →
 //            forces: particle contacts, wall contacts, every ForceTerm → half kick → guards
+//   advance(n): n steps, as many of them as possible in ONE OpenMP team (dem_advance.cpp)
 //
 // Everything here is deterministic: the same input gives the same bits on any number of
 // OpenMP threads, and a restart from a checkpoint continues bit-identically.
@@ -25,8 +26,6 @@
 #include <vector>
 
 namespace magbrush::dem {
-
-class PhaseClock; // dem_system.cpp: per-phase timing inside a parallel region
 
 // Thrown by the stability guards: the message names step, particle, cause and likely fix.
 class StabilityError : public std::runtime_error
@@ -80,7 +79,13 @@ public:
   void add_force_term(std::unique_ptr<ForceTerm> term);
   const std::vector<std::unique_ptr<ForceTerm>> &force_terms() const { return terms_; }
 
+  // One velocity-Verlet step; the same as advance(1).
   void step();
+  // `steps` steps, bit-identical to calling step() `steps` times. The threads stay in one
+  // parallel region for as long as the steps need no serial work (a list rebuild, the force
+  // terms, the energy guard every 100 steps): a fork/join or barrier costs tens of µs when
+  // idle threads sleep, a real share of a step of a few thousand particles.
+  void advance(long steps);
   // Rebuild (and re-sort) the neighbour list at the next step even if no particle moved far.
   void request_neighbor_rebuild() { force_rebuild_ = true; }
   // Runs with the walls at rest for `duration` on a clock from −duration to t = 0 (a field
@@ -148,20 +153,37 @@ private:
   double dt_ = 0.0, time_ = 0.0, skin_ = 0.0;
   long step_ = 0, rebuilds_ = 0;
   bool walls_frozen_ = false, force_rebuild_ = true, initialized_ = false;
-  double max_drift2_ = 0.0;          // largest squared displacement since the last build
   double guard_energy_ = -1.0;       // KE at the last guard check
   double energy_floor_ = 0.0;
   PhaseTimes times_;
 
-  // What the phases of one step report, reduced over the threads; checked after the region.
-  struct StepFlags
+  // What the phases of a step report: one record per thread, written only by its thread and
+  // read by all after a barrier (no reduction clause, so no extra barrier). The alarms are
+  // sticky for the whole advance() call (it stops at the first one); max_drift2 is this
+  // step's. Padded to a cache line: neighbouring threads' records do not share one.
+  struct alignas(64) StepFlags
   {
     double max_drift2 = 0.0;   // largest squared displacement since the list build
     int overlap_alarm = 0;     // a particle pair overlaps beyond the guard
-    long wall_alarm = -1;      // a particle (index) overlaps a wall beyond the guard
-    long wall_crowded = -1;    // a particle (index) touches more than max_wall_contacts walls
-    int not_finite = 0;        // NaN/Inf in the state after the final kick
+    // A particle (index, −1: none) and where it was when the alarm was raised: the team
+    // notices wall and NaN alarms only at the next step's barrier, after another drift.
+    struct ParticleAlarm
+    {
+      long particle = -1;
+      Vector3 at;
+      void set(long i, const Vector3 &x) { particle = i, at = x; }
+    };
+    ParticleAlarm wall_overlap;  // overlaps a wall beyond the guard (the largest index)
+    ParticleAlarm wall_crowded;  // touches more than max_wall_contacts walls (the largest index)
+    ParticleAlarm not_finite;    // NaN/Inf in its state after the final kick (the smallest index)
+    std::vector<double> row_torques; // scratch of the pair phase (kept: no allocation per step)
+    void clear_alarms() { overlap_alarm = 0, wall_overlap = {}, wall_crowded = {}, not_finite = {}; }
   };
+  std::vector<StepFlags> thread_flags_; // one per thread of the team
+  std::size_t team_terms_ = 0;           // leading force terms that run inside the team
+  // Where a team (re)starts within a step, and why it stopped.
+  enum class Resume { step_start, contacts, final_kick };
+  enum class Pause { done, rebuild, force_terms, energy_guard, alarm };
 
   void setup_derived();
   void rebuild_neighbor_list();
@@ -170,19 +192,30 @@ private:
   bool list_is_stale(double max_drift2) const { return force_rebuild_ || max_drift2 > 0.25 * skin_ * skin_; }
   // The phases of a step. Each is called by every thread of an enclosing parallel region
   // (work-shared loops inside); see step() for their order and barriers.
-  void kick_and_drift_phase(double &max_drift2);
-  void pair_and_row_phase(int &overlap_alarm);
+  // The phases of a step. Each is called by every thread of an enclosing parallel region
+  // (work-shared loops inside, reporting into the calling thread's StepFlags); see
+  // dem_advance.cpp for their order and barriers.
+  void kick_and_drift_phase(StepFlags &mine);
+  void pair_and_row_phase(StepFlags &mine);
   void column_phase();
-  void wall_phase(long &alarm, long &too_many);
-  void final_kick_phase(int &not_finite);
-  void contact_phases(StepFlags &flags, PhaseClock &clock, bool with_final_kick);
+  void wall_phase(StepFlags &mine);
+  void final_kick_phase(StepFlags &mine);
+  void begin_step(); // the clock and the walls' pose at the new time (one thread)
+  // advance(): the team's loop over steps, from `from` until it needs serial work.
+  Pause run_team(long &steps_left, Resume from);
+  StepFlags &my_flags();
+  double max_drift2_of_team() const;   // after the drift's barrier
+  bool team_has_state_alarm() const;   // the last step's wall / NaN alarms, after a barrier
+  bool team_has_overlap_alarm() const; // this step's pair alarm, after the pair barrier
+  StepFlags team_alarms() const;        // all threads' alarms combined (serial)
   // After the region: turn the flags into StabilityErrors with a useful message.
-  void raise_contact_alarms(const StepFlags &flags) const;
-  void raise_wall_alarms(long alarm, long too_many) const;
+  void raise_alarms(const StepFlags &flags) const;
+  void raise_wall_alarms(const StepFlags &flags) const;
   void raise_state_alarm(const StepFlags &flags) const;
   void check_overlaps() const;
   void check_energy();
-  std::string describe_particle(std::size_t i) const;
+  std::string describe_particle(std::size_t i) const; // at its current position
+  std::string describe_particle(std::size_t i, const Vector3 &at) const;
 };
 
 } // namespace magbrush::dem

@@ -21,6 +21,15 @@ public:
   virtual ~ForceTerm() = default;
   virtual const char *name() const = 0;
   virtual void add_forces(const ParticleState &state, ForceBuffers &forces, double t) = 0;
+  // Optional, for terms that are a plain loop over the particles (gravity, drag): they may
+  // run inside the engine's OpenMP team instead of in a parallel region of their own, which
+  // saves a fork and a join per step (~45 µs with sleeping idle threads, measured). Such a
+  // term returns true from runs_in_team() and implements add_forces_in_team(), which EVERY
+  // thread of the team calls; it shares its loop with `#pragma omp for schedule(static)
+  // nowait` over the particle index (the split of the engine's per-particle phases, so no
+  // barrier is needed) and gives the same bits as add_forces().
+  virtual bool runs_in_team() const { return false; }
+  virtual void add_forces_in_team(const ParticleState & /*state*/, ForceBuffers & /*forces*/, double /*t*/) {}
   // Particle arrays were re-sorted (new[k] = old[order[k]]): terms that cache per-particle
   // data (e.g. dipole moments) reorder it here.
   virtual void particles_reordered(const std::vector<std::int32_t> & /*order*/) {}
@@ -32,7 +41,9 @@ class Gravity : public ForceTerm
 public:
   explicit Gravity(const std::array<double, 3> &g) : g_(g) {}
   const char *name() const override { return "gravity"; }
-  void add_forces(const ParticleState &s, ForceBuffers &f, double) override;
+  void add_forces(const ParticleState &s, ForceBuffers &f, double t) override;
+  bool runs_in_team() const override { return true; }
+  void add_forces_in_team(const ParticleState &s, ForceBuffers &f, double t) override;
 
 private:
   std::array<double, 3> g_;
@@ -44,7 +55,9 @@ class StokesDrag : public ForceTerm
 public:
   explicit StokesDrag(double viscosity) : eta_(viscosity) {}
   const char *name() const override { return "Stokes drag"; }
-  void add_forces(const ParticleState &s, ForceBuffers &f, double) override;
+  void add_forces(const ParticleState &s, ForceBuffers &f, double t) override;
+  bool runs_in_team() const override { return true; }
+  void add_forces_in_team(const ParticleState &s, ForceBuffers &f, double t) override;
 
 private:
   double eta_;

@@ -16,6 +16,7 @@
 // every configuration runs `repeats` times (1 and 2 threads back to back, so that the
 // speed-up compares runs under the same load) and a summary gives medians and ranges.
 #include "dem_system.h"
+#include "openmp_waiting.h"
 #include "snapshot_writer.h"
 
 #include <omp.h>
@@ -121,8 +122,7 @@ Result run(int per_side, int threads, int steps)
         p.vz.back() = 0.05 * u(rng);
       }
   sys.initialize();
-  for (int k = 0; k < 20; ++k) // warm-up: first rebuilds, page faults
-    sys.step();
+  sys.advance(20); // warm-up: first rebuilds, page faults
   const PhaseTimes before = sys.phase_times();
   const long rebuilds0 = sys.neighbor_rebuilds();
   const auto dir = std::filesystem::temp_directory_path() / "magbrush_bench_dem";
@@ -132,9 +132,11 @@ Result run(int per_side, int threads, int steps)
   const std::vector<double> cpu0 = thread_cpu_times(threads);
   const double t0 = omp_get_wtime();
   double w0 = t0;
-  for (int k = 1; k <= steps; ++k)
+  // Ten steps at a time in one go (the engine keeps its thread team between them), as
+  // DemRun does between outputs.
+  for (int k = 10; k <= steps; k += 10)
   {
-    sys.step();
+    sys.advance(10);
     if (k % 100 == 0)
     {
       const double o0 = omp_get_wtime();
@@ -182,19 +184,17 @@ Result run(int per_side, int threads, int steps)
 
 int main(int argc, char **argv)
 {
-  // OpenMP reads OMP_WAIT_POLICY before main(): if the user did not choose, restart once with
-  // passive waiting (spinning threads are tens of times slower on a shared machine).
-  if (!std::getenv("OMP_WAIT_POLICY"))
-  {
-    setenv("OMP_WAIT_POLICY", "PASSIVE", 1);
+  // The OpenMP runtime reads its wait policy once, at start-up: choose it (a spin as long
+  // as a wake-up, then sleep; openmp_waiting.h) and restart once so that it takes effect.
+  if (magbrush::dem::choose_openmp_waiting())
     execv("/proc/self/exe", argv);
-  }
   const int steps = argc > 1 ? std::atoi(argv[1]) : 300;
   const int max_threads = argc > 2 ? std::atoi(argv[2]) : 2;
   const int repeats = argc > 3 ? std::max(1, std::atoi(argv[3])) : 1;
   std::printf("DEM dense periodic packing: 60 um, 2200 kg/m3, E = 1 GPa, nu = 0.35, mu = 0.45, rolling "
               "friction, damping; %d steps (+20 warm-up), snapshot every 100 steps; %d repeat(s)\n\n",
               steps, repeats);
+  std::printf("OpenMP waiting: %s\n\n", magbrush::dem::openmp_waiting_description().c_str());
   std::printf("%8s %7s %12s %8s | %7s %7s %7s %7s | %8s %9s %8s %8s   %-16s %12s %5s %9s\n", "N", "threads",
               "p-steps/s", "speedup", "neigh%", "cont%", "integ%", "out%", "B/part", "contacts", "rebuilds",
               "wall s", "one rebuild", "median 10-st", "load", "CPU s");

@@ -739,3 +739,135 @@ TEST(DemEngine, VectorisedPairKernelMatchesScalarContactLaw)
   }
   EXPECT_EQ(mismatches, 0);
 }
+
+namespace {
+// A force term that adds a small position-dependent pull (so that it matters for the bits)
+// and, from step `poison_step` on, a NaN or a huge push on particle index 0. It can declare
+// itself a team term (called by every thread inside the engine's team) or a serial one.
+class ProbeTerm : public ForceTerm
+{
+public:
+  ProbeTerm(bool in_team, double dt, long poison_step, double poison)
+    : in_team_(in_team), dt_(dt), poison_step_(poison_step), poison_(poison) {}
+  const char *name() const override { return in_team_ ? "probe (team)" : "probe (serial)"; }
+  bool runs_in_team() const override { return in_team_; }
+  void add_forces(const ParticleState &s, ForceBuffers &f, double t) override
+  {
+#pragma omp parallel if (s.size() > 512)
+    add_forces_in_team(s, f, t);
+  }
+  void add_forces_in_team(const ParticleState &s, ForceBuffers &f, double t) override
+  {
+    const long n = static_cast<long>(s.size());
+#pragma omp for schedule(static) nowait
+    for (long k = 0; k < n; ++k)
+    {
+      const std::size_t i = static_cast<std::size_t>(k);
+      f.fx[i] += 1e-3 * s.mass[i] * std::sin(1e3 * s.y[i]);
+      if (i == 0 && poison_step_ >= 0 && t >= (static_cast<double>(poison_step_) - 0.5) * dt_)
+        f.fz[i] += poison_;
+    }
+  }
+
+private:
+  bool in_team_;
+  double dt_;
+  long poison_step_;
+  double poison_;
+};
+
+// The packing with gravity (a team term), a serial probe, then Stokes drag (a team term, but
+// after a serial one, so it must run serially too: forces are summed in the order of terms).
+std::unique_ptr<DemSystem> make_packing_with_terms(const Case &c, bool probe_in_team, long poison_step = -1,
+                                                   double poison = 0.0)
+{
+  auto sys = std::make_unique<DemSystem>(c);
+  sys->add_force_term(std::make_unique<Gravity>(c.dem.gravity));
+  sys->insert_particles();
+  auto &p = sys->particles();
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (std::size_t i = 0; i < p.size(); ++i)
+    p.vz[i] = u(rng);
+  // The time step is known after initialize(); the probe's poison time uses it, so build a
+  // throw-away system to read it first.
+  const double dt = [&] {
+    DemSystem probe(c);
+    probe.particles() = p;
+    probe.initialize();
+    return probe.time_step();
+  }();
+  sys->add_force_term(std::make_unique<ProbeTerm>(probe_in_team, dt, poison_step, poison));
+  sys->add_force_term(std::make_unique<StokesDrag>(1.8e-5));
+  sys->initialize();
+  return sys;
+}
+
+std::string stability_message(DemSystem &s, bool in_one_call, long steps)
+{
+  try
+  {
+    if (in_one_call)
+      s.advance(steps);
+    else
+      for (long k = 0; k < steps; ++k)
+        s.step();
+  }
+  catch (const StabilityError &e)
+  {
+    return e.what();
+  }
+  return "(no guard)";
+}
+} // namespace
+
+// advance(n) keeps the threads in one team between serial work; it must give exactly the
+// bits of n calls to step(), with list rebuilds, energy checks, team and serial force terms.
+TEST(DemEngine, AdvanceGivesTheBitsOfSingleSteps)
+{
+  omp_set_num_threads(2);
+  const Case c = packing_case();
+  for (bool probe_in_team : {true, false})
+  {
+    auto a = make_packing_with_terms(c, probe_in_team);
+    auto b = make_packing_with_terms(c, probe_in_team);
+    for (int k = 0; k < 1203; ++k)
+      a->step();
+    b->advance(1000);
+    b->advance(203);
+    EXPECT_EQ(a->step_count(), b->step_count());
+    EXPECT_EQ(a->time(), b->time());
+    EXPECT_GT(b->neighbor_rebuilds(), 2);
+    EXPECT_GT(b->particle_contacts(), 50);
+    EXPECT_TRUE(bit_identical(state_by_id(*a), state_by_id(*b))) << "probe in team: " << probe_in_team;
+    std::printf("advance(1000) + advance(203) vs 1203 x step(), probe %s: %ld rebuilds, %ld contacts\n",
+                probe_in_team ? "in the team" : "serial", b->neighbor_rebuilds(), b->particle_contacts());
+  }
+}
+
+// A fault inside a batch of steps run by the team stops it at the faulty step, with the
+// message a step-by-step run gives.
+TEST(DemEngine, GuardsStopAdvanceAtTheFaultyStep)
+{
+  omp_set_num_threads(2);
+  const Case c = packing_case();
+  struct Fault
+  {
+    const char *what;
+    double poison;
+    const char *expect;
+  };
+  for (const Fault &f : {Fault{"NaN", std::nan(""), "NaN"}, Fault{"push", -1e3, "overlaps"}})
+    for (bool probe_in_team : {true, false})
+    {
+      auto a = make_packing_with_terms(c, probe_in_team, 137, f.poison);
+      auto b = make_packing_with_terms(c, probe_in_team, 137, f.poison);
+      const std::string ma = stability_message(*a, false, 1000), mb = stability_message(*b, true, 1000);
+      EXPECT_NE(ma.find(f.expect), std::string::npos) << ma;
+      EXPECT_EQ(ma, mb) << f.what << ", probe in team: " << probe_in_team;
+      EXPECT_EQ(a->step_count(), b->step_count());
+      EXPECT_LT(b->step_count(), 200);
+      std::printf("%s at step 137, probe %s: stopped at step %ld: %.90s...\n", f.what,
+                  probe_in_team ? "in the team" : "serial", b->step_count(), mb.c_str());
+    }
+}

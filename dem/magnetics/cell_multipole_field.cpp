@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <climits>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -279,19 +280,23 @@ void CellMultipoleField::build(std::size_t n, const double *x, const double *y, 
 
   // Translation tensors of the lower levels (depend on the cell size only).
   // The top level's size depends on the number of levels when nothing is periodic.
-  if (h_ != cached_h_ || levels_.size() != cached_levels_)
+  if (h_ != cached_h_)
   {
     lattice_.clear();
     lattice_f_.clear();
   }
   bool tabulated = h_ == cached_h_;
   for (std::size_t level = 0; level + 1 < levels_.size(); ++level)
-    tabulated = tabulated && level < offset_D_.size() &&
+    tabulated = tabulated && level < offset_D_.size() && level < cached_sizes_.size() &&
+                cached_sizes_[level] == levels_[level].size &&
                 (static_cast<int>(level) + 1 >= column_level_ || !offset_D_[level].empty());
   cached_levels_ = levels_.size();
   if (!tabulated)
   {
     cached_h_ = h_;
+    cached_sizes_.clear();
+    for (const Level &l : levels_)
+      cached_sizes_.push_back(l.size);
     offset_D_.assign(levels_.size(), {});
     offset_Df_.assign(levels_.size(), {});
     const std::size_t nd = taylor_.derivative_size();
@@ -365,7 +370,7 @@ void CellMultipoleField::build_interaction_lists()
       else
       {
         l.list_matrix.push_back(lattice_matrix(level, D).data());
-        l.list_matrix_f.push_back(lattice_f_.at({level, D[0], D[1], D[2]}).data());
+        l.list_matrix_f.push_back(lattice_f_.at(lattice_key(level, D)).data());
       }
     };
     for (std::size_t c = 0; c < l.keys.size(); ++c)
@@ -428,9 +433,17 @@ void CellMultipoleField::build_interaction_lists()
   }
 }
 
+CellMultipoleField::LatticeKey CellMultipoleField::lattice_key(int level, const std::array<long, 3> &offset) const
+{
+  LatticeKey key = {level, offset[0], offset[1], offset[2], 0, 0, 0};
+  for (int d = 0; d < 3; ++d)
+    std::memcpy(&key[4 + d], &levels_[level].size[d], sizeof(double));
+  return key;
+}
+
 const std::vector<double> &CellMultipoleField::lattice_matrix(int level, const std::array<long, 3> &offset)
 {
-  const std::array<long, 4> key = {level, offset[0], offset[1], offset[2]};
+  const LatticeKey key = lattice_key(level, offset);
   auto it = lattice_.find(key);
   if (it != lattice_.end())
     return it->second;

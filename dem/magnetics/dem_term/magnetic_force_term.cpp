@@ -1,5 +1,7 @@
 #include "magnetic_force_term.h"
 
+#include <omp.h>
+
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -124,8 +126,16 @@ void MagneticForceTerm::full_refresh(const BeadArrays &beads, double t, double r
 {
   for (auto *v : {&fx_, &fy_, &fz_, &tx_, &ty_, &tz_})
     std::fill(v->begin(), v->end(), 0.0);
+  const double t0 = omp_get_wtime();
   stats_ = dipoles_.compute(beads, lookup_at(t), t,
                             {fx_.data(), fy_.data(), fz_.data(), tx_.data(), ty_.data(), tz_.data()});
+  counts_.full_s += omp_get_wtime() - t0;
+  counts_.lists_s += stats_.time_lists;
+  counts_.tensors_s += stats_.time_tensors;
+  counts_.far_s += stats_.time_far;
+  counts_.sweeps_s += stats_.time_sweeps;
+  counts_.forces_s += stats_.time_forces;
+  counts_.rebuilds += stats_.list_rebuilt;
   counts_.zero_field += stats_.zero_field;
   held_ramp_ = ramp;
   ++evaluations_;
@@ -151,7 +161,11 @@ void MagneticForceTerm::add_forces(const dem::ParticleState &state, dem::ForceBu
   if (must_refresh_)
     check.reason = RefreshReason::first;
   else
+  {
+    const double t0 = omp_get_wtime();
     check = dipoles_.check_staleness(beads, t);
+    counts_.check_s += omp_get_wtime() - t0;
+  }
   // Held forces from a moment without field (before a ramp starts) cannot be rescaled: the
   // field has just come on, so evaluate.
   if (check.reason == RefreshReason::none && held_ramp_ == 0.0 && ramp > 0.0)
@@ -180,7 +194,10 @@ void MagneticForceTerm::add_forces(const dem::ParticleState &state, dem::ForceBu
       if (ramp != held_ramp_)
         dipoles_.scale_applied_field(ramp / held_ramp_);
       held_ramp_ = ramp;
+      const double t0 = omp_get_wtime();
       local = dipoles_.refresh_locally(beads, lookup_at(t), t, local_stats_);
+      counts_.local_s += omp_get_wtime() - t0;
+      counts_.region_beads += local ? static_cast<long>(local_stats_.local_region) : 0;
     }
     if (local)
     {

@@ -58,6 +58,15 @@ public:
   struct RefreshCounts
   {
     long first = 0, interval = 0, moved = 0, zero_field = 0;
+    // Wall time [s] in full evaluations, in local refreshes (including attempts that fell
+    // back to a full one), and in the per-step staleness checks; and the beads solved again
+    // (the regions) summed over the local refreshes.
+    double full_s = 0.0, local_s = 0.0, check_s = 0.0;
+    long region_beads = 0;
+    // The full evaluations' phases summed [s] (MagneticStats): lists / cells, applied field +
+    // tensors, far field, sweeps, forces; and how many rebuilt the lists.
+    double lists_s = 0.0, tensors_s = 0.0, far_s = 0.0, sweeps_s = 0.0, forces_s = 0.0;
+    long rebuilds = 0;
   };
   const RefreshCounts &refresh_counts() const { return counts_; }
   const InducedDipoles &dipoles() const { return dipoles_; }

@@ -885,6 +885,10 @@ StalenessCheck InducedDipoles::check_staleness(const BeadArrays &beads, double t
   // A bead is stale when it moved more than staleness_fraction × its radius since its force
   // was evaluated. The minimum image: a bead wrapped across a periodic face by the caller did
   // not move (the neighbour lists see the jump and are rebuilt at the next compute).
+  const bool relative = settings_.staleness_mode == StalenessMode::relative && list_.built() &&
+                        list_.particle_count() == beads.n;
+  if (relative)
+    move2_.resize(beads.n);
   std::size_t stale = 0;
   double worst2 = 0.0;
   for (std::size_t b = 0; b < beads.n; ++b)
@@ -893,19 +897,20 @@ StalenessCheck InducedDipoles::check_staleness(const BeadArrays &beads, double t
     const double limit = move_limit(beads, b);
     stale += move2 > limit * limit;
     worst2 = std::max(worst2, move2 / (beads.radius[b] * beads.radius[b]));
+    if (relative)
+      move2_[b] = move2;
   }
   c.stale_beads = stale;
   c.max_move = std::sqrt(worst2);
-  // relative: the watched pairs whose vector changed by more than the fraction.
-  // No watched pair can be stale while no bead moved half the smallest pair limit
-  // (|Δr| ≤ |Δx_i| + |Δx_j|): the pair loop is skipped for the first part of every hold.
-  if (settings_.staleness_mode == StalenessMode::relative && list_.built() &&
-      list_.particle_count() == beads.n &&
-      2.0 * c.max_move * max_radius_ > settings_.staleness_fraction * min_radius_)
+  // relative: the watched pairs whose vector changed by more than the fraction. A pair can
+  // only be stale if one of its beads moved half its limit (|Δr| ≤ |Δx_i| + |Δx_j|): the
+  // pair loop is skipped while no bead has, and pairs of beads that have not are skipped.
+  if (relative && 2.0 * c.max_move * max_radius_ > settings_.staleness_fraction * min_radius_)
   {
     std::size_t stale_pairs = 0;
     for (const ClosePair &p : close_)
-      stale_pairs += drift2(beads, p) > p.limit2;
+      if (4.0 * std::max(move2_[p.i], move2_[p.j]) > p.limit2)
+        stale_pairs += drift2(beads, p) > p.limit2;
     c.stale_pairs = stale_pairs;
   }
   if (stale > 0 || c.stale_pairs > 0)
@@ -918,7 +923,7 @@ double InducedDipoles::squared_move(const BeadArrays &beads, std::size_t b) cons
   double d[3] = {beads.x[b] - x_last_[3 * b], beads.y[b] - x_last_[3 * b + 1],
                  beads.z[b] - x_last_[3 * b + 2]};
   for (int a = 0; a < 3; ++a)
-    if (box_[a] > 0.0)
+    if (box_[a] > 0.0 && std::abs(d[a]) > 0.5 * box_[a])
       d[a] -= box_[a] * std::round(d[a] / box_[a]);
   return d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
 }

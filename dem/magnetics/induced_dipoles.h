@@ -231,6 +231,7 @@ private:
   std::vector<ClosePair> close_;
   std::vector<std::int32_t> close_of_pair_;
   double min_radius_ = 0.0, max_radius_ = 0.0;
+  mutable std::vector<double> move2_; // per-step scratch of check_staleness: |Δx_b|²
 
   double cutoff_length(const BeadArrays &beads) const;
   void refresh_list_if_needed(const BeadArrays &beads, double cutoff, MagneticStats &stats);

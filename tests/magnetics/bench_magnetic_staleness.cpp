@@ -238,7 +238,7 @@ void print(const char *title, const char *wall_name, const std::vector<ModeResul
   std::printf("\n%s\n\n", title);
   std::printf("| staleness mode | full evaluations / ms (interval, moved, first) | local refreshes / ms (mean region) | "
               "held-force error RMS: mean / max | worst bead: mean / max | %s force: mean / max | "
-              "magnetic term [s]: full / local / checks / total | rest of the step [s] | magnetics / rest |\n",
+              "magnetic term [s]: full / local / checks / total | rest of the step [s] | magnetics / rest (without the cold first evaluation) |\n",
               wall_name);
   std::printf("|---|---|---|---|---|---|---|---|---|\n");
   for (const ModeResult &r : results)
@@ -246,12 +246,12 @@ void print(const char *title, const char *wall_name, const std::vector<ModeResul
                 r.mode.c_str(), r.full / r.simulated_ms, r.counts.interval, r.counts.moved, r.counts.first,
                 r.local / r.simulated_ms, r.local ? double(r.counts.region_beads) / r.local : 0.0, r.mean_rms,
                 r.max_rms, r.mean_max, r.max_max, r.mean_wall, r.max_wall, r.counts.full_s, r.counts.local_s,
-                r.counts.check_s, r.magnetic_s, r.rest_s, 100.0 * r.magnetic_s / r.rest_s);
-  std::printf("\nFull evaluations, phases summed [s]:\n\n| staleness mode | evaluations | list rebuilds | lists/cells | "
-              "applied field + tensors | far field | sweeps | forces |\n|---|---|---|---|---|---|---|---|\n");
+                r.counts.check_s, r.magnetic_s, r.rest_s, 100.0 * (r.magnetic_s - r.counts.cold_s) / r.rest_s);
+  std::printf("\nFull evaluations, phases summed [s]:\n\n| staleness mode | evaluations | list rebuilds | the cold first one | lists/cells | "
+              "applied field + tensors | far field | sweeps | forces |\n|---|---|---|---|---|---|---|---|---|\n");
   for (const ModeResult &r : results)
-    std::printf("| %s | %ld | %ld | %.2f | %.2f | %.2f | %.2f | %.2f |\n", r.mode.c_str(), r.full, r.counts.rebuilds,
-                r.counts.lists_s, r.counts.tensors_s, r.counts.far_s, r.counts.sweeps_s, r.counts.forces_s);
+    std::printf("| %s | %ld | %ld | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f |\n", r.mode.c_str(), r.full, r.counts.rebuilds,
+                r.counts.cold_s, r.counts.lists_s, r.counts.tensors_s, r.counts.far_s, r.counts.sweeps_s, r.counts.forces_s);
   std::printf("\n(%ld samples per mode over %.3g ms)\n", results.empty() ? 0L : results[0].samples,
               results.empty() ? 0.0 : results[0].simulated_ms);
   std::fflush(stdout);

@@ -129,7 +129,10 @@ void MagneticForceTerm::full_refresh(const BeadArrays &beads, double t, double r
   const double t0 = omp_get_wtime();
   stats_ = dipoles_.compute(beads, lookup_at(t), t,
                             {fx_.data(), fy_.data(), fz_.data(), tx_.data(), ty_.data(), tz_.data()});
-  counts_.full_s += omp_get_wtime() - t0;
+  const double spent = omp_get_wtime() - t0;
+  counts_.full_s += spent;
+  if (evaluations_ == 0)
+    counts_.cold_s = spent;
   counts_.lists_s += stats_.time_lists;
   counts_.tensors_s += stats_.time_tensors;
   counts_.far_s += stats_.time_far;

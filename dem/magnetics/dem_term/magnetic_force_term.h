@@ -62,6 +62,7 @@ public:
     // back to a full one), and in the per-step staleness checks; and the beads solved again
     // (the regions) summed over the local refreshes.
     double full_s = 0.0, local_s = 0.0, check_s = 0.0;
+    double cold_s = 0.0; // of full_s: the run's first evaluation (cell tables, lattice sums)
     long region_beads = 0;
     // The full evaluations' phases summed [s] (MagneticStats): lists / cells, applied field +
     // tensors, far field, sweeps, forces; and how many rebuilt the lists.

@@ -856,6 +856,8 @@ void InducedDipoles::particles_reordered(const std::vector<std::int32_t> &order)
   permute(x_last_);
   list_ = MagneticNeighbourList(); // pair indices refer to the old order
   correction_list_ = MagneticNeighbourList();
+  close_.clear();                  // (the watched pairs too, until the next compute)
+  close_of_pair_.clear();
 }
 
 bool InducedDipoles::needs_refresh(const BeadArrays &beads, double time) const

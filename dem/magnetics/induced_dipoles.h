@@ -17,9 +17,11 @@
 // bit-identical for any number of OpenMP threads. Between neighbour-list rebuilds no memory
 // is allocated (a rebuild uses temporary cell arrays; a new β builds its table once).
 //
-// The DEM may hold the magnetic forces between evaluations: needs_refresh() says when to
-// evaluate again (interval elapsed, or a bead moved more than a fraction of its radius), and
-// add_held_forces() adds the forces of the last evaluation.
+// The DEM may hold the magnetic forces between evaluations: check_staleness() says when and
+// why they are stale (interval elapsed; beads or close pairs moved past a fraction of a radius,
+// by the StalenessMode), refresh_locally() renews them around what moved (holding the far
+// field and everyone else's dipoles), compute() renews everything, and add_held_forces() adds
+// the forces of the last evaluation.
 #pragma once
 
 #include "cell_multipole_field.h"

@@ -1,7 +1,8 @@
 // The DEM adapter: two carriers (and one toner) in the engine, in a uniform field, receive the
 // mutual-dipole pair force; the toner receives nothing; held forces are reused between
-// refreshes and follow the engine's particle re-sorting; the ramp and the local refresh through the
-// engine; the staleness-mode key.
+// refreshes and follow the engine's particle re-sorting; an engine wrap and re-sort are no
+// move; the ramp (held forces ∝ s²) and the local refresh through the engine; the
+// staleness-mode key.
 #include "magnetic_force_term.h"
 #include "two_sphere_exact.h"
 
@@ -152,4 +153,41 @@ TEST(MagneticForceTerm, RampAndLocalRefreshThroughTheEngine)
   std::vector<double> fx, fy, fz;
   term.last_forces(fx, fy, fz);
   EXPECT_EQ(fz[upper], f.fz[upper]);
+}
+
+// The engine wraps beads into [0, L) along periodic axes at its list rebuilds and re-sorts its
+// arrays: neither is a move for the magnetics (no refresh, the same forces, the lists kept).
+TEST(MagneticForceTerm, EngineWrapAndResortAreNoMove)
+{
+  Case c = parse_case_text(scene, "magnetic_pair.yaml");
+  dem::DemSystem system(c);
+  auto &p = system.particles();
+  const double a = 30e-6, L = 1e-3;
+  p.add({0.99e-3, 0.5e-3, 0.4e-3}, a, 2200.0, 0, 0.0);
+  p.add({0.99e-3, 0.5e-3, 0.4e-3 + 2.2 * a}, a, 2200.0, 0, 0.0);
+  p.add({0.2e-3, 0.5e-3, 0.4e-3}, a, 2200.0, 0, 0.0);
+  system.initialize();
+  MagneticForceTerm term(c, MagneticSettings::from_case(c.dem), AppliedMagneticField::uniform({0, 0, 1}, 0.13),
+                         {L, 0.0, 0.0});
+  dem::ForceBuffers f;
+  f.resize(3);
+  f.clear();
+  term.add_forces(p, f, 0.0);
+  const std::vector<double> fz0(f.fz.begin(), f.fz.begin() + 3);
+  // Wrap the two beads near x = L across the face (as the engine would: x − L)...
+  for (std::size_t k = 0; k < 3; ++k)
+    if (p.x[k] > 0.5 * L)
+      p.x[k] -= L;
+  // ... and re-sort the arrays.
+  const std::vector<std::int32_t> order = {2, 0, 1};
+  std::vector<double> scratch;
+  std::vector<std::int32_t> iscratch;
+  p.permute(order, scratch, iscratch);
+  term.particles_reordered(order);
+  f.clear();
+  term.add_forces(p, f, 1e-6);
+  EXPECT_EQ(term.evaluations(), 1);
+  EXPECT_EQ(term.local_refreshes(), 0);
+  for (std::size_t k = 0; k < 3; ++k)
+    EXPECT_EQ(f.fz[k], fz0[static_cast<std::size_t>(order[k])]);
 }

@@ -101,11 +101,17 @@ void MagneticForceTerm::gather_positions(const dem::ParticleState &state)
 
 AppliedFieldFunction MagneticForceTerm::lookup_at(double t) const
 {
+  // The field is looked up at the engine's image of the (unwrapped) position.
   const AppliedMagneticField &field = field_;
-  return [&field, t](const double x[3], double B[3], double g[3][3]) {
+  const std::array<double, 3> box = box_;
+  return [&field, t, box](const double x[3], double B[3], double g[3][3]) {
+    Vec3 X{x[0], x[1], x[2]};
+    for (int d = 0; d < 3; ++d)
+      if (box[d] > 0.0)
+        X[d] -= box[d] * std::floor(X[d] / box[d]);
     Vec3 Bv;
     std::array<Vec3, 3> G;
-    field.evaluate({x[0], x[1], x[2]}, t, Bv, G);
+    field.evaluate(X, t, Bv, G);
     for (int a = 0; a < 3; ++a)
     {
       B[a] = Bv[a];

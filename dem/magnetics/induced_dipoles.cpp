@@ -126,6 +126,7 @@ MagneticStats InducedDipoles::compute(const BeadArrays &beads, const AppliedFiel
     p_.clear();
     force_.assign(3 * n, 0.0);
     torque_.assign(3 * n, 0.0);
+    store_limits(beads);
     for (std::size_t b = 0; b < n; ++b)
       store_reference_position(beads, b);
     t_last_ = time;
@@ -195,6 +196,7 @@ MagneticStats InducedDipoles::compute(const BeadArrays &beads, const AppliedFiel
   gather_forces(out);
   lap(stats.time_forces);
 
+  store_limits(beads);
   for (std::size_t b = 0; b < n; ++b)
     store_reference_position(beads, b);
   if (settings_.staleness_mode == StalenessMode::relative)
@@ -241,6 +243,18 @@ double InducedDipoles::move_limit(const BeadArrays &beads, std::size_t b) const
 {
   const double factor = settings_.staleness_mode == StalenessMode::relative ? settings_.absolute_factor : 1.0;
   return factor * settings_.staleness_fraction * beads.radius[b];
+}
+
+void InducedDipoles::store_limits(const BeadArrays &beads)
+{
+  limit2_.resize(beads.n);
+  inv_radius2_.resize(beads.n);
+  for (std::size_t b = 0; b < beads.n; ++b)
+  {
+    const double limit = move_limit(beads, b);
+    limit2_[b] = limit * limit;
+    inv_radius2_[b] = 1.0 / (beads.radius[b] * beads.radius[b]);
+  }
 }
 
 void InducedDipoles::store_reference_position(const BeadArrays &beads, std::size_t b)
@@ -896,9 +910,8 @@ StalenessCheck InducedDipoles::check_staleness(const BeadArrays &beads, double t
   for (std::size_t b = 0; b < beads.n; ++b)
   {
     const double move2 = squared_move(beads, b);
-    const double limit = move_limit(beads, b);
-    stale += move2 > limit * limit;
-    worst2 = std::max(worst2, move2 / (beads.radius[b] * beads.radius[b]));
+    stale += move2 > limit2_[b];
+    worst2 = std::max(worst2, move2 * inv_radius2_[b]);
     if (relative)
       move2_[b] = move2;
   }
@@ -988,10 +1001,9 @@ bool InducedDipoles::refresh_locally(const BeadArrays &beads, const AppliedField
   };
   for (std::size_t b = 0; b < n; ++b)
   {
-    const double limit = move_limit(beads, b);
     const double move2 = squared_move(beads, b);
-    due |= move2 > limit * limit;
-    if (move2 > batch2 * limit * limit)
+    due |= move2 > limit2_[b];
+    if (move2 > batch2 * limit2_[b])
       add_moved(static_cast<std::uint32_t>(b));
   }
   if (settings_.staleness_mode == StalenessMode::relative)

@@ -234,6 +234,7 @@ private:
   std::vector<std::int32_t> close_of_pair_;
   double min_radius_ = 0.0, max_radius_ = 0.0;
   mutable std::vector<double> move2_; // per-step scratch of check_staleness: |Δx_b|²
+  std::vector<double> limit2_, inv_radius2_; // per bead: move_limit², 1/radius²
 
   double cutoff_length(const BeadArrays &beads) const;
   void refresh_list_if_needed(const BeadArrays &beads, double cutoff, MagneticStats &stats);
@@ -255,6 +256,7 @@ private:
   // Bead b's total force and torque from the stored pair forces, in the fixed order.
   void gather_bead(std::size_t b);
   void store_reference_position(const BeadArrays &beads, std::size_t b);
+  void store_limits(const BeadArrays &beads); // limit2_, inv_radius2_ of the beads
   // |x_b − x_last,b|² (minimum image along periodic axes).
   double squared_move(const BeadArrays &beads, std::size_t b) const;
   // Bead b's staleness limit on its absolute move [m]: staleness_fraction × radius, times

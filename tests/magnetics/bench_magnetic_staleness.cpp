@@ -26,8 +26,9 @@
 //                            [sample_us (2)] [modes (absolute,local,relative)] [refresh_us (the case's: 5)]
 //                            [descent_at_us (2500)] [descent_us (300; 0 = skip)]
 // Environment (knobs without a case key): MAGBRUSH_LOCAL_REGION_LIMIT, MAGBRUSH_LOCAL_BATCH,
-// MAGBRUSH_ABSOLUTE_FACTOR (MagneticSettings local_region_limit, local_batch_fraction,
-// absolute_factor).
+// MAGBRUSH_ABSOLUTE_FACTOR, MAGBRUSH_MAGNETIC_SKIN (MagneticSettings local_region_limit,
+// local_batch_fraction, absolute_factor, skin_fraction: the magnetic lists' skin, otherwise
+// dem.verlet_skin).
 #include "magnetic_force_term.h"
 
 #include "applied_magnetic_field.h"
@@ -203,6 +204,8 @@ ModeResult run_mode(Case c, const std::string &mode, const std::string &restart,
     settings.local_batch_fraction = std::atof(v);
   if (const char *v = std::getenv("MAGBRUSH_ABSOLUTE_FACTOR"))
     settings.absolute_factor = std::atof(v);
+  if (const char *v = std::getenv("MAGBRUSH_MAGNETIC_SKIN"))
+    settings.skin_fraction = std::atof(v);
   auto owned = std::make_unique<MagneticForceTerm>(c, settings, field, system.box().length);
   const MagneticForceTerm *term = owned.get();
   system.add_force_term(std::move(owned));

@@ -91,7 +91,8 @@ void MagneticForceTerm::gather_positions(const dem::ParticleState &state)
       for (std::size_t k = 0; k < n; ++k)
       {
         const double raw = from[carrier_[k]];
-        to[k] = raw + L * std::round((to[k] - raw) / L);
+        const double jump = to[k] - raw; // a multiple of L after a wrap, else a step's move
+        to[k] = std::abs(jump) > 0.5 * L ? raw + L * std::round(jump / L) : raw;
       }
     else
       for (std::size_t k = 0; k < n; ++k)
@@ -233,10 +234,15 @@ void MagneticForceTerm::add_forces(const dem::ParticleState &state, dem::ForceBu
     forces.fx[i] += scale * fx_[k];
     forces.fy[i] += scale * fy_[k];
     forces.fz[i] += scale * fz_[k];
-    forces.tx[i] += scale * tx_[k];
-    forces.ty[i] += scale * ty_[k];
-    forces.tz[i] += scale * tz_[k];
   }
+  if (dipoles_.settings().torque == TorqueModel::paper) // (otherwise no magnetic torque)
+    for (std::size_t k = 0; k < n; ++k)
+    {
+      const std::size_t i = carrier_[k];
+      forces.tx[i] += scale * tx_[k];
+      forces.ty[i] += scale * ty_[k];
+      forces.tz[i] += scale * tz_[k];
+    }
 }
 
 void MagneticForceTerm::last_forces(std::vector<double> &fx, std::vector<double> &fy,

@@ -22,7 +22,10 @@
 //                coming down at 0.1 m/s: run once to `descent_at`, then every mode runs the
 //                same `descent` window from that checkpoint (error on the plate force).
 //
-//   bench_magnetic_staleness [nip|compression|both] [flow_us (nip, 300)] [until_us (compression, 500)]
+//   nip_quick:   the same on tools/run's quick default (cases/kawamoto_nip.yaml, 4,300 beads,
+//                1 mm slab, 40 ns steps).
+//
+//   bench_magnetic_staleness [nip|nip_quick|compression|both] [flow_us (nip, 300)] [until_us (compression, 500)]
 //                            [sample_us (2)] [modes (absolute,local,relative)] [refresh_us (the case's: 5)]
 //                            [descent_at_us (2500)] [descent_us (300; 0 = skip)]
 // Environment (knobs without a case key): MAGBRUSH_LOCAL_REGION_LIMIT, MAGBRUSH_LOCAL_BATCH,
@@ -271,12 +274,21 @@ std::vector<std::string> split(const std::string &list)
 
 double refresh_override_us = 0.0; // > 0: dem.magnetic_refresh for every run
 
-void nip(const fs::path &dir, double flow_us, double sample_us, const std::vector<std::string> &modes)
+// quick = tools/run's quick default (cases/kawamoto_nip.yaml, 4,300 beads in a 1 mm slab),
+// otherwise the reduced regression scene.
+void nip(const fs::path &dir, double flow_us, double sample_us, const std::vector<std::string> &modes,
+         bool quick)
 {
-  const std::string file = std::string(MAGBRUSH_SOURCE_DIR) + "/tests/nip/kawamoto_nip_reduced.yaml";
-  const std::vector<std::string> overrides = {
+  const std::string file = std::string(MAGBRUSH_SOURCE_DIR) +
+                           (quick ? "/cases/kawamoto_nip.yaml" : "/tests/nip/kawamoto_nip_reduced.yaml");
+  std::vector<std::string> overrides = {
     "dem.magnetic_far_field=cell_multipole", "field.output_dir=" + (dir / "fields").string(),
     "output.directory=" + dir.string(), "dem.output_interval=0 s"};
+  if (quick) // as tools/run
+    for (const char *o : {"populations.carrier.count=4300",
+                          "populations.carrier.insert_box=[[12.1mm,-2.5mm,0mm],[13.0mm,1.5mm,1mm]]",
+                          "dem.time_step=40ns"})
+      overrides.push_back(o);
   std::string cmd = "cd '" + dir.string() + "' && OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 '" +
                     std::string(MAGBRUSH_BINARY_DIR) + "/bin/magbrush' field '" + file + "'";
   for (const auto &o : overrides)
@@ -304,8 +316,9 @@ void nip(const fs::path &dir, double flow_us, double sample_us, const std::vecto
     results.push_back(run_mode(c, mode, checkpoint, dir, 1, sample_us * 1e-6, settle));
   char title[512];
   std::snprintf(title, sizeof title,
-                "Flowing nip (tests/nip/kawamoto_nip_reduced.yaml, far field cell_multipole, %zu beads): "
+                "Flowing nip (%s, far field cell_multipole, %zu beads): "
                 "%.3g ms of turning after %.3g ms of settling, step %.3g ns, refresh %.3g us, staleness %.3g",
+                quick ? "cases/kawamoto_nip.yaml, tools/run quick default" : "tests/nip/kawamoto_nip_reduced.yaml",
                 static_cast<std::size_t>(c.populations[0].count), flow_us * 1e-3, settle * 1e3, c.dem.time_step * 1e9,
                 c.dem.magnetic_refresh * 1e6, c.dem.magnetic_staleness);
   print(title, "drum", results);
@@ -373,7 +386,9 @@ int main(int argc, char **argv)
   try
   {
     if (scene == "nip" || scene == "both")
-      nip(dir, flow_us, sample_us, modes);
+      nip(dir, flow_us, sample_us, modes, false);
+    if (scene == "nip_quick")
+      nip(dir, flow_us, sample_us, modes, true);
     if (scene == "compression" || scene == "both")
       compression(dir, until_us, sample_us, modes);
   }

@@ -196,8 +196,9 @@ void MagneticForceTerm::add_forces(const dem::ParticleState &state, dem::ForceBu
   case RefreshReason::moved:
   {
     bool local = false;
-    if (dipoles_.settings().staleness_mode != StalenessMode::absolute && dipoles_.linear() &&
-        held_ramp_ > 0.0)
+    // (Saturating beads while the field ramps: the held state cannot be rescaled exactly.)
+    if (dipoles_.settings().staleness_mode != StalenessMode::absolute && held_ramp_ > 0.0 &&
+        (ramp == held_ramp_ || dipoles_.linear()))
     {
       // The held state at the current field strength first (exact for linear beads), then
       // the region around the moved beads.

@@ -122,6 +122,13 @@ private:
   std::size_t cached_levels_ = 0;
   std::vector<std::array<double, 3>> cached_sizes_; // level cell sizes of offset_D_
 
+  // Dense index of the occupied fine cells over their bounding box (−1 = empty), for O(1)
+  // lookups while collecting the near pairs; empty when the box would be too large.
+  std::vector<std::int32_t> dense_;
+  std::array<long, 3> dense_extent_{0, 0, 0};
+  void build_dense_index(const Level &fine);
+  long find_fine(const std::array<long, 3> &I) const; // as find(levels_[0], I)
+
   std::uint64_t key_of(const std::array<long, 3> &I) const;
   long find(const Level &level, const std::array<long, 3> &I) const; // −1 if empty
   bool wrap(const Level &level, std::array<long, 3> &I) const;       // false if outside

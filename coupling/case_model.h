@@ -196,6 +196,12 @@ struct DemSettings
   int magnetic_far_order = 2;        // Taylor order of the cell multipoles
   double magnetic_far_cell = 1.5;    // fine cell size in mean carrier diameters
   double magnetic_staleness = 0.05;  // refresh early when a bead moved this × its radius
+  // What makes held magnetic forces stale early, and what it triggers (docs/magnetics.md):
+  // "relative" (close pairs whose vector changed by magnetic_staleness × the mean radius, or
+  // beads that moved 5× that in the applied field: a local refresh around them), "local"
+  // (beads that moved magnetic_staleness × their radius: a local refresh) or "absolute"
+  // (the same trigger, a full refresh: the behaviour before issue 5's refresh work).
+  std::string magnetic_staleness_mode = "relative";
   double air_viscosity = 1.81e-5;    // η [Pa s] for Stokes drag (0 = no drag)
   Vec3 gravity{{0.0, -9.81, 0.0}};    // [m/s²]
   unsigned long seed = 1;

@@ -1021,6 +1021,7 @@ private:
     d.magnetic_far_order = static_cast<int>(integer(s, "magnetic_far_order"));
     d.magnetic_far_cell = q(s, "magnetic_far_cell");
     d.magnetic_staleness = q(s, "magnetic_staleness");
+    d.magnetic_staleness_mode = str(s, "magnetic_staleness_mode");
     d.air_viscosity = q(s, "air_viscosity");
     d.gravity = vec3(s, "gravity");
     d.seed = static_cast<unsigned long>(integer(s, "seed"));

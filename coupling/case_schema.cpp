@@ -264,6 +264,9 @@ std::vector<KeySpec> build_schema()
           .def("cell_multipole"),
       integer("dem.magnetic_far_order", "Taylor order of the cell multipoles (error vs cost in docs/magnetics.md).").def("2").non_negative().max(6),
       number("dem.magnetic_staleness", "Refresh the magnetic forces early when some carrier moved more than this fraction of its radius since the last refresh (held-force error ~0.37 x this, RMS, at the refresh; half of it on average, docs/magnetics.md).").def("0.05").positive(),
+      choice("dem.magnetic_staleness_mode", {"relative", "local", "absolute"},
+             "What makes held magnetic forces stale before magnetic_refresh elapses, and what it triggers: relative (a pair closer than 4 radii whose vector changed by magnetic_staleness x its mean radius, or a carrier that moved 5 x magnetic_staleness x its radius in the applied field: a local refresh around them; a rigidly carried brush triggers nothing), local (a carrier that moved magnetic_staleness x its radius: a local refresh around it) or absolute (the same trigger, a full refresh: the behaviour before; docs/magnetics.md).")
+          .def("relative"),
       number("dem.magnetic_far_cell", "Fine cell size of the magnetic far field in mean carrier diameters (1.5 with order 2: <= 0.7 % RMS force error in brushes, docs/magnetics.md).").def("1.5").positive().max(10.0),
       quantity("dem.air_viscosity", D::viscosity, "Air viscosity for Stokes drag (0 = no drag).").def("1.81e-5 Pa*s").non_negative(),
       vector3("dem.gravity", D::acceleration, "Gravitational acceleration.").def("[0, -9.81 m/s^2, 0]"),

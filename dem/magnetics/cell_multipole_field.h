@@ -106,16 +106,28 @@ private:
   std::vector<MagneticNeighbourList::Pair> near_pairs_;
 
   // Translation matrices A[γ][β] = D_(β+γ)(−Δ h_ℓ) for the 7³ offsets of every lower
-  // level, and the lattice-summed ones of the top level per offset (cached while h and the
-  // number of levels are unchanged).
+  // level, and the lattice-summed ones of the upper levels per (level, offset, the level's
+  // cell size): kept across rebuilds while h is unchanged (a lattice sum over a disc of
+  // images costs more than a whole evaluation; the cell size of a level along an open axis
+  // depends on how far the beads spread, so it is part of the key).
+  using LatticeKey = std::array<long, 7>;
+  LatticeKey lattice_key(int level, const std::array<long, 3> &offset) const;
   std::vector<std::vector<double>> offset_D_;
-  std::map<std::array<long, 4>, std::vector<double>> lattice_; // (level, offset) → matrix
+  std::map<LatticeKey, std::vector<double>> lattice_;
   std::vector<std::vector<float>> offset_Df_;
-  std::map<std::array<long, 4>, std::vector<float>> lattice_f_;
+  std::map<LatticeKey, std::vector<float>> lattice_f_;
   bool single_precision_ = true;
   int column_level_ = 0; // first level whose cells span the whole period (m + 1)
   std::array<double, 3> cached_h_{0, 0, 0};
   std::size_t cached_levels_ = 0;
+  std::vector<std::array<double, 3>> cached_sizes_; // level cell sizes of offset_D_
+
+  // Dense index of the occupied fine cells over their bounding box (−1 = empty), for O(1)
+  // lookups while collecting the near pairs; empty when the box would be too large.
+  std::vector<std::int32_t> dense_;
+  std::array<long, 3> dense_extent_{0, 0, 0};
+  void build_dense_index(const Level &fine);
+  long find_fine(const std::array<long, 3> &I) const; // as find(levels_[0], I)
 
   std::uint64_t key_of(const std::array<long, 3> &I) const;
   long find(const Level &level, const std::array<long, 3> &I) const; // −1 if empty

@@ -116,7 +116,33 @@ MagneticStats InducedDipoles::compute(const BeadArrays &beads, const AppliedFiel
     phase += now - clock;
     clock = now;
   };
+  // No applied field anywhere (before a field ramp starts, or a schedule at 0 mT): the
+  // induced dipoles are all zero, and so are the forces: nothing to solve. The next compute
+  // starts cold (from the applied-field dipoles).
+  evaluate_applied_field(beads, field);
+  zero_field_ = std::all_of(B0_.begin(), B0_.end(), [](double v) { return v == 0.0; });
+  if (zero_field_)
+  {
+    p_.clear();
+    force_.assign(3 * n, 0.0);
+    torque_.assign(3 * n, 0.0);
+    store_limits(beads);
+    for (std::size_t b = 0; b < n; ++b)
+      store_reference_position(beads, b);
+    t_last_ = time;
+    computed_ = true;
+    stats.zero_field = true;
+    lap(stats.time_tensors);
+    return stats;
+  }
+  lap(stats.time_tensors);
   double cutoff;
+  {
+    double sum = 0.0;
+    for (std::size_t b = 0; b < n; ++b)
+      sum += beads.radius[b];
+    skin_ = settings_.skin_fraction * 2.0 * sum / n;
+  }
   if (far_)
   {
     // No cutoff: the near pairs are those of neighbouring fine cells. Like a Verlet list,
@@ -153,7 +179,6 @@ MagneticStats InducedDipoles::compute(const BeadArrays &beads, const AppliedFiel
     refresh_list_if_needed(beads, cutoff, stats);
   }
   lap(stats.time_lists);
-  evaluate_applied_field(beads, field);
   evaluate_pair_tensors(beads, cutoff, stats);
   if (far_)
     build_near_entries();
@@ -171,16 +196,73 @@ MagneticStats InducedDipoles::compute(const BeadArrays &beads, const AppliedFiel
   gather_forces(out);
   lap(stats.time_forces);
 
-  x_last_.resize(3 * n);
+  store_limits(beads);
   for (std::size_t b = 0; b < n; ++b)
-  {
-    x_last_[3 * b] = beads.x[b];
-    x_last_[3 * b + 1] = beads.y[b];
-    x_last_[3 * b + 2] = beads.z[b];
-  }
+    store_reference_position(beads, b);
+  if (settings_.staleness_mode == StalenessMode::relative)
+    select_close_pairs(beads);
   t_last_ = time;
   computed_ = true;
   return stats;
+}
+
+void InducedDipoles::select_close_pairs(const BeadArrays &beads)
+{
+  // The pairs that can come within relative_check_radius mean radii before the list expires.
+  const auto &pairs = list_.pairs();
+  close_.clear();
+  close_of_pair_.assign(pairs.size(), -1);
+  min_radius_ = *std::min_element(beads.radius, beads.radius + beads.n);
+  max_radius_ = *std::max_element(beads.radius, beads.radius + beads.n);
+  const double f = settings_.staleness_fraction;
+  for (std::size_t k = 0; k < pairs.size(); ++k)
+  {
+    if (!active_[k])
+      continue;
+    const double a = 0.5 * (beads.radius[pairs[k].i] + beads.radius[pairs[k].j]);
+    const double reach = settings_.relative_check_radius * a + skin_;
+    const double *r = &r_[3 * k];
+    if (r[0] * r[0] + r[1] * r[1] + r[2] * r[2] >= reach * reach)
+      continue;
+    close_of_pair_[k] = static_cast<std::int32_t>(close_.size());
+    close_.push_back({pairs[k].i, pairs[k].j, {0, 0, 0}, f * f * a * a});
+    update_close_pair(k);
+  }
+}
+
+void InducedDipoles::update_close_pair(std::size_t k)
+{
+  if (close_of_pair_.size() != list_.pairs().size() || close_of_pair_[k] < 0)
+    return;
+  ClosePair &c = close_[static_cast<std::size_t>(close_of_pair_[k])];
+  for (int d = 0; d < 3; ++d)
+    c.c[d] = list_.pairs()[k].shift[d] - r_[3 * k + d];
+}
+
+double InducedDipoles::move_limit(const BeadArrays &beads, std::size_t b) const
+{
+  const double factor = settings_.staleness_mode == StalenessMode::relative ? settings_.absolute_factor : 1.0;
+  return factor * settings_.staleness_fraction * beads.radius[b];
+}
+
+void InducedDipoles::store_limits(const BeadArrays &beads)
+{
+  limit2_.resize(beads.n);
+  inv_radius2_.resize(beads.n);
+  for (std::size_t b = 0; b < beads.n; ++b)
+  {
+    const double limit = move_limit(beads, b);
+    limit2_[b] = limit * limit;
+    inv_radius2_[b] = 1.0 / (beads.radius[b] * beads.radius[b]);
+  }
+}
+
+void InducedDipoles::store_reference_position(const BeadArrays &beads, std::size_t b)
+{
+  x_last_.resize(3 * beads.n);
+  x_last_[3 * b] = beads.x[b];
+  x_last_[3 * b + 1] = beads.y[b];
+  x_last_[3 * b + 2] = beads.z[b];
 }
 
 void InducedDipoles::refresh_list_if_needed(const BeadArrays &beads, double cutoff,
@@ -225,35 +307,37 @@ void InducedDipoles::evaluate_applied_field(const BeadArrays &beads,
 void InducedDipoles::evaluate_pair_tensors(const BeadArrays &beads, double cutoff,
                                            MagneticStats &stats)
 {
-  const auto &pairs = list_.pairs();
-  const std::size_t np = pairs.size();
+  const std::size_t np = list_.pairs().size();
   tensor_.resize(np);
   r_.resize(3 * np);
   active_.resize(np);
-  const double rc2 = cutoff * cutoff;
+  cutoff_ = cutoff;
   std::size_t count = 0;
 #pragma omp parallel for schedule(static) reduction(+ : count) if (np >= parallel_threshold)
   for (long k = 0; k < static_cast<long>(np); ++k)
   {
-    const auto &p = pairs[k];
-    double r[3] = {beads.x[p.j] - beads.x[p.i] + p.shift[0],
-                   beads.y[p.j] - beads.y[p.i] + p.shift[1],
-                   beads.z[p.j] - beads.z[p.i] + p.shift[2]};
-    const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-    for (int d = 0; d < 3; ++d)
-      r_[3 * k + d] = r[d];
-    // Hard cutoff (as Kawamoto): pairs beyond it do not interact at all. Coincident
-    // centres (r = 0) cannot occur between non-overlapping beads; they are skipped.
-    active_[k] = (r2 < rc2 && r2 > 0.0);
-    if (active_[k])
-    {
-      tensor_[k] = DipoleTensor::at(r);
-      ++count;
-    }
-    else
-      tensor_[k] = {0, 0, 0, 0, 0, 0};
+    evaluate_pair_tensor(beads, k);
+    count += active_[k];
   }
   stats.pairs = count;
+}
+
+void InducedDipoles::evaluate_pair_tensor(const BeadArrays &beads, std::size_t k)
+{
+  const auto &p = list_.pairs()[k];
+  double r[3] = {beads.x[p.j] - beads.x[p.i] + p.shift[0],
+                 beads.y[p.j] - beads.y[p.i] + p.shift[1],
+                 beads.z[p.j] - beads.z[p.i] + p.shift[2]};
+  const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+  for (int d = 0; d < 3; ++d)
+    r_[3 * k + d] = r[d];
+  // Hard cutoff (as Kawamoto): pairs beyond it do not interact at all. Coincident
+  // centres (r = 0) cannot occur between non-overlapping beads; they are skipped.
+  active_[k] = (r2 < cutoff_ * cutoff_ && r2 > 0.0);
+  if (active_[k])
+    tensor_[k] = DipoleTensor::at(r);
+  else
+    tensor_[k] = {0, 0, 0, 0, 0, 0};
 }
 
 void InducedDipoles::build_near_entries()
@@ -266,6 +350,11 @@ void InducedDipoles::build_near_entries()
   near_begin_.assign(begin.begin(), begin.end());
   near_other_.resize(begin[n]);
   near_tensor_.resize(6 * begin[n]);
+  // Where each pair sits in the two beads' rows (a self-image pair twice in one row).
+  pair_entry_.resize(2 * pairs.size());
+  for (std::size_t b = 0; b < n; ++b)
+    for (std::size_t q = begin[b]; q < begin[b + 1]; ++q)
+      pair_entry_[2 * pair_of[q] + (first[q] ? 0 : 1)] = q;
 #pragma omp parallel for schedule(static) if (n >= parallel_threshold)
   for (long b = 0; b < static_cast<long>(n); ++b)
     for (std::size_t q = begin[b]; q < begin[b + 1]; ++q)
@@ -392,9 +481,10 @@ void InducedDipoles::solve_dipoles(const BeadArrays &beads, MagneticStats &stats
   stats.time_sweeps += omp_get_wtime() - t0;
 }
 
-void InducedDipoles::sweep_to_tolerance(const BeadArrays &beads, MagneticStats &stats)
+void InducedDipoles::sweep_to_tolerance(const BeadArrays &beads, MagneticStats &stats,
+                                        const std::vector<std::uint32_t> *subset)
 {
-  const std::size_t n = beads.n;
+  const std::size_t n = subset ? subset->size() : beads.n;
   // Jacobi sweeps: every bead's new dipole from the old dipoles of its neighbours. Order-free
   // within a sweep, hence parallel and thread-count independent. Plain Jacobi diverges when
   // the coupling matrix αT has an eigenvalue below −1 (e.g. a touching monolayer across the
@@ -411,8 +501,9 @@ void InducedDipoles::sweep_to_tolerance(const BeadArrays &beads, MagneticStats &
       evaluate_tail(p_);
     double max_change2 = 0.0, max_p2 = 0.0;
 #pragma omp parallel for schedule(static) reduction(max : max_change2, max_p2) if (n >= parallel_threshold)
-    for (long b = 0; b < static_cast<long>(n); ++b)
+    for (long m = 0; m < static_cast<long>(n); ++m)
     {
+      const std::size_t b = subset ? (*subset)[m] : static_cast<std::size_t>(m);
       double *B = &B_local_[3 * b];
       gather_local_field(b, p_, B);
       double *p = &p_next_[3 * b];
@@ -429,7 +520,12 @@ void InducedDipoles::sweep_to_tolerance(const BeadArrays &beads, MagneticStats &
       max_change2 = std::max(max_change2, change2);
       max_p2 = std::max(max_p2, p2);
     }
-    p_.swap(p_next_);
+    if (subset) // only the subset's dipoles were updated
+      for (const std::uint32_t b : *subset)
+        for (int d = 0; d < 3; ++d)
+          p_[3 * b + d] = p_next_[3 * b + d];
+    else
+      p_.swap(p_next_);
     stats.sweeps = first_sweep + sweep;
     stats.residual = max_p2 > 0.0 ? std::sqrt(max_change2 / max_p2) : 0.0;
     if (stats.residual <= settings_.tolerance)
@@ -544,30 +640,31 @@ void InducedDipoles::prepare_correction_tables()
 
 void InducedDipoles::evaluate_pair_forces(const BeadArrays &beads, MagneticStats &stats)
 {
-  const auto &pairs = list_.pairs();
-  const std::size_t np = pairs.size();
+  const std::size_t np = list_.pairs().size();
   pair_force_.resize(3 * np);
-  const bool corrected = settings_.model == DipoleModel::corrected;
   const TwoSphereTable *single_table = tables_.size() == 1 ? tables_.begin()->second.get() : nullptr;
   std::size_t corrected_pairs = 0;
 #pragma omp parallel for schedule(static) reduction(+ : corrected_pairs) if (np >= parallel_threshold)
   for (long k = 0; k < static_cast<long>(np); ++k)
-  {
-    double *F = &pair_force_[3 * k];
-    if (!active_[k])
-    {
-      F[0] = F[1] = F[2] = 0.0;
-      continue;
-    }
-    const std::uint32_t i = pairs[k].i, j = pairs[k].j;
-    const double *r = &r_[3 * k];
-    dipole_pair_force(r, &p_[3 * j], &p_[3 * i], F);
-    if (!corrected || far_)
-      continue; // (with the far field, the corrections have their own list)
-    if (add_correction(beads, i, j, r, tensor_[k], single_table, F))
-      ++corrected_pairs;
-  }
+    corrected_pairs += evaluate_pair_force(beads, k, single_table);
   stats.corrected_pairs = corrected_pairs;
+}
+
+bool InducedDipoles::evaluate_pair_force(const BeadArrays &beads, std::size_t k,
+                                         const TwoSphereTable *single_table)
+{
+  double *F = &pair_force_[3 * k];
+  if (!active_[k])
+  {
+    F[0] = F[1] = F[2] = 0.0;
+    return false;
+  }
+  const std::uint32_t i = list_.pairs()[k].i, j = list_.pairs()[k].j;
+  const double *r = &r_[3 * k];
+  dipole_pair_force(r, &p_[3 * j], &p_[3 * i], F);
+  if (settings_.model != DipoleModel::corrected || far_)
+    return false; // (with the far field, the corrections have their own list)
+  return add_correction(beads, i, j, r, tensor_[k], single_table, F);
 }
 
 bool InducedDipoles::add_correction(const BeadArrays &beads, std::uint32_t i, std::uint32_t j,
@@ -644,26 +741,28 @@ void InducedDipoles::refresh_correction_list(const BeadArrays &beads)
 
 void InducedDipoles::evaluate_correction_forces(const BeadArrays &beads, MagneticStats &stats)
 {
-  const auto &pairs = correction_list_.pairs();
-  const std::size_t np = pairs.size();
+  const std::size_t np = correction_list_.pairs().size();
   correction_force_.resize(3 * np);
   const TwoSphereTable *single_table = tables_.size() == 1 ? tables_.begin()->second.get() : nullptr;
   std::size_t corrected_pairs = 0;
 #pragma omp parallel for schedule(static) reduction(+ : corrected_pairs) if (np >= parallel_threshold)
   for (long k = 0; k < static_cast<long>(np); ++k)
-  {
-    double *F = &correction_force_[3 * k];
-    F[0] = F[1] = F[2] = 0.0;
-    const auto &pair = pairs[k];
-    const double r[3] = {beads.x[pair.j] - beads.x[pair.i] + pair.shift[0],
-                         beads.y[pair.j] - beads.y[pair.i] + pair.shift[1],
-                         beads.z[pair.j] - beads.z[pair.i] + pair.shift[2]};
-    if (r[0] * r[0] + r[1] * r[1] + r[2] * r[2] == 0.0)
-      continue;
-    if (add_correction(beads, pair.i, pair.j, r, DipoleTensor::at(r), single_table, F))
-      ++corrected_pairs;
-  }
+    corrected_pairs += evaluate_correction_force(beads, k, single_table);
   stats.corrected_pairs = corrected_pairs;
+}
+
+bool InducedDipoles::evaluate_correction_force(const BeadArrays &beads, std::size_t k,
+                                               const TwoSphereTable *single_table)
+{
+  double *F = &correction_force_[3 * k];
+  F[0] = F[1] = F[2] = 0.0;
+  const auto &pair = correction_list_.pairs()[k];
+  const double r[3] = {beads.x[pair.j] - beads.x[pair.i] + pair.shift[0],
+                       beads.y[pair.j] - beads.y[pair.i] + pair.shift[1],
+                       beads.z[pair.j] - beads.z[pair.i] + pair.shift[2]};
+  if (r[0] * r[0] + r[1] * r[1] + r[2] * r[2] == 0.0)
+    return false;
+  return add_correction(beads, pair.i, pair.j, r, DipoleTensor::at(r), single_table, F);
 }
 
 void InducedDipoles::gather_forces(const ForceArrays &out)
@@ -671,68 +770,69 @@ void InducedDipoles::gather_forces(const ForceArrays &out)
   const std::size_t n = beta_.size();
   force_.resize(3 * n);
   torque_.resize(3 * n);
+#pragma omp parallel for schedule(static) if (n >= parallel_threshold)
+  for (long b = 0; b < static_cast<long>(n); ++b)
+    gather_bead(b);
+  add_held_forces(out);
+}
+
+void InducedDipoles::gather_bead(std::size_t b)
+{
+  const double *p = &p_[3 * b];
+  const double *g = &gradB0_[9 * b];
+  // (p·∇)B_applied: F_a = Σ_c p_c ∂B_a/∂x_c.
+  double F[3];
+  for (int a = 0; a < 3; ++a)
+    F[a] = p[0] * g[3 * a] + p[1] * g[3 * a + 1] + p[2] * g[3 * a + 2];
+  // Slab tail: the sheets vary only along the open axis, F = n̂ (p·∂B_tail/∂u).
+  if (normal_axis_ >= 0)
+  {
+    const double *dB = &tail_dB_[3 * b];
+    F[normal_axis_] += p[0] * dB[0] + p[1] * dB[1] + p[2] * dB[2];
+  }
+  // Far field: (p·∇)B_far.
+  if (far_)
+  {
+    const double *gf = &gradB_far_[9 * b];
+    for (int a = 0; a < 3; ++a)
+      F[a] += p[0] * gf[3 * a] + p[1] * gf[3 * a + 1] + p[2] * gf[3 * a + 2];
+  }
+  // Pair forces are stored as the force on the pair's j bead; its i bead gets the negative.
   const auto &begin = list_.incident_begin();
   const auto &pair_of = list_.incident_pair();
   const auto &first = list_.incident_first();
-  const bool paper_torque = settings_.torque == TorqueModel::paper;
-  const bool corrected = settings_.model == DipoleModel::corrected;
-#pragma omp parallel for schedule(static) if (n >= parallel_threshold)
-  for (long b = 0; b < static_cast<long>(n); ++b)
+  for (std::size_t q = begin[b]; q < begin[b + 1]; ++q)
   {
-    const double *p = &p_[3 * b];
-    const double *g = &gradB0_[9 * b];
-    // (p·∇)B_applied: F_a = Σ_c p_c ∂B_a/∂x_c.
-    double F[3];
+    const double *Fp = &pair_force_[3 * pair_of[q]];
+    const double sign = first[q] ? -1.0 : 1.0;
     for (int a = 0; a < 3; ++a)
-      F[a] = p[0] * g[3 * a] + p[1] * g[3 * a + 1] + p[2] * g[3 * a + 2];
-    // Slab tail: the sheets vary only along the open axis, F = n̂ (p·∂B_tail/∂u).
-    if (normal_axis_ >= 0)
+      F[a] += sign * Fp[a];
+  }
+  if (far_ && settings_.model == DipoleModel::corrected)
+  {
+    const auto &cbegin = correction_list_.incident_begin();
+    const auto &cpair = correction_list_.incident_pair();
+    const auto &cfirst = correction_list_.incident_first();
+    for (std::size_t q = cbegin[b]; q < cbegin[b + 1]; ++q)
     {
-      const double *dB = &tail_dB_[3 * b];
-      F[normal_axis_] += p[0] * dB[0] + p[1] * dB[1] + p[2] * dB[2];
-    }
-    // Far field: (p·∇)B_far.
-    if (far_)
-    {
-      const double *gf = &gradB_far_[9 * b];
-      for (int a = 0; a < 3; ++a)
-        F[a] += p[0] * gf[3 * a] + p[1] * gf[3 * a + 1] + p[2] * gf[3 * a + 2];
-    }
-    // Pair forces are stored as the force on the pair's j bead; its i bead gets the negative.
-    for (std::size_t q = begin[b]; q < begin[b + 1]; ++q)
-    {
-      const double *Fp = &pair_force_[3 * pair_of[q]];
-      const double sign = first[q] ? -1.0 : 1.0;
+      const double *Fp = &correction_force_[3 * cpair[q]];
+      const double sign = cfirst[q] ? -1.0 : 1.0;
       for (int a = 0; a < 3; ++a)
         F[a] += sign * Fp[a];
     }
-    if (far_ && corrected)
-    {
-      const auto &cbegin = correction_list_.incident_begin();
-      const auto &cpair = correction_list_.incident_pair();
-      const auto &cfirst = correction_list_.incident_first();
-      for (std::size_t q = cbegin[b]; q < cbegin[b + 1]; ++q)
-      {
-        const double *Fp = &correction_force_[3 * cpair[q]];
-        const double sign = cfirst[q] ? -1.0 : 1.0;
-        for (int a = 0; a < 3; ++a)
-          F[a] += sign * Fp[a];
-      }
-    }
-    double *T = &torque_[3 * b];
-    if (paper_torque)
-    {
-      const double *B = &B_local_[3 * b];
-      T[0] = p[1] * B[2] - p[2] * B[1];
-      T[1] = p[2] * B[0] - p[0] * B[2];
-      T[2] = p[0] * B[1] - p[1] * B[0];
-    }
-    else
-      T[0] = T[1] = T[2] = 0.0;
-    for (int a = 0; a < 3; ++a)
-      force_[3 * b + a] = F[a];
   }
-  add_held_forces(out);
+  double *T = &torque_[3 * b];
+  if (settings_.torque == TorqueModel::paper)
+  {
+    const double *B = &B_local_[3 * b];
+    T[0] = p[1] * B[2] - p[2] * B[1];
+    T[1] = p[2] * B[0] - p[0] * B[2];
+    T[2] = p[0] * B[1] - p[1] * B[0];
+  }
+  else
+    T[0] = T[1] = T[2] = 0.0;
+  for (int a = 0; a < 3; ++a)
+    force_[3 * b + a] = F[a];
 }
 
 void InducedDipoles::add_held_forces(const ForceArrays &out) const
@@ -770,26 +870,316 @@ void InducedDipoles::particles_reordered(const std::vector<std::int32_t> &order)
   permute(x_last_);
   list_ = MagneticNeighbourList(); // pair indices refer to the old order
   correction_list_ = MagneticNeighbourList();
+  close_.clear();                  // (the watched pairs too, until the next compute)
+  close_of_pair_.clear();
 }
 
 bool InducedDipoles::needs_refresh(const BeadArrays &beads, double time) const
 {
-  if (!computed_ || x_last_.size() != 3 * beads.n)
-    return true;
+  return check_staleness(beads, time).reason != RefreshReason::none;
+}
+
+StalenessCheck InducedDipoles::check_staleness(const BeadArrays &beads, double time) const
+{
+  StalenessCheck c;
+  if (!computed_)
+  {
+    c.reason = RefreshReason::first;
+    return c;
+  }
+  if (x_last_.size() != 3 * beads.n)
+  {
+    c.reason = RefreshReason::bead_count;
+    return c;
+  }
   if (settings_.refresh_interval <= 0.0 ||
       time - t_last_ >= settings_.refresh_interval * (1.0 - 1e-9))
-    return true;
-  bool moved = false;
-#pragma omp parallel for schedule(static) reduction(|| : moved) if (beads.n >= parallel_threshold)
-  for (long b = 0; b < static_cast<long>(beads.n); ++b)
   {
-    const double dx = beads.x[b] - x_last_[3 * b], dy = beads.y[b] - x_last_[3 * b + 1],
-                 dz = beads.z[b] - x_last_[3 * b + 2];
-    const double limit = settings_.staleness_fraction * beads.radius[b];
-    if (dx * dx + dy * dy + dz * dz > limit * limit)
-      moved = true;
+    c.reason = RefreshReason::interval;
+    return c;
   }
-  return moved;
+  // A bead is stale when it moved more than staleness_fraction × its radius since its force
+  // was evaluated. The minimum image: a bead wrapped across a periodic face by the caller did
+  // not move (the neighbour lists see the jump and are rebuilt at the next compute).
+  const bool relative = settings_.staleness_mode == StalenessMode::relative && list_.built() &&
+                        list_.particle_count() == beads.n;
+  if (relative)
+    move2_.resize(beads.n);
+  std::size_t stale = 0;
+  double worst2 = 0.0;
+  for (std::size_t b = 0; b < beads.n; ++b)
+  {
+    const double move2 = squared_move(beads, b);
+    stale += move2 > limit2_[b];
+    worst2 = std::max(worst2, move2 * inv_radius2_[b]);
+    if (relative)
+      move2_[b] = move2;
+  }
+  c.stale_beads = stale;
+  c.max_move = std::sqrt(worst2);
+  // relative: the watched pairs whose vector changed by more than the fraction. A pair can
+  // only be stale if one of its beads moved half its limit (|Δr| ≤ |Δx_i| + |Δx_j|): the
+  // pair loop is skipped while no bead has, and pairs of beads that have not are skipped.
+  if (relative && 2.0 * c.max_move * max_radius_ > settings_.staleness_fraction * min_radius_)
+  {
+    std::size_t stale_pairs = 0;
+    for (const ClosePair &p : close_)
+      if (4.0 * std::max(move2_[p.i], move2_[p.j]) > p.limit2)
+        stale_pairs += drift2(beads, p) > p.limit2;
+    c.stale_pairs = stale_pairs;
+  }
+  if (stale > 0 || c.stale_pairs > 0)
+    c.reason = RefreshReason::moved;
+  return c;
+}
+
+double InducedDipoles::squared_move(const BeadArrays &beads, std::size_t b) const
+{
+  double d[3] = {beads.x[b] - x_last_[3 * b], beads.y[b] - x_last_[3 * b + 1],
+                 beads.z[b] - x_last_[3 * b + 2]};
+  for (int a = 0; a < 3; ++a)
+    if (box_[a] > 0.0 && std::abs(d[a]) > 0.5 * box_[a])
+      d[a] -= box_[a] * std::round(d[a] / box_[a]);
+  return d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+}
+
+bool InducedDipoles::linear() const
+{
+  return std::all_of(Ms_.begin(), Ms_.end(), [](double m) { return m == 0.0; });
+}
+
+void InducedDipoles::scale_applied_field(double ratio)
+{
+  if (!linear())
+    throw std::logic_error("magnetics: scale_applied_field() needs linear beads (p ∝ B); these "
+                           "saturate. Refresh instead.");
+  // Every stored field and dipole is linear in the applied field, every force quadratic.
+  for (auto *v : {&B0_, &gradB0_, &p_, &B_local_, &B_far_, &gradB_far_, &tail_B_, &tail_dB_})
+    for (double &x : *v)
+      x *= ratio;
+  const double ratio2 = ratio * ratio;
+  for (auto *v : {&force_, &torque_, &pair_force_, &correction_force_})
+    for (double &x : *v)
+      x *= ratio2;
+}
+
+bool InducedDipoles::refresh_locally(const BeadArrays &beads, const AppliedFieldFunction &field,
+                                     double time, MagneticStats &stats)
+{
+  (void)time; // the refresh interval counts from the last full compute()
+  stats = MagneticStats();
+  const std::size_t n = beads.n;
+  const double t_start = omp_get_wtime();
+  region_.clear();
+  // Can a local refresh stand in for a full one? The neighbour lists must still hold every
+  // pair the full evaluation would use (no bead moved half the skin, none was wrapped).
+  if (!computed_ || zero_field_ || x_last_.size() != 3 * n || p_.size() != 3 * n ||
+      force_.size() != 3 * n || normal_axis_ >= 0 || !list_.built() || list_.particle_count() != n)
+    return false;
+  if (list_.max_displacement(n, beads.x, beads.y, beads.z) > 0.5 * skin_)
+    return false;
+  const bool far_corrections = far_ && settings_.model == DipoleModel::corrected;
+  if (far_corrections && (!correction_list_.built() || correction_list_.particle_count() != n ||
+                          correction_list_.max_displacement(n, beads.x, beads.y, beads.z) > 0.5 * skin_))
+    return false;
+
+  // 1. The moved beads, and the region R: them and their near neighbours.
+  // Batched: once one bead is past the limit, every bead past local_batch_fraction of it
+  // comes along, so that the next one does not trigger another refresh a step later.
+  // relative: the beads of the watched pairs whose vector changed past the batch fraction.
+  moved_.clear();
+  bool due = false;
+  const double batch2 = settings_.local_batch_fraction * settings_.local_batch_fraction;
+  bead_mark_.assign(n, 0);
+  enum : std::uint8_t { in_region = 1, in_gather = 2, is_moved = 4 };
+  auto add_moved = [&](std::uint32_t b) {
+    if (!(bead_mark_[b] & is_moved))
+    {
+      bead_mark_[b] |= is_moved;
+      moved_.push_back(b);
+    }
+  };
+  for (std::size_t b = 0; b < n; ++b)
+  {
+    const double move2 = squared_move(beads, b);
+    due |= move2 > limit2_[b];
+    if (move2 > batch2 * limit2_[b])
+      add_moved(static_cast<std::uint32_t>(b));
+  }
+  if (settings_.staleness_mode == StalenessMode::relative)
+  {
+    for (const ClosePair &p : close_)
+    {
+      const double d2 = drift2(beads, p);
+      due |= d2 > p.limit2;
+      if (d2 > batch2 * p.limit2)
+      {
+        // The bead(s) that made the drift: |Δr| ≤ |Δx_i| + |Δx_j|, so at least one of them
+        // moved half of it (re-evaluating one re-evaluates the pair).
+        const double half2 = 0.25 * d2;
+        if (squared_move(beads, p.i) >= half2)
+          add_moved(p.i);
+        if (squared_move(beads, p.j) >= half2)
+          add_moved(p.j);
+      }
+    }
+  }
+  if (!due)
+    return true;
+  std::sort(moved_.begin(), moved_.end());
+  const auto &pairs = list_.pairs();
+  const auto &begin = list_.incident_begin();
+  const auto &pair_of = list_.incident_pair();
+  const auto &first = list_.incident_first();
+  region_.clear();
+  auto add_to_region = [&](std::uint32_t b) {
+    if (!(bead_mark_[b] & in_region))
+    {
+      bead_mark_[b] |= in_region;
+      region_.push_back(b);
+    }
+  };
+  for (const std::uint32_t b : moved_)
+  {
+    add_to_region(b);
+    // Its neighbours within local_region_radius of its own radius (current positions).
+    const double reach = settings_.local_region_radius * beads.radius[b];
+    for (std::size_t q = begin[b]; q < begin[b + 1]; ++q)
+    {
+      const auto &pair = pairs[pair_of[q]];
+      const double r[3] = {beads.x[pair.j] - beads.x[pair.i] + pair.shift[0],
+                           beads.y[pair.j] - beads.y[pair.i] + pair.shift[1],
+                           beads.z[pair.j] - beads.z[pair.i] + pair.shift[2]};
+      if (r[0] * r[0] + r[1] * r[1] + r[2] * r[2] < reach * reach)
+        add_to_region(first[q] ? pair.j : pair.i);
+    }
+  }
+  // (A small region is always cheaper than a full refresh, whatever the fraction.)
+  if (region_.size() > 64 &&
+      static_cast<double>(region_.size()) > settings_.local_region_limit * static_cast<double>(n))
+    return false;
+  std::sort(region_.begin(), region_.end()); // a fixed order, whatever the discovery order
+
+  // 2. The moved beads' applied field and the tensors of their pairs (each pair once).
+  for (const std::uint32_t b : moved_)
+  {
+    const double x[3] = {beads.x[b], beads.y[b], beads.z[b]};
+    double B[3], g[3][3];
+    field(x, B, g);
+    for (int a = 0; a < 3; ++a)
+    {
+      B0_[3 * b + a] = B[a];
+      for (int c = 0; c < 3; ++c)
+        gradB0_[9 * b + 3 * a + c] = g[a][c];
+    }
+    store_reference_position(beads, b);
+  }
+  pair_mark_.assign(pairs.size(), 0);
+  touched_pairs_.clear();
+  for (const std::uint32_t b : moved_)
+    for (std::size_t q = begin[b]; q < begin[b + 1]; ++q)
+      if (!pair_mark_[pair_of[q]])
+      {
+        pair_mark_[pair_of[q]] = 1;
+        touched_pairs_.push_back(pair_of[q]);
+      }
+  for (const std::uint32_t k : touched_pairs_)
+  {
+    evaluate_pair_tensor(beads, k);
+    update_close_pair(k);
+    if (far_)
+    { // the per-bead copies the sweeps read
+      const DipoleTensor &T = tensor_[k];
+      for (int side = 0; side < 2; ++side)
+      {
+        double *t = &near_tensor_[6 * pair_entry_[2 * k + side]];
+        t[0] = T.xx;
+        t[1] = T.yy;
+        t[2] = T.zz;
+        t[3] = T.xy;
+        t[4] = T.xz;
+        t[5] = T.yz;
+      }
+    }
+  }
+
+  // 3. The dipoles of R, from the held ones, with everything outside R held.
+  const double t_sweeps = omp_get_wtime();
+  region_p_.resize(3 * region_.size());
+  for (std::size_t m = 0; m < region_.size(); ++m)
+    for (int d = 0; d < 3; ++d)
+      region_p_[3 * m + d] = p_[3 * region_[m] + d];
+  sweep_to_tolerance(beads, stats, &region_);
+  stats.time_sweeps = omp_get_wtime() - t_sweeps;
+  // The beads whose interactions changed: the moved ones, and those of R whose dipole changed
+  // by more than local_dipole_change (the dipole change decays like 1/r³ from a moved bead:
+  // beyond its touching neighbours it is far below a per cent of the moved bead's own).
+  changed_.clear();
+  const double tol2 = settings_.local_dipole_change * settings_.local_dipole_change;
+  for (std::size_t m = 0; m < region_.size(); ++m)
+  {
+    const std::uint32_t b = region_[m];
+    double dp2 = 0.0, p2 = 0.0;
+    for (int d = 0; d < 3; ++d)
+    {
+      const double dp = p_[3 * b + d] - region_p_[3 * m + d];
+      dp2 += dp * dp;
+      p2 += p_[3 * b + d] * p_[3 * b + d];
+    }
+    if ((bead_mark_[b] & is_moved) || tol2 == 0.0 || dp2 > tol2 * p2)
+      changed_.push_back(b);
+  }
+
+  // 4. The force of every pair touching a changed bead, and 5. the total force of every bead
+  //    touching those pairs (pair forces stored once, applied ±: Newton's third law exact).
+  const double t_forces = omp_get_wtime();
+  const TwoSphereTable *single_table = tables_.size() == 1 ? tables_.begin()->second.get() : nullptr;
+  gathered_.clear();
+  auto add_to_gather = [&](std::uint32_t b) {
+    if (!(bead_mark_[b] & in_gather))
+    {
+      bead_mark_[b] |= in_gather;
+      gathered_.push_back(b);
+    }
+  };
+  for (const std::uint32_t b : changed_)
+    for (std::size_t q = begin[b]; q < begin[b + 1]; ++q)
+      if (pair_mark_[pair_of[q]] != 2)
+      {
+        const std::uint32_t k = pair_of[q];
+        pair_mark_[k] = 2;
+        stats.corrected_pairs += evaluate_pair_force(beads, k, single_table);
+        ++stats.local_pairs;
+        add_to_gather(pairs[k].i);
+        add_to_gather(pairs[k].j);
+      }
+  if (far_corrections)
+  {
+    const auto &cpairs = correction_list_.pairs();
+    const auto &cbegin = correction_list_.incident_begin();
+    const auto &cpair = correction_list_.incident_pair();
+    correction_mark_.assign(cpairs.size(), 0);
+    for (const std::uint32_t b : changed_)
+      for (std::size_t q = cbegin[b]; q < cbegin[b + 1]; ++q)
+        if (!correction_mark_[cpair[q]])
+        {
+          const std::uint32_t k = cpair[q];
+          correction_mark_[k] = 1;
+          stats.corrected_pairs += evaluate_correction_force(beads, k, single_table);
+          add_to_gather(cpairs[k].i);
+          add_to_gather(cpairs[k].j);
+        }
+  }
+  for (const std::uint32_t b : gathered_)
+    gather_bead(b);
+  stats.time_forces = omp_get_wtime() - t_forces;
+
+  stats.local_moved = moved_.size();
+  stats.local_region = region_.size();
+  stats.local_gathered = gathered_.size();
+  stats.pairs = touched_pairs_.size();
+  stats.time_tensors = t_sweeps - t_start;
+  return true;
 }
 
 } // namespace magbrush::magnetics

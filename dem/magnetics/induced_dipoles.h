@@ -17,9 +17,11 @@
 // bit-identical for any number of OpenMP threads. Between neighbour-list rebuilds no memory
 // is allocated (a rebuild uses temporary cell arrays; a new β builds its table once).
 //
-// The DEM may hold the magnetic forces between evaluations: needs_refresh() says when to
-// evaluate again (interval elapsed, or a bead moved more than a fraction of its radius), and
-// add_held_forces() adds the forces of the last evaluation.
+// The DEM may hold the magnetic forces between evaluations: check_staleness() says when and
+// why they are stale (interval elapsed; beads or close pairs moved past a fraction of a radius,
+// by the StalenessMode), refresh_locally() renews them around what moved (holding the far
+// field and everyone else's dipoles), compute() renews everything, and add_held_forces() adds
+// the forces of the last evaluation.
 #pragma once
 
 #include "cell_multipole_field.h"
@@ -80,6 +82,23 @@ struct MagneticStats
   // Wall time of the phases [s]: neighbour lists / cells, applied field + pair tensors,
   // far field, sweeps (near field), pair forces + gather.
   double time_lists = 0, time_tensors = 0, time_far = 0, time_sweeps = 0, time_forces = 0;
+  // The applied field was zero at every bead: no dipoles, no forces, nothing solved.
+  bool zero_field = false;
+  // refresh_locally(): beads that moved past the staleness limit, the region whose dipoles
+  // were solved again (those and their near neighbours), pairs whose force was recomputed,
+  // beads whose force was gathered again. All 0 after a full compute().
+  std::size_t local_moved = 0, local_region = 0, local_pairs = 0, local_gathered = 0;
+};
+
+// Why a refresh is due (InducedDipoles::check_staleness).
+enum class RefreshReason { none, first, bead_count, interval, moved };
+
+struct StalenessCheck
+{
+  RefreshReason reason = RefreshReason::none;
+  std::size_t stale_beads = 0; // beads past the staleness limit
+  std::size_t stale_pairs = 0; // relative mode: watched pairs past it
+  double max_move = 0.0;       // largest displacement since the bead's last evaluation / radius
 };
 
 class InducedDipoles
@@ -96,11 +115,37 @@ public:
 
   // True when the held forces are stale: never computed, bead count changed, the refresh
   // interval has elapsed since the last compute(), or some bead moved more than
-  // staleness_fraction × its radius since then.
+  // staleness_fraction × its radius since its force was evaluated (minimum image: a
+  // periodic wrap is no move). check_staleness() says which, and how many beads moved.
   bool needs_refresh(const BeadArrays &beads, double time) const;
+  StalenessCheck check_staleness(const BeadArrays &beads, double time) const;
 
-  // Adds the forces (and torques) of the last compute() again.
+  // Adds the forces (and torques) of the last compute() / refresh_locally() again.
   void add_held_forces(const ForceArrays &out) const;
+
+  // The local refresh (StalenessMode::local): re-evaluates the magnetics around the beads
+  // that moved more than staleness_fraction × their radius since their forces were last
+  // evaluated, holding everything else:
+  //   1. the moved beads' applied field and the tensors of their near pairs;
+  //   2. the dipoles of the region R = moved beads + their near neighbours, Jacobi sweeps to
+  //      the tolerance with the dipoles outside R and the far field held;
+  //   3. the force of every pair touching R (stored once per pair and applied ±: Newton's
+  //      third law stays exact), `corrected` pairs included, and the far-field force of R;
+  //   4. the total force of every bead touching those pairs, gathered in the fixed order.
+  // The refresh interval still counts from the last full compute(). Returns false and
+  // changes nothing when a local refresh cannot stand in for a full one: nothing computed
+  // yet, the bead count changed, a neighbour list expired (a bead moved half the skin or was
+  // wrapped), the slab tail is on, or R would exceed local_region_limit of the beads; the
+  // caller then calls compute(). With no moved bead it does nothing and returns true.
+  bool refresh_locally(const BeadArrays &beads, const AppliedFieldFunction &field, double time,
+                       MagneticStats &stats);
+
+  // Linear beads only (no saturation): the applied field was scaled by `ratio` (a ramp):
+  // scales the held dipoles, fields and forces accordingly (p ∝ B, F ∝ B²: exact), so that a
+  // local refresh continues from a consistent state. Throws for saturating beads.
+  void scale_applied_field(double ratio);
+  // True when every bead of the last compute() is linear (no saturation magnetisation).
+  bool linear() const;
 
   // Forget the dipoles (the next compute starts from the applied-field dipoles).
   void reset_dipoles() { p_.clear(); }
@@ -110,6 +155,8 @@ public:
   void particles_reordered(const std::vector<std::int32_t> &order);
 
   const MagneticSettings &settings() const { return settings_; }
+  // relative: the pairs whose relative displacement is watched.
+  std::size_t watched_pairs() const { return close_.size(); }
   const MagneticNeighbourList &neighbour_list() const { return list_; }
   // Dipoles [A m²] and local fields B_j [T] (applied + other dipoles) of the last compute,
   // interleaved (x, y, z) per bead.
@@ -125,8 +172,11 @@ private:
 
   // Per bead (interleaved x, y, z; gradients 9 per bead).
   std::vector<double> beta_, Ms_, B0_, gradB0_, p_, p_next_, B_local_, force_, torque_;
-  std::vector<double> x_last_; // positions at the last compute (staleness check)
-  double t_last_ = 0.0;
+  std::vector<double> x_last_; // per bead: position at its last force evaluation (staleness)
+  double t_last_ = 0.0;         // time of the last full compute()
+  bool zero_field_ = false;     // the last compute() found no applied field at any bead
+  double cutoff_ = 0.0;         // pair cutoff of the last compute (∞ with the far field)
+  double skin_ = 0.0;           // Verlet skin of the last compute [m]
   bool computed_ = false;
 
   // Per pair within the list: dipole tensor, pair vector, active flag, force on the j bead.
@@ -162,6 +212,29 @@ private:
   std::vector<double> near_tensor_; // 6 per entry
   MagneticNeighbourList correction_list_;
   std::vector<double> correction_force_;
+  // Both incidence entries (i side, j side) of every near pair: a local refresh updates the
+  // per-bead tensor copies of a pair it recomputes.
+  std::vector<std::size_t> pair_entry_;
+
+  // Local refresh work space: marks per bead / pair (cleared after use) and index lists.
+  std::vector<std::uint8_t> bead_mark_, pair_mark_, correction_mark_;
+  std::vector<std::uint32_t> moved_, region_, changed_, gathered_, touched_pairs_;
+  std::vector<double> region_p_; // the region's dipoles before the local sweeps
+  // relative: the pairs whose relative displacement is watched, compact for the per-step
+  // check: drift = x_j − x_i + c, c = image shift − pair vector at the tensor's evaluation;
+  // stale when |drift|² > limit2 = (staleness_fraction × mean radius)². close_of_pair_[k] =
+  // the record of list pair k (−1 = not watched).
+  struct ClosePair
+  {
+    std::uint32_t i, j;
+    double c[3];
+    double limit2;
+  };
+  std::vector<ClosePair> close_;
+  std::vector<std::int32_t> close_of_pair_;
+  double min_radius_ = 0.0, max_radius_ = 0.0;
+  mutable std::vector<double> move2_; // per-step scratch of check_staleness: |Δx_b|²
+  std::vector<double> limit2_, inv_radius2_; // per bead: move_limit², 1/radius²
 
   double cutoff_length(const BeadArrays &beads) const;
   void refresh_list_if_needed(const BeadArrays &beads, double cutoff, MagneticStats &stats);
@@ -172,7 +245,32 @@ private:
   void evaluate_tail(const std::vector<double> &p);
   void gather_local_field(std::size_t b, const std::vector<double> &p, double B[3]) const;
   void solve_dipoles(const BeadArrays &beads, MagneticStats &stats);
-  void sweep_to_tolerance(const BeadArrays &beads, MagneticStats &stats);
+  // Jacobi sweeps over all beads, or over `subset` only (the others' dipoles held).
+  void sweep_to_tolerance(const BeadArrays &beads, MagneticStats &stats,
+                          const std::vector<std::uint32_t> *subset = nullptr);
+  // Pair k's vector, tensor and active flag at the current positions.
+  void evaluate_pair_tensor(const BeadArrays &beads, std::size_t k);
+  // Pair k's force on its j bead (dipole–dipole, plus the correction with a hard cutoff).
+  bool evaluate_pair_force(const BeadArrays &beads, std::size_t k, const TwoSphereTable *single);
+  bool evaluate_correction_force(const BeadArrays &beads, std::size_t k, const TwoSphereTable *single);
+  // Bead b's total force and torque from the stored pair forces, in the fixed order.
+  void gather_bead(std::size_t b);
+  void store_reference_position(const BeadArrays &beads, std::size_t b);
+  void store_limits(const BeadArrays &beads); // limit2_, inv_radius2_ of the beads
+  // |x_b − x_last,b|² (minimum image along periodic axes).
+  double squared_move(const BeadArrays &beads, std::size_t b) const;
+  // Bead b's staleness limit on its absolute move [m]: staleness_fraction × radius, times
+  // absolute_factor in the relative mode.
+  double move_limit(const BeadArrays &beads, std::size_t b) const;
+  // relative: |Δr|² of a watched pair since its tensor was evaluated [m²].
+  static double drift2(const BeadArrays &beads, const ClosePair &c)
+  {
+    const double d[3] = {beads.x[c.j] - beads.x[c.i] + c.c[0], beads.y[c.j] - beads.y[c.i] + c.c[1],
+                         beads.z[c.j] - beads.z[c.i] + c.c[2]};
+    return d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+  }
+  void select_close_pairs(const BeadArrays &beads);
+  void update_close_pair(std::size_t k); // after pair k's tensor was re-evaluated
   void refresh_correction_list(const BeadArrays &beads);
   void evaluate_correction_forces(const BeadArrays &beads, MagneticStats &stats);
   // Adds the exact-minus-mutual two-sphere force of pair (i, j), r = x_j − x_i, to F (the

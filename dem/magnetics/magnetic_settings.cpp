@@ -45,6 +45,29 @@ std::string to_string(FarField far_field)
   return far_field == FarField::none ? "none" : "cell_multipole";
 }
 
+StalenessMode parse_staleness_mode(const std::string &name)
+{
+  if (name == "absolute")
+    return StalenessMode::absolute;
+  if (name == "local")
+    return StalenessMode::local;
+  if (name == "relative")
+    return StalenessMode::relative;
+  throw std::invalid_argument("magnetic staleness mode: expected relative, local or absolute; found '" + name +
+                              "'. Set dem.magnetic_staleness_mode to one of these.");
+}
+
+std::string to_string(StalenessMode mode)
+{
+  switch (mode)
+  {
+    case StalenessMode::absolute: return "absolute";
+    case StalenessMode::local: return "local";
+    case StalenessMode::relative: return "relative";
+  }
+  return "?";
+}
+
 MagneticSettings MagneticSettings::from_case(const DemSettings &dem)
 {
   MagneticSettings s;
@@ -57,6 +80,7 @@ MagneticSettings MagneticSettings::from_case(const DemSettings &dem)
   s.far_order = dem.magnetic_far_order;
   s.far_cell_diameters = dem.magnetic_far_cell;
   s.staleness_fraction = dem.magnetic_staleness;
+  s.staleness_mode = parse_staleness_mode(dem.magnetic_staleness_mode);
   return s;
 }
 

@@ -1,6 +1,8 @@
 // The DEM adapter: two carriers (and one toner) in the engine, in a uniform field, receive the
 // mutual-dipole pair force; the toner receives nothing; held forces are reused between
-// refreshes and follow the engine's particle re-sorting.
+// refreshes and follow the engine's particle re-sorting; an engine wrap and re-sort are no
+// move; the ramp (held forces ∝ s²) and the local refresh through the engine; the
+// staleness-mode key.
 #include "magnetic_force_term.h"
 #include "two_sphere_exact.h"
 
@@ -91,4 +93,101 @@ TEST(MagneticForceTerm, PairForceThroughTheEngine)
   EXPECT_EQ(upper2, 2 - upper);
   EXPECT_NEAR(f.fz[upper2], expected, 1e-9 * std::abs(expected));
   system.add_force_term(std::move(owned));
+}
+
+// The case key of the staleness mode: its default is the contract struct's, and every mode
+// name parses (a bad one names the key).
+TEST(MagneticForceTerm, StalenessModeKey)
+{
+  Case c = parse_case_text(scene, "magnetic_pair.yaml");
+  EXPECT_EQ(c.dem.magnetic_staleness_mode, DemSettings{}.magnetic_staleness_mode);
+  EXPECT_EQ(MagneticSettings::from_case(c.dem).staleness_mode, StalenessMode::relative);
+  for (const char *mode : {"relative", "local", "absolute"})
+    EXPECT_EQ(to_string(parse_staleness_mode(mode)), mode);
+  EXPECT_THROW(parse_staleness_mode("sometimes"), std::invalid_argument);
+}
+
+// Through the engine, a pair of carriers in a ramped uniform field: nothing is solved while
+// the field is zero, the field coming on is evaluated at once, the held forces follow the ramp
+// exactly (F ∝ B²), and a carrier pulled along the axis gets a local refresh (no full one)
+// that gives the exact mutual-dipole force at the new separation.
+TEST(MagneticForceTerm, RampAndLocalRefreshThroughTheEngine)
+{
+  Case c = parse_case_text(scene, "magnetic_pair.yaml");
+  dem::DemSystem system(c);
+  auto &p = system.particles();
+  const double a = 30e-6, D = 2.5, ramp = 1e-5;
+  p.add({0.5e-3, 0.5e-3, 0.4e-3}, a, 2200.0, 0, 0.0);
+  p.add({0.5e-3, 0.5e-3, 0.4e-3 + D * a}, a, 2200.0, 0, 0.0);
+  system.initialize();
+  MagneticSettings s = MagneticSettings::from_case(c.dem);
+  s.tolerance = 1e-13;
+  MagneticForceTerm term(c, s, AppliedMagneticField::uniform({0, 0, 1}, 0.13, ramp), system.box().length);
+  const double beta = (3.9 - 1) / (3.9 + 2);
+  auto expected = [&](double t, double separation) { // on the upper bead, along +z
+    const double H = 0.13 * std::min(1.0, t / ramp) / mu0;
+    return mu0 * H * H * mutual_dipole_pair_force(a, beta, separation).parallel;
+  };
+  const std::size_t upper = p.z[0] > p.z[1] ? 0 : 1;
+  dem::ForceBuffers f;
+  f.resize(2);
+  auto step = [&](double t) {
+    f.clear();
+    term.add_forces(p, f, t);
+  };
+  step(0.0);
+  EXPECT_EQ(term.refresh_counts().zero_field, 1);
+  EXPECT_EQ(f.fz[upper], 0.0);
+  step(1e-8); // the field came on
+  EXPECT_EQ(term.evaluations(), 2);
+  EXPECT_NEAR(f.fz[upper], expected(1e-8, D * a), 1e-9 * std::abs(expected(1e-8, D * a)));
+  step(2e-6); // held, rescaled by (s(t)/s_held)²
+  EXPECT_EQ(term.evaluations(), 2);
+  EXPECT_NEAR(f.fz[upper], expected(2e-6, D * a), 1e-9 * std::abs(expected(2e-6, D * a)));
+  p.z[upper] += 0.08 * a;
+  step(3e-6); // pulled by 8 % of a radius: a local refresh
+  EXPECT_EQ(term.evaluations(), 2);
+  EXPECT_EQ(term.local_refreshes(), 1);
+  EXPECT_NEAR(f.fz[upper], expected(3e-6, (D + 0.08) * a), 1e-9 * std::abs(expected(3e-6, (D + 0.08) * a)));
+  EXPECT_EQ(f.fz[1 - upper], -f.fz[upper]);
+  std::vector<double> fx, fy, fz;
+  term.last_forces(fx, fy, fz);
+  EXPECT_EQ(fz[upper], f.fz[upper]);
+}
+
+// The engine wraps beads into [0, L) along periodic axes at its list rebuilds and re-sorts its
+// arrays: neither is a move for the magnetics (no refresh, the same forces, the lists kept).
+TEST(MagneticForceTerm, EngineWrapAndResortAreNoMove)
+{
+  Case c = parse_case_text(scene, "magnetic_pair.yaml");
+  dem::DemSystem system(c);
+  auto &p = system.particles();
+  const double a = 30e-6, L = 1e-3;
+  p.add({0.99e-3, 0.5e-3, 0.4e-3}, a, 2200.0, 0, 0.0);
+  p.add({0.99e-3, 0.5e-3, 0.4e-3 + 2.2 * a}, a, 2200.0, 0, 0.0);
+  p.add({0.2e-3, 0.5e-3, 0.4e-3}, a, 2200.0, 0, 0.0);
+  system.initialize();
+  MagneticForceTerm term(c, MagneticSettings::from_case(c.dem), AppliedMagneticField::uniform({0, 0, 1}, 0.13),
+                         {L, 0.0, 0.0});
+  dem::ForceBuffers f;
+  f.resize(3);
+  f.clear();
+  term.add_forces(p, f, 0.0);
+  const std::vector<double> fz0(f.fz.begin(), f.fz.begin() + 3);
+  // Wrap the two beads near x = L across the face (as the engine would: x − L)...
+  for (std::size_t k = 0; k < 3; ++k)
+    if (p.x[k] > 0.5 * L)
+      p.x[k] -= L;
+  // ... and re-sort the arrays.
+  const std::vector<std::int32_t> order = {2, 0, 1};
+  std::vector<double> scratch;
+  std::vector<std::int32_t> iscratch;
+  p.permute(order, scratch, iscratch);
+  term.particles_reordered(order);
+  f.clear();
+  term.add_forces(p, f, 1e-6);
+  EXPECT_EQ(term.evaluations(), 1);
+  EXPECT_EQ(term.local_refreshes(), 0);
+  for (std::size_t k = 0; k < 3; ++k)
+    EXPECT_EQ(f.fz[k], fz0[static_cast<std::size_t>(order[k])]);
 }

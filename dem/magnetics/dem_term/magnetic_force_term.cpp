@@ -1,5 +1,8 @@
 #include "magnetic_force_term.h"
 
+#include <omp.h>
+
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -19,7 +22,7 @@ MagneticSettings with_slab_tail(MagneticSettings s, const std::array<double, 3> 
 MagneticForceTerm::MagneticForceTerm(const Case &c, MagneticSettings settings,
                                      const AppliedMagneticField &field,
                                      const std::array<double, 3> &box, bool slab_tail)
-  : dipoles_(with_slab_tail(settings, box, slab_tail), box), field_(field)
+  : dipoles_(with_slab_tail(settings, box, slab_tail), box), field_(field), box_(box)
 {
   for (const Population &pop : c.populations)
   {
@@ -61,8 +64,91 @@ void MagneticForceTerm::select_carriers(const dem::ParticleState &state)
   x_.resize(n);
   y_.resize(n);
   z_.resize(n);
+  for (std::size_t k = 0; k < n; ++k)
+  {
+    x_[k] = state.x[carrier_[k]];
+    y_[k] = state.y[carrier_[k]];
+    z_[k] = state.z[carrier_[k]];
+  }
   for (auto *v : {&fx_, &fy_, &fz_, &tx_, &ty_, &tz_})
     v->assign(n, 0.0);
+  dipoles_.reset_dipoles();
+}
+
+void MagneticForceTerm::gather_positions(const dem::ParticleState &state)
+{
+  // Unwrapped along periodic axes: of the engine position's images, the one nearest to the
+  // bead's previous position (a bead moves far less than half a period per step).
+  const std::size_t n = carrier_.size();
+  const std::vector<double> *engine[3] = {&state.x, &state.y, &state.z};
+  std::vector<double> *mine[3] = {&x_, &y_, &z_};
+  for (int d = 0; d < 3; ++d)
+  {
+    const double L = box_[d];
+    const double *from = engine[d]->data();
+    double *to = mine[d]->data();
+    if (L > 0.0)
+      for (std::size_t k = 0; k < n; ++k)
+      {
+        const double raw = from[carrier_[k]];
+        const double jump = to[k] - raw; // a multiple of L after a wrap, else a step's move
+        to[k] = std::abs(jump) > 0.5 * L ? raw + L * std::round(jump / L) : raw;
+      }
+    else
+      for (std::size_t k = 0; k < n; ++k)
+        to[k] = from[carrier_[k]];
+  }
+}
+
+AppliedFieldFunction MagneticForceTerm::lookup_at(double t) const
+{
+  // The field is looked up at the engine's image of the (unwrapped) position.
+  const AppliedMagneticField &field = field_;
+  const std::array<double, 3> box = box_;
+  return [&field, t, box](const double x[3], double B[3], double g[3][3]) {
+    Vec3 X{x[0], x[1], x[2]};
+    for (int d = 0; d < 3; ++d)
+      if (box[d] > 0.0)
+        X[d] -= box[d] * std::floor(X[d] / box[d]);
+    Vec3 Bv;
+    std::array<Vec3, 3> G;
+    field.evaluate(X, t, Bv, G);
+    for (int a = 0; a < 3; ++a)
+    {
+      B[a] = Bv[a];
+      for (int b = 0; b < 3; ++b)
+        g[a][b] = G[a][b];
+    }
+  };
+}
+
+void MagneticForceTerm::take_held_forces()
+{
+  for (auto *v : {&fx_, &fy_, &fz_, &tx_, &ty_, &tz_})
+    std::fill(v->begin(), v->end(), 0.0);
+  dipoles_.add_held_forces({fx_.data(), fy_.data(), fz_.data(), tx_.data(), ty_.data(), tz_.data()});
+}
+
+void MagneticForceTerm::full_refresh(const BeadArrays &beads, double t, double ramp)
+{
+  for (auto *v : {&fx_, &fy_, &fz_, &tx_, &ty_, &tz_})
+    std::fill(v->begin(), v->end(), 0.0);
+  const double t0 = omp_get_wtime();
+  stats_ = dipoles_.compute(beads, lookup_at(t), t,
+                            {fx_.data(), fy_.data(), fz_.data(), tx_.data(), ty_.data(), tz_.data()});
+  const double spent = omp_get_wtime() - t0;
+  counts_.full_s += spent;
+  if (evaluations_ == 0)
+    counts_.cold_s = spent;
+  counts_.lists_s += stats_.time_lists;
+  counts_.tensors_s += stats_.time_tensors;
+  counts_.far_s += stats_.time_far;
+  counts_.sweeps_s += stats_.time_sweeps;
+  counts_.forces_s += stats_.time_forces;
+  counts_.rebuilds += stats_.list_rebuilt;
+  counts_.zero_field += stats_.zero_field;
+  held_ramp_ = ramp;
+  ++evaluations_;
 }
 
 void MagneticForceTerm::add_forces(const dem::ParticleState &state, dem::ForceBuffers &forces,
@@ -78,82 +164,118 @@ void MagneticForceTerm::add_forces(const dem::ParticleState &state, dem::ForceBu
   const std::size_t n = carrier_.size();
   if (n == 0)
     return;
-  for (std::size_t k = 0; k < n; ++k)
-  {
-    x_[k] = state.x[carrier_[k]];
-    y_[k] = state.y[carrier_[k]];
-    z_[k] = state.z[carrier_[k]];
-  }
+  gather_positions(state);
   const BeadArrays beads{n, x_.data(), y_.data(), z_.data(), radius_.data(), mu_r_.data(), Ms_.data()};
-  if (must_refresh_ || dipoles_.needs_refresh(beads, t))
+  const double ramp = field_.ramp(t);
+  StalenessCheck check;
+  if (must_refresh_)
+    check.reason = RefreshReason::first;
+  else
   {
-    for (auto *v : {&fx_, &fy_, &fz_, &tx_, &ty_, &tz_})
-      std::fill(v->begin(), v->end(), 0.0);
-    const AppliedMagneticField &field = field_;
-    const AppliedFieldFunction lookup = [&field, t](const double x[3], double B[3], double g[3][3]) {
-      Vec3 Bv;
-      std::array<Vec3, 3> G;
-      field.evaluate({x[0], x[1], x[2]}, t, Bv, G);
-      for (int a = 0; a < 3; ++a)
-      {
-        B[a] = Bv[a];
-        for (int b = 0; b < 3; ++b)
-          g[a][b] = G[a][b];
-      }
-    };
-    stats_ = dipoles_.compute(beads, lookup, t,
-                              {fx_.data(), fy_.data(), fz_.data(), tx_.data(), ty_.data(), tz_.data()});
-    ++evaluations_;
-    must_refresh_ = false;
+    const double t0 = omp_get_wtime();
+    check = dipoles_.check_staleness(beads, t);
+    counts_.check_s += omp_get_wtime() - t0;
   }
+  // Held forces from a moment without field (before a ramp starts) cannot be rescaled: the
+  // field has just come on, so evaluate.
+  if (check.reason == RefreshReason::none && held_ramp_ == 0.0 && ramp > 0.0)
+    check.reason = RefreshReason::first;
+  switch (check.reason)
+  {
+  case RefreshReason::none:
+    break;
+  case RefreshReason::first:
+  case RefreshReason::bead_count:
+    ++counts_.first;
+    full_refresh(beads, t, ramp);
+    break;
+  case RefreshReason::interval:
+    ++counts_.interval;
+    full_refresh(beads, t, ramp);
+    break;
+  case RefreshReason::moved:
+  {
+    bool local = false;
+    // (Saturating beads while the field ramps: the held state cannot be rescaled exactly.)
+    if (dipoles_.settings().staleness_mode != StalenessMode::absolute && held_ramp_ > 0.0 &&
+        (ramp == held_ramp_ || dipoles_.linear()))
+    {
+      // The held state at the current field strength first (exact for linear beads), then
+      // the region around the moved beads.
+      if (ramp != held_ramp_)
+        dipoles_.scale_applied_field(ramp / held_ramp_);
+      held_ramp_ = ramp;
+      const double t0 = omp_get_wtime();
+      local = dipoles_.refresh_locally(beads, lookup_at(t), t, local_stats_);
+      counts_.local_s += omp_get_wtime() - t0;
+      counts_.region_beads += local ? static_cast<long>(local_stats_.local_region) : 0;
+    }
+    if (local)
+    {
+      ++local_refreshes_;
+      take_held_forces();
+    }
+    else
+    {
+      ++counts_.moved;
+      full_refresh(beads, t, ramp);
+    }
+    break;
+  }
+  }
+  must_refresh_ = false;
+  // While the field ramps, the held forces follow it: F ∝ B² for linear beads. (Saturating
+  // beads keep their forces until the next refresh.)
+  const double scale = (held_ramp_ > 0.0 && ramp != held_ramp_ && dipoles_.linear())
+                         ? (ramp / held_ramp_) * (ramp / held_ramp_) : 1.0;
+  last_scale_ = scale;
   for (std::size_t k = 0; k < n; ++k)
   {
     const std::size_t i = carrier_[k];
-    forces.fx[i] += fx_[k];
-    forces.fy[i] += fy_[k];
-    forces.fz[i] += fz_[k];
-    forces.tx[i] += tx_[k];
-    forces.ty[i] += ty_[k];
-    forces.tz[i] += tz_[k];
+    forces.fx[i] += scale * fx_[k];
+    forces.fy[i] += scale * fy_[k];
+    forces.fz[i] += scale * fz_[k];
+  }
+  if (dipoles_.settings().torque == TorqueModel::paper) // (otherwise no magnetic torque)
+    for (std::size_t k = 0; k < n; ++k)
+    {
+      const std::size_t i = carrier_[k];
+      forces.tx[i] += scale * tx_[k];
+      forces.ty[i] += scale * ty_[k];
+      forces.tz[i] += scale * tz_[k];
+    }
+}
+
+void MagneticForceTerm::last_forces(std::vector<double> &fx, std::vector<double> &fy,
+                                    std::vector<double> &fz) const
+{
+  fx.assign(state_size_, 0.0);
+  fy.assign(state_size_, 0.0);
+  fz.assign(state_size_, 0.0);
+  for (std::size_t k = 0; k < carrier_.size(); ++k)
+  {
+    fx[carrier_[k]] = last_scale_ * fx_[k];
+    fy[carrier_[k]] = last_scale_ * fy_[k];
+    fz[carrier_[k]] = last_scale_ * fz_[k];
   }
 }
 
 void MagneticForceTerm::particles_reordered(const std::vector<std::int32_t> &order)
 {
-  // Map the compact carrier order through the engine's permutation, so that the kept dipoles
-  // (the warm start), the held forces and the staleness reference follow their beads.
-  std::vector<std::int32_t> compact_of_full(order.size(), -1);
-  for (std::size_t k = 0; k < carrier_.size(); ++k)
-    compact_of_full[carrier_[k]] = static_cast<std::int32_t>(k);
-  std::vector<std::int32_t> compact_order;
-  std::vector<std::uint32_t> new_carrier;
-  for (std::size_t k = 0; k < order.size(); ++k)
+  // The engine re-sorted its arrays (new[k] = old[order[k]]): only the engine index of each
+  // compact bead changes. The magnetics keep their own order, lists, dipoles and forces.
+  if (carrier_.empty())
+    return;
+  if (order.size() != state_size_)
   {
-    const std::int32_t old_compact = compact_of_full[static_cast<std::size_t>(order[k])];
-    if (old_compact >= 0)
-    {
-      compact_order.push_back(old_compact);
-      new_carrier.push_back(static_cast<std::uint32_t>(k));
-    }
-  }
-  if (compact_order.size() == carrier_.size())
-  {
-    dipoles_.particles_reordered(compact_order);
-    // The held forces follow their beads too: a re-sort is no reason to re-evaluate (the
-    // staleness check still sees how far every bead moved since the last evaluation).
-    for (auto *v : {&radius_, &mu_r_, &Ms_, &fx_, &fy_, &fz_, &tx_, &ty_, &tz_})
-    {
-      const std::vector<double> old(*v);
-      for (std::size_t k = 0; k < compact_order.size(); ++k)
-        (*v)[k] = old[compact_order[k]];
-    }
-    carrier_ = new_carrier;
-  }
-  else
-  {
-    dipoles_.reset_dipoles();
     must_refresh_ = true;
+    return;
   }
+  std::vector<std::uint32_t> new_index(order.size());
+  for (std::size_t k = 0; k < order.size(); ++k)
+    new_index[static_cast<std::size_t>(order[k])] = static_cast<std::uint32_t>(k);
+  for (auto &i : carrier_)
+    i = new_index[i];
 }
 
 } // namespace magbrush::magnetics

@@ -3,9 +3,18 @@
 //
 // Only carrier beads (populations of kind carrier) take part; each gets μr and M_s from its
 // population's material. Per step, the term gathers the carriers' positions into compact
-// arrays, and either re-evaluates the magnetics (needs_refresh: refresh interval elapsed or a
-// bead moved more than the staleness fraction of its radius) or adds the held forces of the
-// last evaluation — Kawamoto's "magnetics every 5 µs while stepping at 20 ns".
+// arrays and then, Kawamoto's "magnetics every 5 µs while stepping at 20 ns":
+//   * a full evaluation when the refresh interval elapsed (or nothing is held yet);
+//   * when some beads moved more than the staleness fraction of their radius: a local
+//     refresh around them (StalenessMode::local) or a full evaluation (absolute);
+//   * otherwise the held forces of the last evaluation, rescaled by (s(t)/s_held)² while
+//     the applied field ramps (linear beads: p ∝ B, F ∝ B², exact).
+//
+// The compact carrier order is the magnetics' own, fixed when the carriers are selected: the
+// engine's spatial re-sorting only changes which engine index each compact bead reads, so
+// the magnetic neighbour lists, cells and dipoles survive it. Positions are unwrapped along
+// periodic axes (each bead keeps the image nearest to its previous position), so a wrap by
+// the engine is no jump for the magnetics either.
 #pragma once
 
 #include "force_term.h"
@@ -34,11 +43,37 @@ public:
   void add_forces(const dem::ParticleState &state, dem::ForceBuffers &forces, double t) override;
   void particles_reordered(const std::vector<std::int32_t> &order) override;
 
+  // Statistics of the last full evaluation, and of the last local refresh.
   const MagneticStats &last_stats() const { return stats_; }
+  const MagneticStats &last_local_stats() const { return local_stats_; }
   // A disabled term adds nothing (benchmarks compare settings in one system).
   void set_enabled(bool enabled) { enabled_ = enabled; }
+  // Full evaluations (compute) and local refreshes so far.
   long evaluations() const { return evaluations_; }
+  long local_refreshes() const { return local_refreshes_; }
+  // Full evaluations by cause: first / bead count changed / the field came on, interval
+  // elapsed, beads moved
+  // (absolute mode, or a local refresh that could not stand in for a full one), and how
+  // many of those found no applied field (nothing solved).
+  struct RefreshCounts
+  {
+    long first = 0, interval = 0, moved = 0, zero_field = 0;
+    // Wall time [s] in full evaluations, in local refreshes (including attempts that fell
+    // back to a full one), and in the per-step staleness checks; and the beads solved again
+    // (the regions) summed over the local refreshes.
+    double full_s = 0.0, local_s = 0.0, check_s = 0.0;
+    double cold_s = 0.0; // of full_s: the run's first evaluation (cell tables, lattice sums)
+    long region_beads = 0;
+    // The full evaluations' phases summed [s] (MagneticStats): lists / cells, applied field +
+    // tensors, far field, sweeps, forces; and how many rebuilt the lists.
+    double lists_s = 0.0, tensors_s = 0.0, far_s = 0.0, sweeps_s = 0.0, forces_s = 0.0;
+    long rebuilds = 0;
+  };
+  const RefreshCounts &refresh_counts() const { return counts_; }
   const InducedDipoles &dipoles() const { return dipoles_; }
+  // The magnetic forces this term added at its last step, by engine index (0 for toner):
+  // `fx` etc. are resized to the engine's particle count and overwritten [N].
+  void last_forces(std::vector<double> &fx, std::vector<double> &fy, std::vector<double> &fz) const;
 
 private:
   // Per population: is it a carrier, and its material's μr and M_s (copied from the case).
@@ -51,16 +86,26 @@ private:
   std::size_t state_size_ = 0;
   InducedDipoles dipoles_;
   AppliedMagneticField field_;
-  MagneticStats stats_;
-  long evaluations_ = 0;
+  std::array<double, 3> box_;
+  MagneticStats stats_, local_stats_;
+  long evaluations_ = 0, local_refreshes_ = 0;
+  RefreshCounts counts_;
 
-  // Compact carrier arrays; carrier_[k] = full index of compact bead k.
+  // Compact carrier arrays in the magnetics' own order; carrier_[k] = engine index of
+  // compact bead k (updated on every engine re-sort).
   std::vector<std::uint32_t> carrier_;
   std::vector<double> x_, y_, z_, radius_, mu_r_, Ms_, fx_, fy_, fz_, tx_, ty_, tz_;
   bool must_refresh_ = true;
   bool enabled_ = true;
+  // The applied field's ramp factor s(t) when the held forces were evaluated.
+  double held_ramp_ = 1.0;
+  double last_scale_ = 1.0; // the ramp rescaling of the held forces at the last step
 
   void select_carriers(const dem::ParticleState &state);
+  void gather_positions(const dem::ParticleState &state);
+  AppliedFieldFunction lookup_at(double t) const;
+  void full_refresh(const BeadArrays &beads, double t, double ramp);
+  void take_held_forces();
 };
 
 } // namespace magbrush::magnetics

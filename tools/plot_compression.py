@@ -122,7 +122,7 @@ def main():
                     fn = d["Fn_N"][m][b].mean() * 1e3
                     n = d["touching"][m][b].mean()
                     pts.append((lo + BIN_MM / 2, fn))
-                    length_rows.append([name, r["protocol"], r["d"], lo + BIN_MM / 2, fn, fn / r["area"] * 1e3, n,
+                    length_rows.append([name, r["protocol"], r["d"], lo + BIN_MM / 2, fn, fn / r["area"], n,
                                         n / r["area"], (fn * 1e3 / n) if n > 0 else 0.0,
                                         math.sqrt(r["area"] / n) * 1e3 if n > 0 else 0.0])
                 curves[name] = (r, pts)
@@ -131,7 +131,7 @@ def main():
                 fn = d["Fn_N"][m].mean() * 1e3
                 n = d["touching"][m].mean()
                 steps.setdefault(name, (r, []))[1].append((L, fn))
-                step_rows.append([name, r["d"], L, fn, fn / r["area"] * 1e3, n, n / r["area"],
+                step_rows.append([name, r["d"], L, fn, fn / r["area"], n, n / r["area"],
                                   (fn * 1e3 / n) if n > 0 else 0.0])
             elif ph == "slide":
                 fn, ft = d["Fn_N"][m].mean() * 1e3, d["Ft_N"][m].mean() * 1e3

@@ -13,6 +13,17 @@
 namespace magbrush::magnetics {
 
 namespace {
+
+// Appends bead b to `list` the first time it is flagged with `bit` (a set kept as a list in
+// first-seen order, with the flags as the membership test).
+void add_once(std::vector<std::uint8_t> &mark, std::uint8_t bit, std::vector<std::uint32_t> &list, std::uint32_t b)
+{
+  if (!(mark[b] & bit))
+  {
+    mark[b] |= bit;
+    list.push_back(b);
+  }
+}
 // Below this many beads (or pairs) a loop runs on one thread: forking a team costs more than
 // it saves, and far more on an oversubscribed machine. The results do not depend on it.
 constexpr std::size_t parallel_threshold = 512;
@@ -992,13 +1003,7 @@ bool InducedDipoles::refresh_locally(const BeadArrays &beads, const AppliedField
   const double batch2 = settings_.local_batch_fraction * settings_.local_batch_fraction;
   bead_mark_.assign(n, 0);
   enum : std::uint8_t { in_region = 1, in_gather = 2, is_moved = 4 };
-  auto add_moved = [&](std::uint32_t b) {
-    if (!(bead_mark_[b] & is_moved))
-    {
-      bead_mark_[b] |= is_moved;
-      moved_.push_back(b);
-    }
-  };
+  auto add_moved = [&](std::uint32_t b) { add_once(bead_mark_, is_moved, moved_, b); };
   for (std::size_t b = 0; b < n; ++b)
   {
     const double move2 = squared_move(beads, b);
@@ -1032,13 +1037,7 @@ bool InducedDipoles::refresh_locally(const BeadArrays &beads, const AppliedField
   const auto &pair_of = list_.incident_pair();
   const auto &first = list_.incident_first();
   region_.clear();
-  auto add_to_region = [&](std::uint32_t b) {
-    if (!(bead_mark_[b] & in_region))
-    {
-      bead_mark_[b] |= in_region;
-      region_.push_back(b);
-    }
-  };
+  auto add_to_region = [&](std::uint32_t b) { add_once(bead_mark_, in_region, region_, b); };
   for (const std::uint32_t b : moved_)
   {
     add_to_region(b);
@@ -1135,13 +1134,7 @@ bool InducedDipoles::refresh_locally(const BeadArrays &beads, const AppliedField
   const double t_forces = omp_get_wtime();
   const TwoSphereTable *single_table = tables_.size() == 1 ? tables_.begin()->second.get() : nullptr;
   gathered_.clear();
-  auto add_to_gather = [&](std::uint32_t b) {
-    if (!(bead_mark_[b] & in_gather))
-    {
-      bead_mark_[b] |= in_gather;
-      gathered_.push_back(b);
-    }
-  };
+  auto add_to_gather = [&](std::uint32_t b) { add_once(bead_mark_, in_gather, gathered_, b); };
   for (const std::uint32_t b : changed_)
     for (std::size_t q = begin[b]; q < begin[b + 1]; ++q)
       if (pair_mark_[pair_of[q]] != 2)

@@ -302,16 +302,20 @@ void InducedDipoles::evaluate_applied_field(const BeadArrays &beads,
   gradB0_.resize(9 * n);
 #pragma omp parallel for schedule(static) if (n >= parallel_threshold)
   for (long b = 0; b < static_cast<long>(n); ++b)
+    evaluate_applied_field_at(beads, field, static_cast<std::size_t>(b));
+}
+
+void InducedDipoles::evaluate_applied_field_at(const BeadArrays &beads, const AppliedFieldFunction &field,
+                                               std::size_t b)
+{
+  const double x[3] = {beads.x[b], beads.y[b], beads.z[b]};
+  double B[3], g[3][3];
+  field(x, B, g);
+  for (int a = 0; a < 3; ++a)
   {
-    const double x[3] = {beads.x[b], beads.y[b], beads.z[b]};
-    double B[3], g[3][3];
-    field(x, B, g);
-    for (int a = 0; a < 3; ++a)
-    {
-      B0_[3 * b + a] = B[a];
-      for (int c = 0; c < 3; ++c)
-        gradB0_[9 * b + 3 * a + c] = g[a][c];
-    }
+    B0_[3 * b + a] = B[a];
+    for (int c = 0; c < 3; ++c)
+      gradB0_[9 * b + 3 * a + c] = g[a][c];
   }
 }
 
@@ -1062,15 +1066,7 @@ bool InducedDipoles::refresh_locally(const BeadArrays &beads, const AppliedField
   // 2. The moved beads' applied field and the tensors of their pairs (each pair once).
   for (const std::uint32_t b : moved_)
   {
-    const double x[3] = {beads.x[b], beads.y[b], beads.z[b]};
-    double B[3], g[3][3];
-    field(x, B, g);
-    for (int a = 0; a < 3; ++a)
-    {
-      B0_[3 * b + a] = B[a];
-      for (int c = 0; c < 3; ++c)
-        gradB0_[9 * b + 3 * a + c] = g[a][c];
-    }
+    evaluate_applied_field_at(beads, field, b);
     store_reference_position(beads, b);
   }
   pair_mark_.assign(pairs.size(), 0);

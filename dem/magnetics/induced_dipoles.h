@@ -239,6 +239,7 @@ private:
   double cutoff_length(const BeadArrays &beads) const;
   void refresh_list_if_needed(const BeadArrays &beads, double cutoff, MagneticStats &stats);
   void evaluate_applied_field(const BeadArrays &beads, const AppliedFieldFunction &field);
+  void evaluate_applied_field_at(const BeadArrays &beads, const AppliedFieldFunction &field, std::size_t b);
   void evaluate_pair_tensors(const BeadArrays &beads, double cutoff, MagneticStats &stats);
   void build_near_entries();
   void prepare_tail(const BeadArrays &beads, double cutoff);

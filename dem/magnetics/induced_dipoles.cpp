@@ -14,6 +14,24 @@ namespace magbrush::magnetics {
 
 namespace {
 
+// Adds to F the stored forces of the pairs incident to bead b. A pair's force is stored as the
+// force on its j bead; its i bead gets the negative (Newton's third law, exact). The list's
+// fixed incidence order makes the sum the same on any number of threads.
+void add_incident_pair_forces(const MagneticNeighbourList &list, const std::vector<double> &pair_force,
+                              std::size_t b, double F[3])
+{
+  const auto &begin = list.incident_begin();
+  const auto &pair_of = list.incident_pair();
+  const auto &first = list.incident_first();
+  for (std::size_t q = begin[b]; q < begin[b + 1]; ++q)
+  {
+    const double *Fp = &pair_force[3 * pair_of[q]];
+    const double sign = first[q] ? -1.0 : 1.0;
+    for (int a = 0; a < 3; ++a)
+      F[a] += sign * Fp[a];
+  }
+}
+
 // Appends bead b to `list` the first time it is flagged with `bit` (a set kept as a list in
 // first-seen order, with the flags as the membership test).
 void add_once(std::vector<std::uint8_t> &mark, std::uint8_t bit, std::vector<std::uint32_t> &list, std::uint32_t b)
@@ -812,30 +830,9 @@ void InducedDipoles::gather_bead(std::size_t b)
     for (int a = 0; a < 3; ++a)
       F[a] += p[0] * gf[3 * a] + p[1] * gf[3 * a + 1] + p[2] * gf[3 * a + 2];
   }
-  // Pair forces are stored as the force on the pair's j bead; its i bead gets the negative.
-  const auto &begin = list_.incident_begin();
-  const auto &pair_of = list_.incident_pair();
-  const auto &first = list_.incident_first();
-  for (std::size_t q = begin[b]; q < begin[b + 1]; ++q)
-  {
-    const double *Fp = &pair_force_[3 * pair_of[q]];
-    const double sign = first[q] ? -1.0 : 1.0;
-    for (int a = 0; a < 3; ++a)
-      F[a] += sign * Fp[a];
-  }
+  add_incident_pair_forces(list_, pair_force_, b, F);
   if (far_ && settings_.model == DipoleModel::corrected)
-  {
-    const auto &cbegin = correction_list_.incident_begin();
-    const auto &cpair = correction_list_.incident_pair();
-    const auto &cfirst = correction_list_.incident_first();
-    for (std::size_t q = cbegin[b]; q < cbegin[b + 1]; ++q)
-    {
-      const double *Fp = &correction_force_[3 * cpair[q]];
-      const double sign = cfirst[q] ? -1.0 : 1.0;
-      for (int a = 0; a < 3; ++a)
-        F[a] += sign * Fp[a];
-    }
-  }
+    add_incident_pair_forces(correction_list_, correction_force_, b, F);
   double *T = &torque_[3 * b];
   if (settings_.torque == TorqueModel::paper)
   {

@@ -119,7 +119,7 @@ public:
   }
 
   // The same with plain arrays, for code that takes a callable
-  // void(const double x[3], double B[3], double gradB[3][3]) (dem/magnetics): bind t with
+  // void(const double x[3], double B[3], double gradB[3][3]) (magnetics/): bind t with
   //   [&field, t](const double *x, double *B, double (*g)[3]) { field.evaluate(x, t, B, g); }
   void evaluate(const double x[3], double t, double B[3], double gradB[3][3]) const
   {

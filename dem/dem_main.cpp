@@ -1,14 +1,11 @@
 // magbrush-dem — the OpenMP discrete-element engine (run through `magbrush dem`).
 //
 //   magbrush-dem CASE [--set key=value ...] [--restart FILE] [--threads N] [--output DIR]
-#include "dem_run.h"
-#include "openmp_waiting.h"
+#include "dem/dem_run.h"
+#include "dem/measurements/measurement_registry.h"
+#include "dem/openmp_waiting.h"
 
-#include "applied_magnetic_field.h"
-#include "case_parser.h"
-#include "field_files.h"
-#include "magnetic_force_term.h"
-#include "measurement_registry.h"
+#include "coupling/case_parser.h"
 
 #include <cstdlib>
 #include <unistd.h>
@@ -31,27 +28,6 @@ time_series.csv, checkpoint.bin}.
   --threads N      OpenMP threads (default: dem.threads, then all cores)
   --output DIR     output directory instead of <output.directory>/dem
 )";
-// The carriers' induced-dipole magnetics (dem/magnetics), when the scene has an applied field
-// and carriers to feel it: a uniform (ramped) field needs no grid; a roller field is read from
-// the stored magnetic grid, which must have been computed for this very case (`magbrush field`).
-void add_magnetics(magbrush::dem::DemRun &run, const magbrush::Case &c)
-{
-  using magbrush::AppliedField;
-  if (c.applied_field.kind == AppliedField::Kind::none)
-    return;
-  bool has_carriers = false;
-  for (const auto &p : c.populations)
-    has_carriers |= p.kind == magbrush::ParticleKind::carrier;
-  if (!has_carriers)
-    return;
-  const magbrush::AppliedMagneticField field =
-      c.applied_field.kind == AppliedField::Kind::roller
-          ? magbrush::AppliedMagneticField::for_case(c, magbrush::field::magnetic_grid_path(c))
-          : magbrush::AppliedMagneticField::from_settings(c.applied_field);
-  auto &system = run.system();
-  system.add_force_term(std::make_unique<magbrush::magnetics::MagneticForceTerm>(
-      c, magbrush::magnetics::MagneticSettings::from_case(c.dem), field, system.box().length));
-}
 } // namespace
 
 int main(int argc, char **argv)
@@ -126,7 +102,6 @@ int main(int argc, char **argv)
   {
     const magbrush::Case c = magbrush::load_case(case_path, overrides);
     magbrush::dem::DemRun run(c, options, std::cout);
-    add_magnetics(run, c);
     magbrush::dem::add_case_measurements(run, c);
     run.run();
   }

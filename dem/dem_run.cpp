@@ -1,6 +1,6 @@
 // A whole DEM run with its outputs (see dem_run.h).
-#include "dem_run.h"
-#include "openmp_waiting.h"
+#include "dem/dem_run.h"
+#include "dem/openmp_waiting.h"
 
 #include <omp.h>
 
@@ -23,20 +23,10 @@ DemRun::DemRun(const Case &c, const RunOptions &options, std::ostream &log)
   out_dir_ = options_.output_dir.empty() ? (fs::path(case_.output.directory) / "dem").string() : options_.output_dir;
   fs::create_directories(out_dir_);
   system_ = std::make_unique<DemSystem>(case_);
-  add_scene_force_terms();
+  force_terms_ = add_case_force_terms(*system_, case_);
 }
 
 std::string DemRun::checkpoint_path() const { return (fs::path(out_dir_) / "checkpoint.bin").string(); }
-
-void DemRun::add_scene_force_terms()
-{
-  // Each term only when the scene needs it.
-  const auto &g = case_.dem.gravity;
-  if (g[0] != 0.0 || g[1] != 0.0 || g[2] != 0.0)
-    system_->add_force_term(std::make_unique<Gravity>(g));
-  if (case_.dem.air_viscosity > 0.0)
-    system_->add_force_term(std::make_unique<StokesDrag>(case_.dem.air_viscosity));
-}
 
 void DemRun::log_setup() const
 {
@@ -59,11 +49,16 @@ void DemRun::log_setup() const
                 s.time_step(), case_.dem.time_step > 0 ? "user" : "automatic", st.limit, st.limiting.c_str(),
                 st.rayleigh, st.hertz);
   log_ << line;
-  std::snprintf(line, sizeof line, "  Verlet skin %.3g m; force terms on: contacts", s.skin());
+  std::snprintf(line, sizeof line, "  Verlet skin %.3g m\n", s.skin());
   log_ << line;
+  // The force list of the step, in the order the forces are added.
+  log_ << "  force terms on: contacts";
   for (const auto &t : s.force_terms())
     log_ << ", " << t->name();
   log_ << "\n";
+  for (const ForceTermChoice &choice : force_terms_)
+    if (!choice.on)
+      log_ << "  force term off: " << choice.name << " (" << choice.reason << ")\n";
   if (!measurements_.empty())
   {
     log_ << "  measurements:";
@@ -71,12 +66,6 @@ void DemRun::log_setup() const
       log_ << " " << m->name() << (&m == &measurements_.back() ? "" : ",");
     log_ << "\n";
   }
-  bool magnetics_on = false;
-  for (const auto &t : s.force_terms())
-    magnetics_on |= std::string(t->name()) == "magnetic dipoles";
-  if (case_.applied_field.kind != AppliedField::Kind::none && !magnetics_on)
-    log_ << "  note: the case has an applied magnetic field but no induced-dipole term was added "
-            "(no carriers?)\n";
   if (case_.electric.enabled)
     log_ << "  note: electrostatic terms (Coulomb, qE) are not part of this engine build yet\n";
   log_.flush();

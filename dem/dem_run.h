@@ -8,11 +8,12 @@
 // checkpoint.bin}.
 #pragma once
 
-#include "dem_system.h"
-#include "measurement.h"
-#include "snapshot_writer.h"
+#include "dem/dem_system.h"
+#include "dem/force_terms/force_term_registry.h"
+#include "dem/measurement.h"
+#include "dem/snapshot_writer.h"
 
-#include "case_model.h"
+#include "coupling/case_model.h"
 
 #include <iosfwd>
 #include <memory>
@@ -32,10 +33,14 @@ struct RunOptions
 class DemRun
 {
 public:
+  // Builds the engine with every registered force term the scene needs
+  // (dem/force_terms/force_term_registry.h).
   DemRun(const Case &c, const RunOptions &options, std::ostream &log);
 
-  // The engine, e.g. to plug in further force terms (magnetics) before run().
+  // The engine, e.g. to replace a force term by one with other settings before run().
   DemSystem &system() { return *system_; }
+  // Each registered force term: on, or off and why.
+  const std::vector<ForceTermChoice> &force_term_choices() const { return force_terms_; }
   // A measurement sampled during the run and written into output_dir() at its end.
   void add_measurement(std::unique_ptr<Measurement> m) { measurements_.push_back(std::move(m)); }
   const std::vector<std::unique_ptr<Measurement>> &measurements() const { return measurements_; }
@@ -54,8 +59,8 @@ private:
   std::string out_dir_;
   std::unique_ptr<DemSystem> system_;
   std::vector<std::unique_ptr<Measurement>> measurements_;
+  std::vector<ForceTermChoice> force_terms_;
 
-  void add_scene_force_terms();
   void log_setup() const;
   void log_timings(double wall) const;
   void write_measurements() const;

@@ -38,6 +38,20 @@ void DemSystem::add_force_term(std::unique_ptr<ForceTerm> term)
   terms_.push_back(std::move(term));
 }
 
+void DemSystem::replace_force_term(const std::string &name, std::unique_ptr<ForceTerm> term)
+{
+  for (auto &t : terms_)
+    if (name == t->name())
+    {
+      if (term->runs_in_team() != t->runs_in_team())
+        throw std::invalid_argument("dem: the replacement of force term '" + name +
+                                    "' must run in the same place of the step (in the team or not)");
+      t = std::move(term);
+      return;
+    }
+  throw std::invalid_argument("dem: no force term '" + name + "' to replace");
+}
+
 void DemSystem::setup_derived()
 {
   const std::size_t n = particles_.size();

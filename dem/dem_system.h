@@ -77,6 +77,9 @@ public:
   void initialize();
 
   void add_force_term(std::unique_ptr<ForceTerm> term);
+  // Puts `term` in the place of the term called `name` (same position in the force list);
+  // throws std::invalid_argument when there is none. For studies of a term's settings.
+  void replace_force_term(const std::string &name, std::unique_ptr<ForceTerm> term);
   const std::vector<std::unique_ptr<ForceTerm>> &force_terms() const { return terms_; }
 
   // One velocity-Verlet step; the same as advance(1).

@@ -1,8 +1,9 @@
-// The plug-in interface for body forces and long-range interactions: gravity, Stokes drag
-// (Kawamoto A12), and — plugged in by the scene set-up — the induced-dipole magnetics
-// (dem/magnetics), Coulomb, qE and van der Waals. Each term is called ONCE per step with the
-// whole particle state (structure of arrays) and ADDS its forces and torques, so a term is
-// free to vectorise, parallelise, or refresh itself only every few steps.
+// The plug-in interface for the forces of a step beyond the contacts: gravity, Stokes drag
+// (Kawamoto A12), the induced-dipole magnetics (A8–A11), and the electrostatic terms to come.
+// Each term lives in one file of dem/force_terms/ and registers itself there with the rule
+// that says whether a scene needs it (force_term_registry.h). Each term is called ONCE per
+// step with the whole particle state (structure of arrays) and ADDS its forces and torques,
+// so a term is free to vectorise, parallelise, or refresh itself only every few steps.
 //
 // Determinism contract: a term must produce the same bits on any number of threads (each
 // particle's contribution computed in a fixed order), or the engine's 1-vs-N-threads
@@ -11,7 +12,8 @@
 
 #include "particle_state.h"
 
-#include <array>
+#include <cstdint>
+#include <vector>
 
 namespace magbrush::dem {
 
@@ -33,34 +35,6 @@ public:
   // Particle arrays were re-sorted (new[k] = old[order[k]]): terms that cache per-particle
   // data (e.g. dipole moments) reorder it here.
   virtual void particles_reordered(const std::vector<std::int32_t> & /*order*/) {}
-};
-
-// Gravity (A12): F = m g.
-class Gravity : public ForceTerm
-{
-public:
-  explicit Gravity(const std::array<double, 3> &g) : g_(g) {}
-  const char *name() const override { return "gravity"; }
-  void add_forces(const ParticleState &s, ForceBuffers &f, double t) override;
-  bool runs_in_team() const override { return true; }
-  void add_forces_in_team(const ParticleState &s, ForceBuffers &f, double t) override;
-
-private:
-  std::array<double, 3> g_;
-};
-
-// Stokes drag of still air (A12): F = −6π η r v.
-class StokesDrag : public ForceTerm
-{
-public:
-  explicit StokesDrag(double viscosity) : eta_(viscosity) {}
-  const char *name() const override { return "Stokes drag"; }
-  void add_forces(const ParticleState &s, ForceBuffers &f, double t) override;
-  bool runs_in_team() const override { return true; }
-  void add_forces_in_team(const ParticleState &s, ForceBuffers &f, double t) override;
-
-private:
-  double eta_;
 };
 
 } // namespace magbrush::dem

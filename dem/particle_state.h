@@ -1,6 +1,6 @@
 // Particle data as structure of arrays: one contiguous array per quantity, so that every
 // kernel streams through exactly the data it needs and vectorises, and so that other units
-// (the magnetics in dem/magnetics, future Coulomb/van der Waals terms) can work on plain
+// (the magnetics in magnetics/, future Coulomb/van der Waals terms) can work on plain
 // arrays without knowing anything about the engine.
 //
 // Index order is NOT stable: the engine periodically re-sorts particles in cell order for

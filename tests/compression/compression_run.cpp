@@ -2,7 +2,7 @@
 #include "compression_run.h"
 
 #include "dem_run.h"
-#include "magnetic_force_term.h"
+#include "dem/force_terms/magnetic_force_term.h"
 #include "measurement_registry.h"
 
 #include "applied_magnetic_field.h"
@@ -101,12 +101,10 @@ RunResult run_case(const Case &c, const std::string &output_dir, int threads)
   options.output_dir = output_dir;
   options.threads = threads;
   options.progress_interval = 1e9;
+  // As magbrush-dem: the scene's force terms (the induced dipoles in the scheduled uniform
+  // field among them) and measurements.
   dem::DemRun run(c, options, log);
-  // As magbrush-dem: the induced dipoles in the (scheduled) uniform field, slab tail on.
   auto &system = run.system();
-  system.add_force_term(std::make_unique<magnetics::MagneticForceTerm>(
-      c, magnetics::MagneticSettings::from_case(c.dem), AppliedMagneticField::from_settings(c.applied_field),
-      system.box().length));
   dem::add_case_measurements(run, c);
   const dem::PlateCompression *plate = nullptr;
   for (const auto &m : run.measurements())

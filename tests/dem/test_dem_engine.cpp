@@ -3,6 +3,8 @@
 // re-sorting, stability guards that stop with a useful message, refusal of unstable user
 // time steps, insertion, and the contact-law building blocks.
 #include "dem_test_scenes.h"
+#include "dem/force_terms/gravity.h"
+#include "dem/force_terms/stokes_drag.h"
 
 #include "insertion.h"
 #include "dem_run.h"

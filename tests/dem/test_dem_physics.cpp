@@ -3,6 +3,7 @@
 //  * a sphere rolling on a plane, decelerated by rolling friction at a = (5/7) μ_r g;
 //  * a particle in a rotating drum brought to the wall's surface speed by friction.
 #include "dem_test_scenes.h"
+#include "dem/force_terms/gravity.h"
 
 #include <gtest/gtest.h>
 

@@ -3,6 +3,7 @@
 // dynamic checks: a particle carried along by a plate sliding sideways (Kawamoto's shear
 // step) and a particle resting on a blade face at the Hertz static overlap.
 #include "dem_test_scenes.h"
+#include "dem/force_terms/gravity.h"
 
 #include "wall_contacts.h"
 

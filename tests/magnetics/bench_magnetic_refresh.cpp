@@ -5,7 +5,7 @@
 //
 //   bench_magnetic_refresh [particles] [steps]
 #include "dem_system.h"
-#include "magnetic_force_term.h"
+#include "dem/force_terms/magnetic_force_term.h"
 
 #include "applied_magnetic_field.h"
 #include "case_parser.h"

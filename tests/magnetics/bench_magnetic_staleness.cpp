@@ -32,7 +32,7 @@
 // MAGBRUSH_ABSOLUTE_FACTOR, MAGBRUSH_MAGNETIC_SKIN (MagneticSettings local_region_limit,
 // local_batch_fraction, absolute_factor, skin_fraction: the magnetic lists' skin, otherwise
 // dem.verlet_skin).
-#include "magnetic_force_term.h"
+#include "dem/force_terms/magnetic_force_term.h"
 
 #include "applied_magnetic_field.h"
 #include "case_parser.h"
@@ -211,7 +211,7 @@ ModeResult run_mode(Case c, const std::string &mode, const std::string &restart,
     settings.skin_fraction = std::atof(v);
   auto owned = std::make_unique<MagneticForceTerm>(c, settings, field, system.box().length);
   const MagneticForceTerm *term = owned.get();
-  system.add_force_term(std::move(owned));
+  system.replace_force_term("magnetic dipoles", std::move(owned));
   auto probe = std::make_unique<HeldForceError>(c, term, settings, field, system.box().length, wall, sample);
   const HeldForceError *error = probe.get();
   run.add_measurement(std::move(probe));

@@ -16,7 +16,7 @@
 //
 //   bench_magnetic_step_share [nip_carriers] [compression_carriers] [steps] [brush|loose]
 #include "dem_system.h"
-#include "magnetic_force_term.h"
+#include "dem/force_terms/magnetic_force_term.h"
 #include "brush_configuration.h"
 
 #include "applied_magnetic_field.h"

@@ -3,7 +3,7 @@
 // refreshes and follow the engine's particle re-sorting; an engine wrap and re-sort are no
 // move; the ramp (held forces ∝ s²) and the local refresh through the engine; the
 // staleness-mode key.
-#include "magnetic_force_term.h"
+#include "dem/force_terms/magnetic_force_term.h"
 #include "two_sphere_exact.h"
 
 #include "applied_magnetic_field.h"

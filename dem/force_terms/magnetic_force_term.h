@@ -1,5 +1,6 @@
-// The DEM force term of the induced-dipole magnetics: plugs InducedDipoles into the engine's
-// ForceTerm interface (dem/force_term.h).
+// The DEM force term of the induced-dipole magnetics (Kawamoto A8–A11, Kweon eq. 2–5): plugs
+// the magnetics library (magnetics/induced_dipoles.h) into the engine's ForceTerm interface
+// (dem/force_term.h). On when the case has an applied field and a carrier population.
 //
 // Only carrier beads (populations of kind carrier) take part; each gets μr and M_s from its
 // population's material. Per step, the term gathers the carriers' positions into compact
@@ -17,11 +18,11 @@
 // the engine is no jump for the magnetics either.
 #pragma once
 
-#include "force_term.h"
-#include "induced_dipoles.h"
+#include "dem/force_term.h"
+#include "magnetics/induced_dipoles.h"
 
-#include "applied_magnetic_field.h"
-#include "case_model.h"
+#include "coupling/applied_magnetic_field.h"
+#include "coupling/case_model.h"
 
 #include <array>
 #include <cstdint>

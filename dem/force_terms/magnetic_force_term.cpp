@@ -1,4 +1,9 @@
-#include "magnetic_force_term.h"
+#include "dem/force_terms/magnetic_force_term.h"
+
+#include "dem/dem_system.h"
+#include "dem/force_terms/force_term_registry.h"
+
+#include "coupling/field_files.h"
 
 #include <omp.h>
 
@@ -277,5 +282,33 @@ void MagneticForceTerm::particles_reordered(const std::vector<std::int32_t> &ord
   for (auto &i : carrier_)
     i = new_index[i];
 }
+
+namespace {
+// The carriers' induced-dipole magnetics, when the scene has an applied field and carriers to
+// feel it: a uniform (ramped) field needs no grid; a roller field is read from the stored
+// magnetic grid, which must have been computed for this very case (`magbrush field`).
+std::string magnetics_not_needed_because(const Case &c)
+{
+  if (c.applied_field.kind == AppliedField::Kind::none)
+    return "the case has no applied field";
+  for (const auto &p : c.populations)
+    if (p.kind == ParticleKind::carrier)
+      return "";
+  return "no carrier population";
+}
+
+std::unique_ptr<dem::ForceTerm> make_magnetics(const Case &c, const dem::DemSystem &system)
+{
+  const AppliedMagneticField field =
+      c.applied_field.kind == AppliedField::Kind::roller
+          ? AppliedMagneticField::for_case(c, field::magnetic_grid_path(c))
+          : AppliedMagneticField::from_settings(c.applied_field);
+  return std::make_unique<MagneticForceTerm>(c, MagneticSettings::from_case(c.dem), field,
+                                             system.box().length);
+}
+
+const bool registered = dem::register_force_term({"magnetic dipoles", dem::force_term_order::magnetic_dipoles,
+                                                  magnetics_not_needed_because, make_magnetics});
+} // namespace
 
 } // namespace magbrush::magnetics

@@ -8,7 +8,7 @@
 // the returned force acts on i (the partner receives −F).
 #pragma once
 
-#include "vector3.h"
+#include "dem/vector3.h"
 
 #include <algorithm>
 #include <cmath>
@@ -61,9 +61,11 @@ struct ViscoelasticDamping
 // (ξ = −(F_t + c_t v_t)/k_t, as in LAMMPS and Luding 2008), so stick resumes without a jump.
 struct MindlinTangential
 {
+  // k_t = 8 G* a with the contact radius a = √(R* δ), written as √R* √δ: the kernel shares
+  // both roots with the normal spring (and this is the form its bits are pinned to).
   static double stiffness(double G_star, double R_star, double delta)
   {
-    return 8.0 * G_star * std::sqrt(R_star * delta);
+    return 8.0 * G_star * std::sqrt(R_star) * std::sqrt(delta);
   }
   static void rotate_into_tangent_plane(Vector3 &xi, const Vector3 &n)
   {
@@ -153,18 +155,18 @@ inline ContactOutcome evaluate_contact(const ContactCoefficients &c, const Conta
                                        Vector3 &history, double dt)
 {
   ContactOutcome out;
-  // The same formulas as the sub-models above, sharing √R* and √δ (4 square roots, not 6).
-  const double sqrt_R = std::sqrt(k.R_star), sqrt_delta = std::sqrt(k.overlap);
-  const double k_n = 4.0 / 3.0 * c.effective_modulus * sqrt_R;            // HertzNormal::stiffness
+  // The sub-models above, each formula in one place. They share √R* and √δ: the compiler
+  // computes each root once (sqrt has no side effects with -fno-math-errno, dem/CMakeLists.txt).
+  const double k_n = HertzNormal::stiffness(c.effective_modulus, k.R_star);
   // v_rel·n > 0: i moves towards the partner (approach); the dashpot opposes it.
   const double approach = dot(k.v_rel, k.n);
-  const double c_n = c.damping_normal * std::sqrt(k.m_star * k_n * sqrt_delta); // ViscoelasticDamping::normal
+  const double c_n = ViscoelasticDamping::normal(c.damping_normal, k.m_star, k_n, k.overlap);
   // Magnitude of the repulsive normal force; a dashpot may not pull the bodies together.
-  const double f_n = std::max(0.0, k_n * k.overlap * sqrt_delta + c_n * approach);
+  const double f_n = std::max(0.0, HertzNormal::force(k_n, k.overlap) + c_n * approach);
   out.normal_force = f_n;
 
   const Vector3 v_t = k.v_rel - approach * k.n;
-  const double k_t = 8.0 * c.effective_shear * sqrt_R * sqrt_delta;     // MindlinTangential::stiffness
+  const double k_t = MindlinTangential::stiffness(c.effective_shear, k.R_star, k.overlap);
   const double c_t = ViscoelasticDamping::tangential(c.damping_tangential, k.m_star, k_t);
   MindlinTangential::rotate_into_tangent_plane(history, k.n);
   const Vector3 f_t = MindlinTangential::force(history, v_t, k_t, c_t, c.friction, f_n, dt);

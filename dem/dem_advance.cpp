@@ -29,9 +29,9 @@
 //   * this step's overlap alarms after barrier P (written in the pair loop, before P);
 // so every thread leaves the loop at the same point. After the team, the alarms are raised
 // serially with the usual messages (dem_system.cpp).
-#include "dem_system.h"
+#include "dem/dem_system.h"
 
-#include "phase_clock.h"
+#include "dem/phase_clock.h"
 
 #include <omp.h>
 
@@ -55,8 +55,7 @@ bool DemSystem::team_has_state_alarm() const
 {
   for (int t = 0; t < omp_get_num_threads(); ++t)
   {
-    const StepFlags &f = thread_flags_[static_cast<std::size_t>(t)];
-    if (f.wall_overlap.particle >= 0 || f.wall_crowded.particle >= 0 || f.not_finite.particle >= 0)
+    if (thread_flags_[static_cast<std::size_t>(t)].has_state_alarm())
       return true;
   }
   return false;
@@ -70,19 +69,11 @@ bool DemSystem::team_has_overlap_alarm() const
   return false;
 }
 
-DemSystem::StepFlags DemSystem::team_alarms() const
+StepAlarms DemSystem::team_alarms() const
 {
-  StepFlags all;
+  StepAlarms all;
   for (const StepFlags &f : thread_flags_)
-  {
-    all.overlap_alarm |= f.overlap_alarm;
-    if (f.wall_overlap.particle > all.wall_overlap.particle)
-      all.wall_overlap = f.wall_overlap;
-    if (f.wall_crowded.particle > all.wall_crowded.particle)
-      all.wall_crowded = f.wall_crowded;
-    if (f.not_finite.particle >= 0 && (all.not_finite.particle < 0 || f.not_finite.particle < all.not_finite.particle))
-      all.not_finite = f.not_finite;
-  }
+    all.merge(f);
   return all;
 }
 
@@ -119,7 +110,7 @@ void DemSystem::advance(long steps)
     case Pause::done:
       return;
     case Pause::rebuild: // the step has begun (kick and drift done); its contacts follow
-      rebuild_neighbor_list();
+      rebuild_neighbour_list();
       from = Resume::contacts;
       break;
     case Pause::force_terms: // contacts and team terms done; the others add theirs, then the final kick
@@ -240,7 +231,7 @@ void DemSystem::settle(double duration)
   walls_frozen_ = false;
   step_ = 0;
   time_ = 0.0;
-  guard_energy_ = -1.0;
+  guards_.set_last_energy(-1.0);
 }
 
 } // namespace magbrush::dem

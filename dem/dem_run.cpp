@@ -81,14 +81,14 @@ void DemRun::log_timings(double wall) const
     log_ << line;
   };
   log_ << "time per phase (wall clock):\n";
-  row("neighbour list", t.neighbor);
+  row("neighbour list", t.neighbour);
   row("particle contacts", t.particle_contacts);
   row("wall contacts", t.wall_contacts);
   for (std::size_t k = 0; k < s.force_terms().size(); ++k)
     row(s.force_terms()[k]->name(), t.terms[k]);
   row("integration", t.integrate);
   row("guards", t.guards);
-  double rest = wall - t.neighbor - t.particle_contacts - t.wall_contacts - t.integrate - t.guards;
+  double rest = wall - t.neighbour - t.particle_contacts - t.wall_contacts - t.integrate - t.guards;
   for (double v : t.terms)
     rest -= v;
   row("output and other", rest);
@@ -218,7 +218,7 @@ void DemRun::run()
   std::snprintf(line, sizeof line, "done: %ld steps to t = %.6g s in %.2f s wall (%.3g particle-steps/s), %ld list rebuilds\n",
                 s.step_count() - start_step, s.time(), wall,
                 static_cast<double>(s.step_count() - start_step) * static_cast<double>(s.particles().size()) / std::max(wall, 1e-9),
-                s.neighbor_rebuilds());
+                s.neighbour_rebuilds());
   log_ << line;
   log_ << "outputs: " << out_dir_ << "/{particles.xdmf, snapshots/, time_series.csv, checkpoint.bin}\n";
   log_timings(wall);

@@ -5,18 +5,27 @@
 //            forces: particle contacts, wall contacts, every ForceTerm → half kick → guards
 //   advance(n): n steps, as many of them as possible in ONE OpenMP team (dem_advance.cpp)
 //
+// Its parts, each in a file of its own: the particles (particle_state.h), the pair list with
+// the contact history (neighbour_list.h), the contact law (contact_law.h), the walls and their
+// contact slots (wall_contacts.h, wall_contact_slots.h), the force terms (force_term.h,
+// force_terms/), the stability guards (stability_guards.h) and the checkpoint file
+// (checkpoint_file.h). This class owns them and runs the step; the pair kernel and the
+// phases are in dem_system.cpp, the team's step loop in dem_advance.cpp.
+//
 // Everything here is deterministic: the same input gives the same bits on any number of
 // OpenMP threads, and a restart from a checkpoint continues bit-identically.
 #pragma once
 
-#include "contact_parameters.h"
-#include "force_term.h"
-#include "neighbor_list.h"
-#include "particle_state.h"
-#include "time_step.h"
-#include "wall_contacts.h"
+#include "dem/contact_parameters.h"
+#include "dem/force_term.h"
+#include "dem/neighbour_list.h"
+#include "dem/particle_state.h"
+#include "dem/stability_guards.h"
+#include "dem/time_step.h"
+#include "dem/wall_contact_slots.h"
+#include "dem/wall_contacts.h"
 
-#include "case_model.h"
+#include "coupling/case_model.h"
 
 #include <array>
 #include <cstdint>
@@ -27,35 +36,10 @@
 
 namespace magbrush::dem {
 
-// Thrown by the stability guards: the message names step, particle, cause and likely fix.
-class StabilityError : public std::runtime_error
-{
-public:
-  using std::runtime_error::runtime_error;
-};
-
-// Total load of the particles on one wall [N, N m] (torque about the wall's axis for
-// cylinders, about the z axis through the origin otherwise).
-struct WallLoad
-{
-  std::array<double, 3> force{0, 0, 0};
-  std::array<double, 3> torque{0, 0, 0};
-  long contacts = 0;
-};
-
-// One particle touching one wall at the current step: what the wall feels from it. Used by
-// measurements (pressure on the drum, beads touching the compression plate, slip speed).
-struct WallContactRecord
-{
-  std::uint32_t particle = 0;  // current index into particles() (not stable: see `id`)
-  Vector3 force_on_wall;       // −(contact force on the particle) [N]
-  Vector3 torque_on_wall;      // about the wall's reference point [N m]
-};
-
 // Wall time spent in each phase of the step [s].
 struct PhaseTimes
 {
-  double neighbor = 0, particle_contacts = 0, wall_contacts = 0, integrate = 0, guards = 0;
+  double neighbour = 0, particle_contacts = 0, wall_contacts = 0, integrate = 0, guards = 0;
   std::vector<double> terms; // one per force term
 };
 
@@ -90,7 +74,7 @@ public:
   // idle threads sleep, a real share of a step of a few thousand particles.
   void advance(long steps);
   // Rebuild (and re-sort) the neighbour list at the next step even if no particle moved far.
-  void request_neighbor_rebuild() { force_rebuild_ = true; }
+  void request_neighbour_rebuild() { force_rebuild_ = true; }
   // Runs with the walls at rest for `duration` on a clock from −duration to t = 0 (a field
   // ramp or a wall path given from t = 0 has not started yet).
   void settle(double duration);
@@ -102,11 +86,11 @@ public:
   const ContactTable &contact_table() const { return table_; }
   const DemWalls &walls() const { return walls_; }
   const PeriodicBox &box() const { return box_; }
-  const NeighborList &neighbor_list() const { return list_; }
+  const NeighbourList &neighbour_list() const { return list_; }
   const ForceBuffers &forces() const { return forces_; }
   const std::vector<std::int32_t> &contact_count() const { return contact_count_; }
   const PhaseTimes &phase_times() const { return times_; }
-  long neighbor_rebuilds() const { return rebuilds_; }
+  long neighbour_rebuilds() const { return rebuilds_; }
   double skin() const { return skin_; }
 
   // Diagnostics, summed in a fixed order (thread-independent).
@@ -127,7 +111,7 @@ public:
   void read_checkpoint(const std::string &path);
 
   // Maximum number of walls one particle may touch at once.
-  static constexpr int max_wall_contacts = 3;
+  static constexpr int max_wall_contacts = WallContactSlots::per_particle;
   // Rows (particles) per block of the contact kernel: fixed, so that the work split, and
   // hence every floating-point sum, is the same on any number of threads.
   static constexpr long contact_block_rows = 128;
@@ -141,46 +125,30 @@ private:
   StableTimeStep stable_;
   ParticleState particles_;
   ForceBuffers forces_;
-  NeighborList list_;
+  NeighbourList list_;
   std::vector<std::unique_ptr<ForceTerm>> terms_;
   std::vector<std::int32_t> contact_count_;
   std::vector<double> x0_, y0_, z0_; // positions at the last list build
-  // Wall contact slots, max_wall_contacts per particle: wall index (−1 free), history ξ,
-  // force on the wall and its torque (for the wall loads).
-  std::vector<std::int32_t> wall_id_;
-  std::vector<double> wall_hx_, wall_hy_, wall_hz_;
-  std::vector<double> wall_fx_, wall_fy_, wall_fz_, wall_tx_, wall_ty_, wall_tz_;
+  WallContactSlots wall_slots_;
   std::vector<double> scratch_;
   std::vector<std::int32_t> iscratch_;
 
   double dt_ = 0.0, time_ = 0.0, skin_ = 0.0;
   long step_ = 0, rebuilds_ = 0;
   bool walls_frozen_ = false, force_rebuild_ = true, initialized_ = false;
-  double guard_energy_ = -1.0;       // KE at the last guard check
-  double energy_floor_ = 0.0;
+  StabilityGuards guards_;
+  double energy_floor_ = 0.0;        // the energy guard ignores growth below this
   PhaseTimes times_;
 
   // What the phases of a step report: one record per thread, written only by its thread and
-  // read by all after a barrier (no reduction clause, so no extra barrier). The alarms are
-  // sticky for the whole advance() call (it stops at the first one); max_drift2 is this
-  // step's. Padded to a cache line: neighbouring threads' records do not share one.
-  struct alignas(64) StepFlags
+  // read by all after a barrier (no reduction clause, so no extra barrier). The alarms
+  // (stability_guards.h) are sticky for the whole advance() call (it stops at the first one);
+  // max_drift2 is this step's. Padded to a cache line: neighbouring threads' records do not
+  // share one.
+  struct alignas(64) StepFlags : StepAlarms
   {
     double max_drift2 = 0.0;   // largest squared displacement since the list build
-    int overlap_alarm = 0;     // a particle pair overlaps beyond the guard
-    // A particle (index, −1: none) and where it was when the alarm was raised: the team
-    // notices wall and NaN alarms only at the next step's barrier, after another drift.
-    struct ParticleAlarm
-    {
-      long particle = -1;
-      Vector3 at;
-      void set(long i, const Vector3 &x) { particle = i, at = x; }
-    };
-    ParticleAlarm wall_overlap;  // overlaps a wall beyond the guard (the largest index)
-    ParticleAlarm wall_crowded;  // touches more than max_wall_contacts walls (the largest index)
-    ParticleAlarm not_finite;    // NaN/Inf in its state after the final kick (the smallest index)
     std::vector<double> row_torques; // scratch of the pair phase (kept: no allocation per step)
-    void clear_alarms() { overlap_alarm = 0, wall_overlap = {}, wall_crowded = {}, not_finite = {}; }
   };
   std::vector<StepFlags> thread_flags_; // one per thread of the team
   std::size_t team_terms_ = 0;           // leading force terms that run inside the team
@@ -189,12 +157,10 @@ private:
   enum class Pause { done, rebuild, force_terms, energy_guard, alarm };
 
   void setup_derived();
-  void rebuild_neighbor_list();
+  void rebuild_neighbour_list();
   void permute_particles(const std::vector<std::int32_t> &order);
   bool parallel() const { return particles_.size() > 512; } // below: one thread is faster
   bool list_is_stale(double max_drift2) const { return force_rebuild_ || max_drift2 > 0.25 * skin_ * skin_; }
-  // The phases of a step. Each is called by every thread of an enclosing parallel region
-  // (work-shared loops inside); see step() for their order and barriers.
   // The phases of a step. Each is called by every thread of an enclosing parallel region
   // (work-shared loops inside, reporting into the calling thread's StepFlags); see
   // dem_advance.cpp for their order and barriers.
@@ -210,13 +176,12 @@ private:
   double max_drift2_of_team() const;   // after the drift's barrier
   bool team_has_state_alarm() const;   // the last step's wall / NaN alarms, after a barrier
   bool team_has_overlap_alarm() const; // this step's pair alarm, after the pair barrier
-  StepFlags team_alarms() const;        // all threads' alarms combined (serial)
-  // After the region: turn the flags into StabilityErrors with a useful message.
-  void raise_alarms(const StepFlags &flags) const;
-  void raise_wall_alarms(const StepFlags &flags) const;
-  void raise_state_alarm(const StepFlags &flags) const;
-  void check_overlaps() const;
+  StepAlarms team_alarms() const;       // all threads' alarms combined (serial)
+  // After the region: turn the alarms into StabilityErrors with a useful message.
+  void raise_alarms(const StepAlarms &alarms) const;
+  void raise_worst_pair_overlap() const;
   void check_energy();
+  StepClock clock() const { return {step_, time_, dt_}; }
   std::string describe_particle(std::size_t i) const; // at its current position
   std::string describe_particle(std::size_t i, const Vector3 &at) const;
 };

@@ -5,7 +5,7 @@
 // them settle (DemSettings::settle_time).
 #pragma once
 
-#include "neighbor_list.h"
+#include "neighbour_list.h"
 #include "particle_state.h"
 #include "wall_contacts.h"
 

@@ -3,6 +3,7 @@
 #include "dem/dem_system.h"
 
 #include <algorithm>
+#include <stdexcept>
 
 namespace magbrush::dem {
 
@@ -31,6 +32,11 @@ std::vector<ForceTermFactory> force_term_factories()
 
 std::vector<ForceTermChoice> add_case_force_terms(DemSystem &system, const Case &c)
 {
+  // The terms register from an OBJECT library: a program that links only magbrush_dem would
+  // silently run without gravity, drag or magnetics. Refuse that instead.
+  if (table().empty())
+    throw std::logic_error("dem: no force term is registered: link the program with magbrush_force_terms "
+                           "(dem/force_terms/CMakeLists.txt)");
   std::vector<ForceTermChoice> choices;
   for (const ForceTermFactory &f : force_term_factories())
   {

@@ -97,7 +97,7 @@ struct Result
 {
   double window_rate = 0, load = 0; // median over 10-step windows; load average at the end
   double busiest_thread_cpu = 0;    // CPU seconds of the busiest thread in the timed loop
-  double rate = 0, neighbor = 0, contact = 0, integrate = 0, output = 0, total = 0, bytes = 0, contacts = 0;
+  double rate = 0, neighbour = 0, contact = 0, integrate = 0, output = 0, total = 0, bytes = 0, contacts = 0;
   long rebuilds = 0;
   double rebuild_ms = 0, rebuild_steps = 0; // cost of one list rebuild, in ms and in steps
 };
@@ -161,7 +161,7 @@ Result run(int per_side, int threads, int steps)
   DemSystem &sys = *holder;
   auto &p = sys.particles();
   const PhaseTimes before = sys.phase_times();
-  const long rebuilds0 = sys.neighbor_rebuilds();
+  const long rebuilds0 = sys.neighbour_rebuilds();
   const auto dir = std::filesystem::temp_directory_path() / "magbrush_bench_dem";
   SnapshotWriter writer(dir.string());
   double output = 0.0;
@@ -195,23 +195,23 @@ Result run(int per_side, int threads, int steps)
   r.window_rate = windows.empty() ? 0.0 : 10.0 * static_cast<double>(p.size()) / median(windows);
   r.load = load_average();
   const PhaseTimes &after = sys.phase_times();
-  r.neighbor = after.neighbor - before.neighbor;
+  r.neighbour = after.neighbour - before.neighbour;
   r.contact = after.particle_contacts - before.particle_contacts;
   r.integrate = after.integrate - before.integrate + after.guards - before.guards;
   r.output = output;
   r.rate = static_cast<double>(steps) * static_cast<double>(p.size()) / r.total;
   r.bytes = static_cast<double>(sys.memory_bytes()) / static_cast<double>(p.size());
   r.contacts = 2.0 * static_cast<double>(sys.particle_contacts()) / static_cast<double>(p.size());
-  r.rebuilds = sys.neighbor_rebuilds() - rebuilds0;
+  r.rebuilds = sys.neighbour_rebuilds() - rebuilds0;
   // The list rarely needs rebuilding in a dense packing (skin 6 µm); measure one rebuild
   // (re-sort + cell list + history transfer) explicitly.
-  const double nb0 = sys.phase_times().neighbor;
+  const double nb0 = sys.phase_times().neighbour;
   for (int k = 0; k < 5; ++k)
   {
-    sys.request_neighbor_rebuild();
+    sys.request_neighbour_rebuild();
     sys.step();
   }
-  r.rebuild_ms = 1e3 * (sys.phase_times().neighbor - nb0) / 5.0;
+  r.rebuild_ms = 1e3 * (sys.phase_times().neighbour - nb0) / 5.0;
   r.rebuild_steps = 1e-3 * r.rebuild_ms / (r.total / steps);
   std::filesystem::remove_all(dir);
   return r;
@@ -260,7 +260,7 @@ int main(int argc, char **argv)
         char rebuild[32];
         std::snprintf(rebuild, sizeof rebuild, "%.2f (%.1f)", r.rebuild_ms, r.rebuild_steps);
         std::printf("%8d %7d %12.4g %8.2f | %7.1f %7.1f %7.1f %7.1f | %8.0f %9.2f %8ld %8.2f   %-16s %12.4g %5.2f %9.3f\n",
-                    N, threads, r.rate, r.rate / single, 100 * r.neighbor / r.total, 100 * r.contact / r.total,
+                    N, threads, r.rate, r.rate / single, 100 * r.neighbour / r.total, 100 * r.contact / r.total,
                     100 * r.integrate / r.total, 100 * r.output / r.total, r.bytes, r.contacts, r.rebuilds,
                     r.total, rebuild, r.window_rate, r.load, r.busiest_thread_cpu);
       }

@@ -103,7 +103,7 @@ TEST(DemEngine, OneAndTwoThreadsGiveIdenticalBits)
       sys->step();
     result[threads - 1] = state_by_id(*sys);
     contacts = sys->particle_contacts();
-    rebuilds = sys->neighbor_rebuilds();
+    rebuilds = sys->neighbour_rebuilds();
   }
   omp_set_num_threads(2);
   std::printf("1 vs 2 threads: 1500 particles, 1500 steps, %ld contacts at the end, %ld list rebuilds\n", contacts,
@@ -172,7 +172,7 @@ TEST(DemEngine, HistorySurvivesRebuildAndResorting)
   }
   PeriodicBox box;
   box.length = {L, L, L};
-  NeighborList list;
+  NeighbourList list;
   std::vector<double> scratch;
   std::vector<std::int32_t> iscratch;
   auto permute = [&](const std::vector<std::int32_t> &order) { s.permute(order, scratch, iscratch); };
@@ -232,7 +232,7 @@ TEST(DemEngine, ForcesAreContinuousAcrossForcedRebuilds)
   for (int k = 1; k <= 400; ++k)
   {
     if (k % 50 == 0)
-      b->request_neighbor_rebuild();
+      b->request_neighbour_rebuild();
     a->step();
     b->step();
   }
@@ -245,8 +245,8 @@ TEST(DemEngine, ForcesAreContinuousAcrossForcedRebuilds)
       scale = std::max(scale, std::abs(sa[i + k]));
     }
   std::printf("forced rebuilds: max force difference %.3g N of max force %.3g N (%ld vs %ld rebuilds)\n", worst,
-              scale, a->neighbor_rebuilds(), b->neighbor_rebuilds());
-  EXPECT_GT(b->neighbor_rebuilds(), a->neighbor_rebuilds());
+              scale, a->neighbour_rebuilds(), b->neighbour_rebuilds());
+  EXPECT_GT(b->neighbour_rebuilds(), a->neighbour_rebuilds());
   EXPECT_LT(worst, 1e-6 * scale);
 }
 
@@ -643,7 +643,7 @@ TEST(DemEngine, VectorisedPairKernelMatchesScalarContactLaw)
   // The state the next step's contact kernel will see: the list as it is (no rebuild may
   // happen in that step) with its histories, and the kicked and drifted particles, computed
   // here with the engine's own arithmetic.
-  const NeighborList &list = sys.neighbor_list();
+  const NeighbourList &list = sys.neighbour_list();
   const std::vector<double> hx0 = list.hist_x, hy0 = list.hist_y, hz0 = list.hist_z;
   ParticleState s = p;
   const ForceBuffers &f = sys.forces();
@@ -660,9 +660,9 @@ TEST(DemEngine, VectorisedPairKernelMatchesScalarContactLaw)
     s.y[i] += dt * s.vy[i];
     s.z[i] += dt * s.vz[i];
   }
-  const long rebuilds = sys.neighbor_rebuilds();
+  const long rebuilds = sys.neighbour_rebuilds();
   sys.step();
-  ASSERT_EQ(sys.neighbor_rebuilds(), rebuilds) << "the reference assumes the step keeps its list";
+  ASSERT_EQ(sys.neighbour_rebuilds(), rebuilds) << "the reference assumes the step keeps its list";
 
   const std::size_t n = s.size(), P = list.pairs();
   std::vector<ContactOutcome> out(P);
@@ -839,11 +839,11 @@ TEST(DemEngine, AdvanceGivesTheBitsOfSingleSteps)
     b->advance(203);
     EXPECT_EQ(a->step_count(), b->step_count());
     EXPECT_EQ(a->time(), b->time());
-    EXPECT_GT(b->neighbor_rebuilds(), 2);
+    EXPECT_GT(b->neighbour_rebuilds(), 2);
     EXPECT_GT(b->particle_contacts(), 50);
     EXPECT_TRUE(bit_identical(state_by_id(*a), state_by_id(*b))) << "probe in team: " << probe_in_team;
     std::printf("advance(1000) + advance(203) vs 1203 x step(), probe %s: %ld rebuilds, %ld contacts\n",
-                probe_in_team ? "in the team" : "serial", b->neighbor_rebuilds(), b->particle_contacts());
+                probe_in_team ? "in the team" : "serial", b->neighbour_rebuilds(), b->particle_contacts());
   }
 }
 

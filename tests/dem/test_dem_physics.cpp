@@ -54,9 +54,9 @@ TEST(DemPhysics, UndampedPeriodicGasConservesEnergy)
   const double e1 = sys.kinetic_energy() + sys.rotational_energy() + sys.elastic_energy();
   std::printf("periodic Hertz gas: 128 spheres, 1e5 steps of %.3g s (%.3g s simulated), %ld list rebuilds, "
               "%ld contacts sampled; |dE|/E: worst %.3g, final %.3g\n",
-              sys.time_step(), sys.time(), sys.neighbor_rebuilds(), collisions_seen, worst, std::abs(e1 - e0) / e0);
+              sys.time_step(), sys.time(), sys.neighbour_rebuilds(), collisions_seen, worst, std::abs(e1 - e0) / e0);
   EXPECT_GT(collisions_seen, 100);        // it really is a colliding gas
-  EXPECT_GT(sys.neighbor_rebuilds(), 10); // and the list really was rebuilt
+  EXPECT_GT(sys.neighbour_rebuilds(), 10); // and the list really was rebuilt
   EXPECT_LT(std::abs(e1 - e0) / e0, 1e-4);
   EXPECT_LT(worst, 1e-3);
 }

@@ -4,7 +4,7 @@
 //
 // A ring R_i < r < R_o with M_r = M cos(n(θ − φ)), μr = 1, has outside r > R_o
 //   B_x − i B_y = μ0 n E_n e^{inφ} z^{−(n+1)},   E_n = M R_o^{n+1} (1 − ρ^{n+1}) / (2(n+1)),
-// ρ = R_i/R_o (DESIGN.md). With B = curl(A ẑ) and A = Re G(z), B_x − i B_y = i G'(z), so
+// ρ = R_i/R_o (the 2D field of a magnetised ring, from its surface and volume pole densities). With B = curl(A ẑ) and A = Re G(z), B_x − i B_y = i G'(z), so
 //   G(z) = i μ0 E_n e^{inφ} z^{−n},   A = μ0 E_n r^{−n} sin(n(θ − φ)).
 // The test suite checks B = curl A numerically, so a slip in this derivation would show.
 #pragma once
@@ -85,7 +85,7 @@ public:
     return from_complex(I * G1, I * G2);
   }
 
-  // The field as DESIGN.md writes it, term by term: B_x − i B_y = μ0 n E_n e^{inφ} z^{−(n+1)}
+  // The field formula above, term by term: B_x − i B_y = μ0 n E_n e^{inφ} z^{−(n+1)}
   // (independent of G: the tests compare curl A with this).
   FieldAndGradient B_design_formula(double x, double y) const
   {

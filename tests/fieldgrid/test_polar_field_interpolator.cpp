@@ -80,7 +80,7 @@ Errors measure(const PolarFieldInterpolator &interp, const MultipoleField &f,
 
 } // namespace
 
-// The reference itself: curl(A ẑ) of the potential we derived equals DESIGN.md's field
+// The reference itself: curl(A ẑ) of the potential we derived equals the ring's field
 // formula, and ∇B by central differences matches; the fast series agrees with both.
 TEST(ExactMultipole, FieldIsCurlOfPotentialAndGradientMatches)
 {

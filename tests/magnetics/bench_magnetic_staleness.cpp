@@ -225,7 +225,7 @@ ModeResult run_mode(Case c, const std::string &mode, const std::string &restart,
   const dem::PhaseTimes p = system.phase_times();
   for (std::size_t k = 0; k < system.force_terms().size(); ++k)
     (system.force_terms()[k].get() == term ? r.magnetic_s : r.rest_s) += p.terms[k];
-  r.rest_s += p.neighbor + p.particle_contacts + p.wall_contacts + p.integrate + p.guards;
+  r.rest_s += p.neighbour + p.particle_contacts + p.wall_contacts + p.integrate + p.guards;
   r.samples = error->samples_;
   if (r.samples > 0)
   {

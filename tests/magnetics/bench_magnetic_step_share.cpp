@@ -98,7 +98,7 @@ void scene(const char *label, const std::string &file, long carriers, long steps
     const dem::PhaseTimes p1 = system.phase_times();
     const std::size_t me = p1.terms.size() - 1;
     const double magnetic = p1.terms[me] - p0.terms[me];
-    double rest = (p1.neighbor - p0.neighbor) + (p1.particle_contacts - p0.particle_contacts) +
+    double rest = (p1.neighbour - p0.neighbour) + (p1.particle_contacts - p0.particle_contacts) +
                   (p1.wall_contacts - p0.wall_contacts) + (p1.integrate - p0.integrate) +
                   (p1.guards - p0.guards);
     for (std::size_t t = 0; t < me; ++t)

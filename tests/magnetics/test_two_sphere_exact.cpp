@@ -61,7 +61,7 @@ TEST(TwoSphereExact, UnequalSpheresSwapSymmetry)
   EXPECT_LT(rel(s.transverse, a.transverse), 1e-7);
 }
 
-// DESIGN.md: touching spheres at μr = 3.9, field along the axis, exact/point-dipole ≈ 2.6 and
+// The classic figures: touching spheres at μr = 3.9, field along the axis, exact/point-dipole ≈ 2.6 and
 // mutual-dipole/point-dipole ≈ 1.3. Measured: 2.632 and 1.2998.
 TEST(TwoSphereExact, TouchingFiguresAtMu3_9)
 {

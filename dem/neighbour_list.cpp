@@ -1,5 +1,5 @@
-// Cell-list Verlet neighbour list with spatial sorting and id-keyed history (neighbor_list.h).
-#include "neighbor_list.h"
+// Cell-list Verlet neighbour list with spatial sorting and id-keyed history (neighbour_list.h).
+#include "neighbour_list.h"
 
 #include <algorithm>
 #include <cmath>
@@ -25,7 +25,7 @@ void PeriodicBox::wrap(ParticleState &s) const
   }
 }
 
-void NeighborList::stash_history(const ParticleState &s)
+void NeighbourList::stash_history(const ParticleState &s)
 {
   const std::size_t n = s.size();
   old_start_.assign(n + 1, 0);
@@ -63,7 +63,7 @@ void NeighborList::stash_history(const ParticleState &s)
   }
 }
 
-void NeighborList::compute_cell_order(const ParticleState &s, const PeriodicBox &box, double skin)
+void NeighbourList::compute_cell_order(const ParticleState &s, const PeriodicBox &box, double skin)
 {
   const std::size_t n = s.size();
   double r_max = 0.0;
@@ -152,7 +152,7 @@ void NeighborList::compute_cell_order(const ParticleState &s, const PeriodicBox 
   }
 }
 
-void NeighborList::build_pairs(const ParticleState &s, const PeriodicBox &box, double skin)
+void NeighbourList::build_pairs(const ParticleState &s, const PeriodicBox &box, double skin)
 {
   const std::size_t n = s.size();
   const std::int32_t N = static_cast<std::int32_t>(n);
@@ -256,7 +256,7 @@ void NeighborList::build_pairs(const ParticleState &s, const PeriodicBox &box, d
   }
 }
 
-void NeighborList::restore_history(const ParticleState &s)
+void NeighbourList::restore_history(const ParticleState &s)
 {
   const std::int32_t N = static_cast<std::int32_t>(s.size());
   const bool have = !old_partner_id_.empty();
@@ -299,7 +299,7 @@ void NeighborList::restore_history(const ParticleState &s)
   }
 }
 
-std::size_t NeighborList::memory_bytes() const
+std::size_t NeighbourList::memory_bytes() const
 {
   std::size_t b = 0;
   for (const auto *a : {&row_start, &owner, &partner, &image, &touching, &col_start, &col_pair, &cell_of_, &cell_start_, &order_,

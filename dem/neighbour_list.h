@@ -29,7 +29,7 @@ struct PeriodicBox
   void wrap(ParticleState &s) const;
 };
 
-class NeighborList
+class NeighbourList
 {
 public:
   // --- pair data, indexed by pair p -------------------------------------------------------

@@ -1,0 +1,62 @@
+// The particle–particle pair kernel of the DEM step: the contact law (contact_law.h) for a
+// range of pairs of the neighbour list, written so that it vectorises.
+//
+// The half list stores each pair once, row by row (rows in particle order), so a range of
+// rows is a contiguous range of pairs. Rows are cut into fixed blocks (independent of the
+// thread count). For each block:
+//   * the pair kernel computes every pair's contact: the force on i (kept in the pair's slot,
+//     the partner needs it too), the torque on i (into a small per-thread buffer: only the
+//     row needs it) and the torque on j (into the pair's slot);
+//   * while that is still in cache, each row of the block sums its pairs: force and torque
+//     of particle i from its own pairs, in pair order.
+// After a barrier each particle adds the pairs in which it is the partner (its column, in
+// ascending pair order). The order of every sum is fixed by the list alone, so the forces
+// have the same bits on any number of threads, with no atomics.
+//
+// The kernel's loop body is branch-free (a pair that does not touch goes through the same
+// arithmetic at a harmless stand-in geometry and its outputs are selected to zero), so it
+// vectorises; an AVX-512 or AVX2 clone is picked at load time where the CPU has one. Vector
+// and scalar code give the same bits: every operation is an IEEE add, multiply, divide or
+// square root in the same order, and fused multiply-adds are off (dem/CMakeLists.txt).
+#pragma once
+
+#include <cstdint>
+
+namespace magbrush::dem {
+
+struct PairKernelData
+{
+  // Particles (read).
+  const double *x, *y, *z, *vx, *vy, *vz, *wx, *wy, *wz, *radius, *mass, *inv_inertia;
+  const std::int32_t *species;
+  // Pairs (read).
+  const std::int32_t *owner, *partner;
+  const std::int32_t *image;
+  const double *shift_x, *shift_y, *shift_z; // by image code
+  // Coefficients by interaction type (species s, t at s * table_columns + t), one array per
+  // field so that the vector code can gather them. `uniform`: one type only (one species),
+  // then the coefficients are loop constants and nothing is gathered.
+  const double *effective_modulus, *effective_shear, *friction, *rolling_friction, *damping_normal,
+      *damping_tangential;
+  std::int64_t table_columns;
+  bool uniform;
+  double dt, overlap_guard;
+  // Pairs (read and write): history; (write) force on i, torque on j, touching flag.
+  double *hx, *hy, *hz;
+  double *fx, *fy, *fz, *tjx, *tjy, *tjz;
+  std::int32_t *touching;
+};
+
+// Torque on i of the pairs p_begin + k, k = 0 .. block size (a per-thread buffer).
+struct RowTorques
+{
+  double *x, *y, *z;
+};
+
+// The kernel for pairs [p_begin, p_end): each pair's contact force on i (into the pair's
+// slot), torque on i (into T, indexed from p_begin) and on j (into the pair's slot), the
+// updated history and the touching flag. Returns 1 when some pair overlaps by more than the
+// guard fraction of the smaller radius.
+int particle_pair_kernel(const PairKernelData &D, const RowTorques &T, std::int64_t p_begin, std::int64_t p_end);
+
+} // namespace magbrush::dem

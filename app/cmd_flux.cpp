@@ -8,17 +8,17 @@
 //   3. read the scan, compare (RMS/max errors, per-pole peaks), write the residuals and plot;
 //   4. --fit: Levenberg–Marquardt on the exact ring, parameters with uncertainties, the
 //      fitted case file, and "the FEM as the final check" when magbrush-field is available.
-#include "subcommand.h"
+#include "app/subcommand.h"
 
-#include "case_hash.h"
-#include "case_parser.h"
-#include "field_files.h"
-#include "field_grid.h"
-#include "flux_compare.h"
-#include "flux_scan.h"
-#include "multipole_ring.h"
-#include "pole_fit.h"
-#include "units.h"
+#include "calibration/flux_compare.h"
+#include "calibration/flux_scan.h"
+#include "calibration/pole_fit.h"
+#include "coupling/case_hash.h"
+#include "coupling/case_parser.h"
+#include "coupling/field_files.h"
+#include "coupling/field_grid.h"
+#include "coupling/multipole_ring.h"
+#include "coupling/units.h"
 
 #include <yaml-cpp/yaml.h>
 

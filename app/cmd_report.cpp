@@ -12,12 +12,12 @@
 //   4. call tools/report.py (found next to the sources this binary was built from, or in
 //      $MAGBRUSH_TOOLS) with /usr/bin/python3 or $MAGBRUSH_PYTHON: it draws the PNGs and writes
 //      index.md and index.html, every file atomically.
-#include "subcommand.h"
+#include "app/subcommand.h"
 
-#include "case_format.h"
-#include "case_parser.h"
-#include "field_files.h"
-#include "flux_scan.h"
+#include "calibration/flux_scan.h"
+#include "coupling/case_format.h"
+#include "coupling/case_parser.h"
+#include "coupling/field_files.h"
 
 #include <cmath>
 #include <cstdio>

@@ -22,10 +22,10 @@
 // Cov = s² (JᵀJ)⁻¹ with s² = RSS/(m − p), mapped to the physical parameters.
 #pragma once
 
-#include "case_model.h"
-#include "flux_compare.h"
-#include "flux_scan.h"
-#include "multipole_ring.h"
+#include "calibration/flux_compare.h"
+#include "calibration/flux_scan.h"
+#include "coupling/case_model.h"
+#include "coupling/multipole_ring.h"
 
 #include <string>
 #include <vector>

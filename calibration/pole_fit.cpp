@@ -1,5 +1,5 @@
 // Pole fitting by Levenberg–Marquardt on the exact ring (see pole_fit.h).
-#include "pole_fit.h"
+#include "calibration/pole_fit.h"
 
 #include <Eigen/Dense>
 #include <unsupported/Eigen/NonLinearOptimization>

@@ -1,5 +1,5 @@
 // Reading gaussmeter scans (see flux_scan.h for the accepted format).
-#include "flux_scan.h"
+#include "calibration/flux_scan.h"
 
 #include <algorithm>
 #include <cctype>

@@ -5,10 +5,10 @@
 //  * a finite-element profile in field.output_dir is used when present;
 //  * bad input: unreadable scan, bad cell, probe radius inside the magnet, --fit without a
 //    scan, unknown option — exit status and message; a missing python only warns.
-#include "case_parser.h"
-#include "field_grid.h"
-#include "multipole_ring.h"
-#include "test_support.h"
+#include "coupling/case_parser.h"
+#include "coupling/field_grid.h"
+#include "coupling/multipole_ring.h"
+#include "tests/calibration/test_support.h"
 
 #include <gtest/gtest.h>
 

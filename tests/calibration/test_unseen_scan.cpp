@@ -27,6 +27,7 @@
 #include "coupling/case_hash.h"
 #include "coupling/case_parser.h"
 #include "coupling/multipole_ring.h"
+#include "tests/calibration/unseen_roller.h"
 
 #include <gtest/gtest.h>
 
@@ -35,55 +36,11 @@
 #include <random>
 
 using namespace magbrush;
+using namespace magbrush::unseen;
 
 namespace {
 
-constexpr double deg = M_PI / 180.0;
 constexpr double mu0 = 4e-7 * M_PI;
-constexpr double probe_radius = 13e-3;
-constexpr double noise_sigma = 0.5e-3;  // [T] on each component
-constexpr double encoder_offset = 3.7 * deg; // roller angle = scan angle + this
-
-double wrap_pm_pi(double a)
-{
-  a = std::remainder(a, 2 * M_PI);
-  return a <= -M_PI ? a + 2 * M_PI : a;
-}
-
-// The roller of these tests with the design (nominal) poles the fit starts from: six poles at
-// irregular angles, round strengths, α = 10. Air core (μ_r = 1) so the charge model is exact.
-Roller design_roller()
-{
-  Roller r;
-  r.shaft_radius = 4e-3;
-  r.shaft_mu_r = 1.0;
-  r.magnet_radius = 12e-3;
-  r.magnet_mu_r = 1.0;
-  r.poles = {{"N1", 10 * deg, 200e3, 10},  {"S1", 70 * deg, -200e3, 10},
-             {"N2", 135 * deg, 200e3, 10}, {"S2", 190 * deg, -200e3, 10},
-             {"N3", 250 * deg, 200e3, 10}, {"S3", 310 * deg, -200e3, 10}};
-  return r;
-}
-
-// The roller that made the scan: the design angles with deviations summing to zero (so that
-// the whole common rotation is the encoder offset, as the fit defines it), other strengths,
-// and the given shape factors.
-Roller true_roller(const std::vector<double> &alpha)
-{
-  Roller r = design_roller();
-  const double deviation_deg[] = {+1.2, -0.8, +0.5, -1.5, +0.9, -0.3};
-  const double strength[] = {250e3, -180e3, 210e3, -300e3, 160e3, -220e3};
-  for (size_t i = 0; i < r.poles.size(); ++i)
-  {
-    r.poles[i].angle += deviation_deg[i] * deg;
-    r.poles[i].strength = strength[i];
-    r.poles[i].shape_factor = alpha[i];
-  }
-  return r;
-}
-
-const std::vector<double> per_pole_alpha{6, 14, 9, 20, 11, 8};
-const std::vector<double> shared_alpha(6, 12.0);
 
 double magnetisation(const Roller &roller, double theta)
 {
@@ -172,30 +129,6 @@ FluxScan scan_of(const Roller &roller, double offset, double sigma, unsigned see
     s.Bt.push_back(Bt + noise(rng));
   }
   return s;
-}
-
-struct Worst
-{
-  double angle = 0, strength = 0, shape = 0;
-};
-
-Worst worst_deviation(const PoleFitResult &fit, const Roller &truth)
-{
-  Worst w;
-  for (size_t i = 0; i < truth.poles.size(); ++i)
-  {
-    const Pole &f = fit.poles[i].pole, &t = truth.poles[i];
-    w.angle = std::max(w.angle, std::abs(wrap_pm_pi(f.angle - t.angle)));
-    w.strength = std::max(w.strength, std::abs(f.strength / t.strength - 1.0));
-    w.shape = std::max(w.shape, std::abs(f.shape_factor / t.shape_factor - 1.0));
-  }
-  return w;
-}
-
-// The comparison's RMS over both components, in the fit's measure.
-double combined_rms(const FluxComparison &c)
-{
-  return std::sqrt(0.5 * (c.Bn.rms * c.Bn.rms + c.Bt.rms * c.Bt.rms));
 }
 
 } // namespace

@@ -6,8 +6,11 @@
 //   2. the computed profile: the FEM's when magbrush-field has written one for this radius,
 //      otherwise the exact multipole ring (which one is always said);
 //   3. read the scan, compare (RMS/max errors, per-pole peaks), write the residuals and plot;
-//   4. --fit: Levenberg–Marquardt on the exact ring, parameters with uncertainties, the
-//      fitted case file, and "the FEM as the final check" when magbrush-field is available.
+//   4. --fit: Levenberg–Marquardt on the exact ring (one shape factor for all poles or one
+//      each, chosen by an F-test), parameters with uncertainties, the residual against the
+//      noise estimated from the scan, the comparison with the scan rotated by the fitted
+//      encoder offset, the fitted case file (which records that offset as the scan's angular
+//      origin), and "the FEM as the final check" when magbrush-field is available.
 #include "app/subcommand.h"
 
 #include "calibration/flux_compare.h"
@@ -784,7 +787,8 @@ private:
       throw std::runtime_error("internal error: the fitted case " + fitted_case_ +
                                " does not load: " + e.what());
     }
-    std::cout << "  fitted case " << fitted_case_ << "\n  fit report  " << dir_ << "/flux_fit.txt\n";
+    std::cout << "  fitted case " << fitted_case_ << " (measured_flux_angle_origin "
+              << fixed(origin * to_deg, 4) << " deg)\n  fit report  " << dir_ << "/flux_fit.txt\n";
   }
 
   void plot_overlay()

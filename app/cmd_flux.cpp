@@ -6,19 +6,22 @@
 //   2. the computed profile: the FEM's when magbrush-field has written one for this radius,
 //      otherwise the exact multipole ring (which one is always said);
 //   3. read the scan, compare (RMS/max errors, per-pole peaks), write the residuals and plot;
-//   4. --fit: Levenberg–Marquardt on the exact ring, parameters with uncertainties, the
-//      fitted case file, and "the FEM as the final check" when magbrush-field is available.
-#include "subcommand.h"
+//   4. --fit: Levenberg–Marquardt on the exact ring (one shape factor for all poles or one
+//      each, chosen by an F-test), parameters with uncertainties, the residual against the
+//      noise estimated from the scan, the comparison with the scan rotated by the fitted
+//      encoder offset, the fitted case file (which records that offset as the scan's angular
+//      origin), and "the FEM as the final check" when magbrush-field is available.
+#include "app/subcommand.h"
 
-#include "case_hash.h"
-#include "case_parser.h"
-#include "field_files.h"
-#include "field_grid.h"
-#include "flux_compare.h"
-#include "flux_scan.h"
-#include "multipole_ring.h"
-#include "pole_fit.h"
-#include "units.h"
+#include "calibration/flux_compare.h"
+#include "calibration/flux_scan.h"
+#include "calibration/pole_fit.h"
+#include "coupling/case_hash.h"
+#include "coupling/case_parser.h"
+#include "coupling/field_files.h"
+#include "coupling/field_grid.h"
+#include "coupling/multipole_ring.h"
+#include "coupling/units.h"
 
 #include <yaml-cpp/yaml.h>
 
@@ -63,14 +66,16 @@ Options:
   --set key=value        override a case value (repeatable), e.g. --set field.probe_radius=10mm
   --angle-unit deg|rad   unit of the scan's angle column (overrides the header)
   --field-unit T|mT|G|kG unit of the scan's Bn/Bt columns (overrides the header)
-  --angle-offset ANGLE   roller angle = scan angle + ANGLE (e.g. 2.5deg)
+  --angle-offset ANGLE   roller angle = scan angle + ANGLE (e.g. 2.5deg); default: the case's
+                         measured_flux_angle_origin (which --fit writes into the fitted case)
   --clockwise            the scan's angle runs clockwise (Bt is then negated too)
   --flip-bt              the probe's Bt is positive clockwise: negate it
   --source auto|ring|fem computed profile from the FEM if present (auto), the exact ring, or
                          the FEM only (error if missing)
   --fit                  fit the pole model to the scan; writes <case>_fitted.yaml in DIR
-  --fit-shape shared|per-pole|fixed   shape factors α: one for all (default when the
-                         case's α agree, else per pole), one per pole, or held at the case's values
+  --fit-shape auto|shared|per-pole|fixed   shape factors α: auto (default) fits one for all
+                         and one per pole and keeps per-pole when an F-test finds it significantly
+                         better (p < 0.001); or one for all, one per pole, held at the case's values
   --no-offset            do not fit an encoder offset (every pole angle free)
   --bn-only              fit Bn only (ignore Bt)
   --no-fem-check         skip running magbrush-field on the fitted case
@@ -91,7 +96,7 @@ struct FluxOptions
   std::string source = "auto";
   bool fit = false, no_fem_check = false, no_plot = false;
   PoleFitOptions fit_options;
-  bool shape_given = false; // --fit-shape was given (else: shared if the case's α agree)
+  bool angle_offset_given = false; // --angle-offset (else the case's measured_flux_angle_origin)
   int harmonics = 0;
 };
 
@@ -124,7 +129,10 @@ FluxOptions parse_arguments(const std::vector<std::string> &args)
     else if (a == "--field-unit")
       o.scan.field_unit = value(i);
     else if (a == "--angle-offset")
+    {
       o.scan.angle_offset = parse_quantity(value(i), Dimension::angle);
+      o.angle_offset_given = true;
+    }
     else if (a == "--clockwise")
       o.scan.clockwise = true;
     else if (a == "--flip-bt")
@@ -140,15 +148,16 @@ FluxOptions parse_arguments(const std::vector<std::string> &args)
     else if (a == "--fit-shape")
     {
       const std::string s = value(i);
-      o.shape_given = true;
-      if (s == "shared")
+      if (s == "auto")
+        o.fit_options.shape = PoleFitOptions::Shape::automatic;
+      else if (s == "shared")
         o.fit_options.shape = PoleFitOptions::Shape::shared;
       else if (s == "per-pole" || s == "per_pole")
         o.fit_options.shape = PoleFitOptions::Shape::per_pole;
       else if (s == "fixed")
         o.fit_options.shape = PoleFitOptions::Shape::fixed;
       else
-        throw UsageError("--fit-shape expects shared, per-pole or fixed, found '" + s + "'");
+        throw UsageError("--fit-shape expects auto, shared, per-pole or fixed, found '" + s + "'");
     }
     else if (a == "--no-offset")
       o.fit_options.fit_offset = false;
@@ -454,7 +463,8 @@ void apply_override(YAML::Node root, const std::string &override_text)
 }
 
 std::string fitted_case_text(const Case &c, const FluxOptions &o, const PoleFitResult &fit,
-                             const std::string &scan_path, const std::string &fitted_name)
+                             double scan_origin, const std::string &scan_path,
+                             const std::string &fitted_name)
 {
   YAML::Node root = YAML::LoadFile(c.source_file);
   for (const auto &ov : o.overrides)
@@ -477,8 +487,11 @@ std::string fitted_case_text(const Case &c, const FluxOptions &o, const PoleFitR
     poles.push_back(n);
   }
   root["roller"]["poles"] = poles;
-  if (o.fit_options.shape == PoleFitOptions::Shape::shared)
+  if (fit.shape == PoleFitOptions::Shape::shared)
     root["roller"]["shape_factor"] = fixed(fit.poles[0].pole.shape_factor, 4) + " rad^-2";
+  // The scan's angular origin as the fit found it: the one it was read with plus the fitted
+  // offset, so that every later comparison with this scan lines up with the fitted poles.
+  root["measured_flux_angle_origin"] = fixed(scan_origin * to_deg, 4) + " deg";
 
   std::ostringstream out;
   std::time_t now = std::time(nullptr);
@@ -489,7 +502,8 @@ std::string fitted_case_text(const Case &c, const FluxOptions &o, const PoleFitR
       << stamp << ").\n"
       << "# Residual RMS " << fixed(fit.rms * 1e3, 3) << " mT over " << fit.samples
       << " values; encoder offset " << fixed(fit.offset * to_deg, 4) << " ± "
-      << fixed(fit.offset_sigma * to_deg, 4) << " deg (roller angle = scan angle + offset).\n"
+      << fixed(fit.offset_sigma * to_deg, 4)
+      << " deg, included in measured_flux_angle_origin (roller angle = scan angle + origin).\n"
       << "# Comments of the original file are not carried over.\n";
   YAML::Emitter emitter;
   emitter << root;
@@ -507,7 +521,16 @@ std::string fit_report(const PoleFitResult &fit, const FluxOptions &o)
       << fit.iterations << " iterations, " << fit.evaluations << " evaluations\n"
       << "  residual RMS " << fixed(fit.rms * 1e3, 4) << " mT (Bn " << fixed(fit.rms_Bn * 1e3, 4)
       << ", Bt " << fixed(fit.rms_Bt * 1e3, 4) << "), initial guess " << fixed(fit.initial_rms * 1e3, 3)
-      << " mT\n";
+      << " mT\n"
+      << "  noise estimated from the scan " << fixed(fit.noise_rms * 1e3, 4) << " mT (Bn "
+      << fixed(fit.noise.Bn * 1e3, 4) << ", Bt " << fixed(fit.noise.Bt * 1e3, 4)
+      << "; each sample against the cubic through its two neighbours on either side): residual / "
+         "noise = "
+      << fixed(fit.noise_rms > 0 ? fit.rms / fit.noise_rms : 0.0, 2) << "\n"
+      << "  shape factors: " << shape_name(fit.shape)
+      << (fit.shape_selection.automatic ? " (chosen: " + fit.shape_selection.reason + ")"
+                                        : std::string(" (as asked)"))
+      << "\n";
   if (o.fit_options.fit_offset)
     out << "  encoder offset " << fixed(fit.offset * to_deg, 4) << " ± "
         << fixed(fit.offset_sigma * to_deg, 4)
@@ -527,11 +550,15 @@ std::string fit_report(const PoleFitResult &fit, const FluxOptions &o)
   out << "  (± one standard error from the Jacobian at the optimum, s² = RSS/(m − p))\n";
   for (const auto &n : fit.notes)
     out << "  note: " << n << "\n";
+  const std::string warning = residual_warning(fit);
+  if (!warning.empty())
+    out << "\nwarning: " << warning << "\n";
   return out.str();
 }
 
 // "The FEM as the final check": magbrush-field on the fitted case, its probe profile against
 // the scan, and the FEM against the exact ring. Says why when it cannot be done.
+// `scan` is in the fitted case's roller frame (rotated by the fitted encoder offset).
 void fem_check(const std::string &fitted_case, const FluxScan &scan, const std::string &dir)
 {
   const fs::path field_exe = fs::path(executable_dir()) / "magbrush-field";
@@ -619,12 +646,14 @@ private:
   std::optional<FluxScan> scan_;
   std::string residuals_, fit_residuals_, fitted_case_;
   std::optional<PoleFitResult> fit_;
+  std::optional<FluxScan> aligned_scan_; // the scan rotated by the fitted encoder offset
 
   // 1. The case, the probe radius, the exact ring.
   void load_case_and_exact_ring()
   {
     case_ = load_case(o_.case_path, o_.overrides);
     probe_radius_ = probe_radius_of(case_);
+    choose_scan_origin();
     ring_options_.harmonics = o_.harmonics;
     ring_.emplace(*case_.roller, ring_options_);
     dir_ = o_.output_dir.empty() ? case_.output.directory + "/" + case_.name + "/flux" : o_.output_dir;
@@ -643,6 +672,18 @@ private:
                             scientific(std::max(ring_->harmonic_choice().tail, 1e-16)) +
                             " of the largest)")
               << "\n";
+  }
+
+  // The scan's angular origin: --angle-offset when given, else the case's
+  // measured_flux_angle_origin (a fitted case carries the encoder offset its fit found).
+  void choose_scan_origin()
+  {
+    if (!o_.angle_offset_given)
+      o_.scan.angle_offset = case_.measured_flux_angle_origin;
+    else if (case_.measured_flux_angle_origin != 0.0)
+      std::cout << "  note: --angle-offset " << fixed(o_.scan.angle_offset * to_deg, 4)
+                << " deg replaces the case's measured_flux_angle_origin "
+                << fixed(case_.measured_flux_angle_origin * to_deg, 4) << " deg\n";
   }
 
   // 2. The computed profile: the FEM's if there is one for this radius, else the exact ring.
@@ -678,6 +719,9 @@ private:
               << (scan_->has_tangential() ? ", Bn and Bt" : ", Bn only") << "\n";
     for (const auto &n : scan_->notes)
       std::cout << "  note: " << n << "\n";
+    if (o_.scan.angle_offset != 0.0)
+      std::cout << "  scan angular origin " << fixed(o_.scan.angle_offset * to_deg, 4)
+                << " deg (roller angle = scan angle + origin)\n";
     return true;
   }
 
@@ -710,24 +754,16 @@ private:
   // 5. Levenberg–Marquardt on the exact ring, and the fitted model against the scan.
   void fit_poles_to_scan()
   {
-    if (!o_.shape_given)
-      for (const Pole &p : case_.roller->poles)
-        if (p.shape_factor != case_.roller->poles[0].shape_factor &&
-            o_.fit_options.shape == PoleFitOptions::Shape::shared)
-        {
-          o_.fit_options.shape = PoleFitOptions::Shape::per_pole;
-          std::cout << "  note: the case gives different shape factors per pole: fitting one "
-                       "per pole (--fit-shape shared: one for all, from their geometric mean)\n";
-        }
     fit_ = fit_poles(*case_.roller, *scan_, probe_radius_, o_.fit_options);
     std::cout << "\n" << fit_report(*fit_, o_) << "\n";
     if (!fit_->converged)
       std::cout << "warning: the fit did not converge; the parameters above are the last iterate\n";
-    const MultipoleRing fitted_ring(fit_->roller, ring_options_);
-    ComputedProfile fitted;
-    fitted_ring.profile(probe_radius_, scan_->angle, fitted.Bn, fitted.Bt);
-    const FluxComparison c = compare_flux(*scan_, fitted.Bn, fitted.Bt, fit_->roller.poles);
-    print_comparison(c, "Scan against the fitted pole model (exact ring):");
+    // From here on the scan is seen as the fit saw it: rotated by the fitted encoder offset.
+    aligned_scan_ = rotated_scan(*scan_, fit_->offset);
+    const FluxComparison c =
+        compare_with_fitted_model(*scan_, *fit_, probe_radius_, ring_options_);
+    print_comparison(c, "Scan against the fitted pole model (exact ring, scan rotated by the "
+                        "fitted encoder offset " + fixed(fit_->offset * to_deg, 4) + " deg):");
     fit_residuals_ = dir_ + "/flux_fit_residuals.csv";
     write_residuals_csv(fit_residuals_, c);
     std::cout << "  residuals   " << fit_residuals_ << "\n";
@@ -738,8 +774,9 @@ private:
   {
     const std::string stem = fs::path(case_.source_file).stem().string();
     fitted_case_ = dir_ + "/" + stem + "_fitted.yaml";
-    write_file_atomically(fitted_case_,
-                          fitted_case_text(case_, o_, *fit_, scan_path_, case_.name + "_fitted"));
+    const double origin = std::remainder(o_.scan.angle_offset + fit_->offset, 2.0 * M_PI);
+    write_file_atomically(fitted_case_, fitted_case_text(case_, o_, *fit_, origin, scan_path_,
+                                                         case_.name + "_fitted"));
     write_file_atomically(dir_ + "/flux_fit.txt", fit_report(*fit_, o_));
     try
     {
@@ -750,7 +787,8 @@ private:
       throw std::runtime_error("internal error: the fitted case " + fitted_case_ +
                                " does not load: " + e.what());
     }
-    std::cout << "  fitted case " << fitted_case_ << "\n  fit report  " << dir_ << "/flux_fit.txt\n";
+    std::cout << "  fitted case " << fitted_case_ << " (measured_flux_angle_origin "
+              << fixed(origin * to_deg, 4) << " deg)\n  fit report  " << dir_ << "/flux_fit.txt\n";
   }
 
   void plot_overlay()
@@ -769,7 +807,7 @@ private:
     if (o_.no_fem_check)
       std::cout << "FEM check skipped (--no-fem-check)\n";
     else
-      fem_check(fitted_case_, *scan_, dir_);
+      fem_check(fitted_case_, *aligned_scan_, dir_);
   }
 };
 

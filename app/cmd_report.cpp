@@ -12,12 +12,12 @@
 //   4. call tools/report.py (found next to the sources this binary was built from, or in
 //      $MAGBRUSH_TOOLS) with /usr/bin/python3 or $MAGBRUSH_PYTHON: it draws the PNGs and writes
 //      index.md and index.html, every file atomically.
-#include "subcommand.h"
+#include "app/subcommand.h"
 
-#include "case_format.h"
-#include "case_parser.h"
-#include "field_files.h"
-#include "flux_scan.h"
+#include "calibration/flux_scan.h"
+#include "coupling/case_format.h"
+#include "coupling/case_parser.h"
+#include "coupling/field_files.h"
 
 #include <cmath>
 #include <cstdio>
@@ -112,7 +112,10 @@ std::string normalised_scan(const Case &c, const fs::path &report_dir)
 {
   if (c.measured_flux_file.empty())
     return "";
-  const FluxScan scan = read_flux_scan(c.measured_flux_file);
+  // In the roller frame: the scan's angular origin (the encoder offset a pole fit found) applied.
+  ScanReadOptions read_options;
+  read_options.angle_offset = c.measured_flux_angle_origin;
+  const FluxScan scan = read_flux_scan(c.measured_flux_file, read_options);
   std::ostringstream o;
   o << "# measured sleeve flux from " << c.measured_flux_file << " (units normalised by magbrush report)\n";
   o << (scan.has_tangential() ? "angle_deg,Bn_mT,Bt_mT\n" : "angle_deg,Bn_mT\n");

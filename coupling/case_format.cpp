@@ -89,6 +89,7 @@ std::vector<ResolvedEntry> resolved_entries(const Case &c)
   e.s("name", "name", c.name);
   e.s("scene", "scene", c.scene);
   e.s("measured_flux_file", "measured_flux_file", c.measured_flux_file);
+  e.q("measured_flux_angle_origin", "measured_flux_angle_origin", c.measured_flux_angle_origin);
   if (c.roller)
   {
     const Roller &r = *c.roller;

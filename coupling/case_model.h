@@ -269,6 +269,7 @@ struct Case
   CompressionSettings compression; // added by the compression study
   OutputSettings output;
   std::string measured_flux_file;     // optional gaussmeter scan to overlay in the report
+  double measured_flux_angle_origin = 0.0; // [rad] roller angle = scan angle + this (the encoder offset)
 
   const Material &material(const std::string &name) const; // throws if absent
 };

@@ -731,6 +731,7 @@ private:
     c.measured_flux_file = str(top, "measured_flux_file");
     if (!c.measured_flux_file.empty() && std::filesystem::path(c.measured_flux_file).is_relative())
       c.measured_flux_file = (std::filesystem::path(file).parent_path() / c.measured_flux_file).lexically_normal().string();
+    c.measured_flux_angle_origin = q(top, "measured_flux_angle_origin");
 
     if (present.count("roller"))
       c.roller = build_roller(top.child("roller"));

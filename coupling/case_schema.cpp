@@ -68,6 +68,10 @@ std::vector<KeySpec> build_schema()
           .def("roller"),
       text("measured_flux_file", "Optional gaussmeter scan (CSV: angle_deg, Bn_mT, Bt_mT) overlaid in the report; relative to the case file.")
           .def(""),
+      quantity("measured_flux_angle_origin", D::angle,
+               "Roller angle (counter-clockwise from +x) at which the scan's angle reads 0: roller angle = scan angle + this. "
+               "`magbrush flux --fit` writes the fitted encoder offset here; every comparison with the scan applies it. About the scan only: changes no field.")
+          .def("0 deg").min(-pi).max(pi),
 
       section("roller", "The magnet roller: a magnetised annulus on an optional soft-iron shaft (Kweon eq. 9-10)."),
       quantity("roller.shaft_radius", D::length, "Radius of the soft-iron shaft (0 = none).")

@@ -8,7 +8,8 @@ Bn_computed_mT, Bn_residual_mT[, Bt_measured_mT, Bt_computed_mT, Bt_residual_mT]
                  [--title TEXT] [--label LABEL] -o flux_overlay.png
 
 Top: Bn and Bt against the angle (measured as points, computed as lines, the fitted model
-dashed); bottom: the residuals. Exit status 3 when matplotlib is missing (the caller then
+dashed, at the measured points even when the fit found an encoder offset); bottom: the
+residuals. Exit status 3 when matplotlib is missing (the caller then
 warns and carries on), 2 for bad arguments or unreadable files.
 """
 import argparse
@@ -64,7 +65,10 @@ def main():
         bottom.plot(a, base["Bt_residual_mT"], "-", lw=0.9, color="tab:orange",
                     label=f"Bt measured − {args.label}")
     if fitted:
-        fa = fitted["angle_deg"]
+        # The fitted residuals are at the scan's angles rotated by the fitted encoder offset;
+        # drawn at the scan's own angles (same samples, same order) they sit on the measured
+        # points above instead of beside them.
+        fa = a if len(fitted["angle_deg"]) == len(a) else fitted["angle_deg"]
         top.plot(fa, fitted["Bn_computed_mT"], "--", lw=1.0, color="navy", label="Bn fitted")
         bottom.plot(fa, fitted["Bn_residual_mT"], "--", lw=0.9, color="navy",
                     label="Bn measured − fitted")

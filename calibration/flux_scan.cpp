@@ -1,5 +1,5 @@
 // Reading gaussmeter scans (see flux_scan.h for the accepted format).
-#include "flux_scan.h"
+#include "calibration/flux_scan.h"
 
 #include <algorithm>
 #include <cctype>
@@ -401,6 +401,13 @@ FluxScan parse_flux_scan(std::istream &in, const std::string &name,
 }
 
 // Periodic cubic Hermite interpolation with three-point (non-uniform) slopes.
+FluxScan rotated_scan(FluxScan scan, double angle)
+{
+  for (double &a : scan.angle)
+    a += angle;
+  return scan;
+}
+
 std::vector<double> interpolate_periodic(const std::vector<double> &angle,
                                          const std::vector<double> &value,
                                          const std::vector<double> &at)

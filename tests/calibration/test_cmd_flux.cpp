@@ -2,13 +2,15 @@
 //  * --fit on the example scan recovers its header's poles in the written case file;
 //  * --fit on a synthetic scan written here (gauss, radians, other column names, an encoder
 //    offset, noise) recovers the generating poles and offset;
+//  * the fitted case carries the fitted encoder offset (measured_flux_angle_origin) and later
+//    comparisons apply it;
 //  * a finite-element profile in field.output_dir is used when present;
 //  * bad input: unreadable scan, bad cell, probe radius inside the magnet, --fit without a
 //    scan, unknown option — exit status and message; a missing python only warns.
-#include "case_parser.h"
-#include "field_grid.h"
-#include "multipole_ring.h"
-#include "test_support.h"
+#include "coupling/case_parser.h"
+#include "coupling/field_grid.h"
+#include "coupling/multipole_ring.h"
+#include "tests/calibration/test_support.h"
 
 #include <gtest/gtest.h>
 
@@ -145,11 +147,11 @@ TEST(CmdFlux, FitOnTheExampleScanRecoversItsHeaderPoles)
   EXPECT_TRUE(contains(r.output, "Scan against the fitted pole model")) << r.output;
 }
 
-TEST(CmdFlux, FitRecoversASyntheticScanWithOffsetInOtherUnits)
+namespace {
+
+// Truth: the design layout with zero-mean deviations, other strengths, α = 12.
+Roller synthetic_truth()
 {
-  // Truth: the design layout with zero-mean deviations, other strengths, α = 12; the scan is
-  // read by an encoder 2.5° behind (scan angle = roller angle − 2.5°), written in radians and
-  // gauss, noise 0.4 mT.
   Roller truth = example_roller();
   const double angles[] = {1.0, 71.0, 143.0, 216.0, 289.0}; // mean = 144 = the design's mean
   for (size_t i = 0; i < truth.poles.size(); ++i)
@@ -157,7 +159,13 @@ TEST(CmdFlux, FitRecoversASyntheticScanWithOffsetInOtherUnits)
     truth.poles[i].angle = angles[i] * deg;
     truth.poles[i].shape_factor = 12.0;
   }
-  const double offset = 2.5 * deg;
+  return truth;
+}
+
+// A scan of `truth` read by an encoder `offset` behind (scan angle = roller angle − offset),
+// written in radians and gauss with other column names, noise 0.4 mT.
+fs::path write_synthetic_scan(const fs::path &dir, const Roller &truth, double offset)
+{
   std::vector<double> scan_angle, roller_angle, Bn, Bt;
   for (int k = 0; k < 240; ++k)
   {
@@ -167,17 +175,33 @@ TEST(CmdFlux, FitRecoversASyntheticScanWithOffsetInOtherUnits)
   MultipoleRing(truth).profile(10e-3, roller_angle, Bn, Bt);
   std::mt19937 rng(11);
   std::normal_distribution<double> noise(0.0, 0.4e-3);
+  const fs::path scan = dir / "scan.txt";
+  std::ofstream out(scan);
+  out << "# synthetic scan, gauss, radians\ntheta [rad]; B_theta (G); B_r (G)\n";
+  out.precision(10);
+  for (size_t k = 0; k < scan_angle.size(); ++k)
+    out << scan_angle[k] << "; " << (Bt[k] + noise(rng)) * 1e4 << "; " << (Bn[k] + noise(rng)) * 1e4
+        << "\n";
+  return scan;
+}
+
+// The number after the first `label` at or after `from` in `text` (NaN when absent).
+double number_after(const std::string &text, const std::string &label, size_t from = 0)
+{
+  const auto at = text.find(label, from);
+  return at == std::string::npos ? NAN : std::atof(text.c_str() + at + label.size());
+}
+
+} // namespace
+
+TEST(CmdFlux, FitRecoversASyntheticScanWithOffsetInOtherUnits)
+{
+  // The scan is read by an encoder 2.5° behind, written in radians and gauss, noise 0.4 mT.
+  const Roller truth = synthetic_truth();
+  const double offset = 2.5 * deg;
   const fs::path dir = scratch("synthetic");
   const fs::path case_file = write_case(dir);
-  const fs::path scan = dir / "scan.txt";
-  {
-    std::ofstream out(scan);
-    out << "# synthetic scan, gauss, radians\ntheta [rad]; B_theta (G); B_r (G)\n";
-    out.precision(10);
-    for (size_t k = 0; k < scan_angle.size(); ++k)
-      out << scan_angle[k] << "; " << (Bt[k] + noise(rng)) * 1e4 << "; " << (Bn[k] + noise(rng)) * 1e4
-          << "\n";
-  }
+  const fs::path scan = write_synthetic_scan(dir, truth, offset);
   const CommandResult r = run_magbrush(case_file.string() + " --measured " + scan.string() + " -o " +
                              (dir / "out").string() + " --fit --no-fem-check --no-plot");
   ASSERT_EQ(r.status, 0) << r.output;
@@ -197,6 +221,37 @@ TEST(CmdFlux, FitRecoversASyntheticScanWithOffsetInOtherUnits)
   ASSERT_EQ(given.status, 0) << given.output;
   const Case fitted_given = load_case((dir / "given" / "example_roller_fitted.yaml").string());
   expect_poles_near(*fitted_given.roller, truth, 0.1 * deg, 0.01, 0.01);
+}
+
+TEST(CmdFlux, FittedCaseCarriesTheEncoderOffsetIntoLaterComparisons)
+{
+  // The fitted case records the scan's angular origin (the fitted encoder offset): the
+  // comparison right after the fit and a later `magbrush flux` of the fitted case (scan from
+  // its measured_flux_file, no --measured) both line the scan up with the fitted poles, so
+  // their RMS errors are the fit's residual, not the error of a scan 2.5° off.
+  const fs::path dir = scratch("origin");
+  const fs::path case_file = write_case(dir);
+  const fs::path scan = write_synthetic_scan(dir, synthetic_truth(), 2.5 * deg);
+  const CommandResult fit = run_magbrush(case_file.string() + " --measured " + scan.string() +
+                                         " -o " + (dir / "out").string() +
+                                         " --fit --no-fem-check --no-plot");
+  ASSERT_EQ(fit.status, 0) << fit.output;
+  const fs::path fitted_file = dir / "out" / "example_roller_fitted.yaml";
+  const Case fitted = load_case(fitted_file.string());
+  EXPECT_NEAR(fitted.measured_flux_angle_origin, 2.5 * deg, 0.05 * deg);
+
+  const double residual_bn = number_after(fit.output, "(Bn ", fit.output.find("residual RMS "));
+  const double after_fit_bn =
+      number_after(fit.output, "  Bn ", fit.output.find("Scan against the fitted pole model"));
+  const CommandResult later =
+      run_magbrush(fitted_file.string() + " -o " + (dir / "later").string() + " --no-plot");
+  ASSERT_EQ(later.status, 0) << later.output;
+  EXPECT_TRUE(contains(later.output, "scan angular origin 2.")) << later.output;
+  const double later_bn = number_after(later.output, "  Bn ", later.output.find("Scan against"));
+  std::printf("Bn RMS: fit residual %.4f, after the fit %.4f, later run of the fitted case %.4f mT\n",
+              residual_bn, after_fit_bn, later_bn);
+  EXPECT_NEAR(after_fit_bn / residual_bn, 1.0, 0.03);
+  EXPECT_NEAR(later_bn / residual_bn, 1.0, 0.03);
 }
 
 TEST(CmdFlux, UsesTheFiniteElementProfileWhenPresent)

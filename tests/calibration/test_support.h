@@ -3,7 +3,7 @@
 // α = 10), the pole formula itself, and a plain reader for the example file.
 #pragma once
 
-#include "case_model.h"
+#include "coupling/case_model.h"
 
 #include <cmath>
 #include <fstream>
@@ -55,7 +55,7 @@ struct PlainScan
   std::vector<double> angle, Bn, Bt; // rad, T, T
 };
 
-// Independent of coupling/flux_scan (deliberately naive): skip '#' lines and the header.
+// Independent of calibration/flux_scan (deliberately naive): skip '#' lines and the header.
 inline PlainScan read_example_scan_plain()
 {
   std::ifstream in(example_scan_path());

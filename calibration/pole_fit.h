@@ -20,12 +20,20 @@
 //
 // Uncertainties are the standard errors from the Jacobian at the optimum,
 // Cov = s² (JᵀJ)⁻¹ with s² = RSS/(m − p), mapped to the physical parameters.
+//
+// The shape model can be chosen from the data (Shape::automatic, see shape_selection.h): one
+// shared α, or one per pole when that lowers the residual significantly. Every fit also
+// estimates the scan's noise from the scan itself (scan_noise.h) and says plainly when the
+// residual stays far above it: then the model does not describe the scan, whatever the
+// uncertainties say.
 #pragma once
 
-#include "case_model.h"
-#include "flux_compare.h"
-#include "flux_scan.h"
-#include "multipole_ring.h"
+#include "calibration/flux_compare.h"
+#include "calibration/flux_scan.h"
+#include "calibration/nested_model_test.h"
+#include "calibration/scan_noise.h"
+#include "coupling/case_model.h"
+#include "coupling/multipole_ring.h"
 
 #include <string>
 #include <vector>
@@ -34,7 +42,10 @@ namespace magbrush {
 
 struct PoleFitOptions
 {
-  enum class Shape { fixed, shared, per_pole } shape = Shape::shared;
+  // fixed: the case's α; shared: one α for all poles; per_pole: one each; automatic: shared,
+  // or per_pole when the F-test says it fits significantly better (shape_selection.h).
+  enum class Shape { fixed, shared, per_pole, automatic } shape = Shape::automatic;
+  double shape_significance = 0.001; // automatic: per_pole when the F-test's p-value is below
   bool fit_offset = true;
   bool use_tangential = true;   // fit Bt too when the scan has it
   int harmonics = 0;            // 0 = enough for 4× the largest initial α (relative 1e-12)
@@ -50,6 +61,16 @@ struct FittedPole
   Pole initial;                 // the initial guess from the scan
 };
 
+// How Shape::automatic chose between one shared α and one α per pole.
+struct ShapeSelection
+{
+  bool automatic = false;                    // false: the shape model was given
+  double rms_shared = 0.0, rms_per_pole = 0.0; // residual RMS of both fits [T]
+  NestedModelTest test;                      // per-pole against shared
+  double significance = 0.0;                 // per-pole kept when test.p_value < this
+  std::string reason;                        // the verdict in words
+};
+
 struct PoleFitResult
 {
   Roller roller;                // the case's roller with the fitted poles
@@ -62,6 +83,10 @@ struct PoleFitResult
   size_t samples = 0, parameters = 0;
   bool converged = false;
   std::string status;           // LM's verdict in words
+  PoleFitOptions::Shape shape = PoleFitOptions::Shape::shared; // the shape model fitted
+  ShapeSelection shape_selection;
+  ScanNoise noise;              // estimated from the scan itself (scan_noise.h)
+  double noise_rms = 0.0;       // that noise over the fitted components, comparable with rms [T]
   std::vector<std::string> notes;
 };
 
@@ -92,5 +117,23 @@ private:
 
 PoleFitResult fit_poles(const Roller &nominal, const FluxScan &scan, double probe_radius,
                         const PoleFitOptions &options = {});
+
+// The scan against the fitted model as the fit saw it: the scan rotated by the fitted encoder
+// offset (its angles then are roller angles of the fitted case), the exact ring of the fitted
+// poles at those angles. Its RMS error is the fit's residual.
+FluxComparison compare_with_fitted_model(const FluxScan &scan, const PoleFitResult &fit,
+                                         double probe_radius,
+                                         const MultipoleRing::Options &ring_options = {});
+
+// A residual RMS above this multiple of the noise means the model misses something real.
+// (A right model leaves rms ≈ noise·√((m − p)/m); the noise estimate is good to a few %.)
+constexpr double residual_far_above_noise = 1.5;
+
+// "" when the fit's residual is compatible with the scan's noise, else a plain warning: how
+// far above the noise it is and what to try.
+std::string residual_warning(const PoleFitResult &fit);
+
+// "shared", "per-pole", "fixed", "auto" (as the --fit-shape option spells them).
+std::string shape_name(PoleFitOptions::Shape shape);
 
 } // namespace magbrush

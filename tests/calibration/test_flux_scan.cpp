@@ -1,7 +1,7 @@
-// Unit tests of the gaussmeter-scan reader (coupling/flux_scan.h): header names and units,
+// Unit tests of the gaussmeter-scan reader (calibration/flux_scan.h): header names and units,
 // comments, separators, angular origin and direction, and every error with its line number.
-#include "flux_scan.h"
-#include "test_support.h"
+#include "calibration/flux_scan.h"
+#include "tests/calibration/test_support.h"
 
 #include <gtest/gtest.h>
 

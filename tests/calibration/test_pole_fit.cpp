@@ -1,14 +1,14 @@
-// Verification of the pole fit (coupling/pole_fit.h) and the profile comparison
-// (coupling/flux_compare.h):
+// Verification of the pole fit (calibration/pole_fit.h) and the profile comparison
+// (calibration/flux_compare.h):
 //  * the analytic Jacobian terms against finite differences;
 //  * synthetic scans made here from the exact ring with 0.4 mT noise (several seeds): the fit
 //    recovers the generating strengths, angles, shape factor and encoder offset;
 //  * the real example file: the fit recovers its header's poles;
 //  * peaks and errors of the comparison on profiles with a known shift.
-#include "flux_compare.h"
-#include "multipole_ring.h"
-#include "pole_fit.h"
-#include "test_support.h"
+#include "calibration/flux_compare.h"
+#include "calibration/pole_fit.h"
+#include "coupling/multipole_ring.h"
+#include "tests/calibration/test_support.h"
 
 #include <gtest/gtest.h>
 

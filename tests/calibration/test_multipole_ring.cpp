@@ -5,8 +5,8 @@
 //  * the convergence of the Fourier series of the Gaussian pole model;
 //  * the example gaussmeter scan (cases/data/sleeve_profile_example.csv), which was generated
 //    from the same exact solution plus 0.4 mT noise: the residual must be that noise.
-#include "multipole_ring.h"
-#include "test_support.h"
+#include "coupling/multipole_ring.h"
+#include "tests/calibration/test_support.h"
 
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
 // Profile comparison: errors, per-pole peaks, residual file (see flux_compare.h).
-#include "flux_compare.h"
+#include "calibration/flux_compare.h"
 
 #include <Eigen/Dense>
 

@@ -1,5 +1,7 @@
 // Pole fitting by Levenberg–Marquardt on the exact ring (see pole_fit.h).
-#include "pole_fit.h"
+#include "calibration/pole_fit.h"
+
+#include "calibration/shape_selection.h"
 
 #include <Eigen/Dense>
 #include <unsupported/Eigen/NonLinearOptimization>
@@ -477,13 +479,26 @@ void summarise(const FitProblem &problem, const Eigen::VectorXd &x, double stren
                            "rerun with more harmonics");
 }
 
+// The scan's noise (scan_noise.h) over the components the fit used, in the same measure as
+// the residual RMS: the RMS of the per-component noise over all fitted values.
+void estimate_noise_of_fitted_values(const FluxScan &scan, bool used_bt, PoleFitResult &result)
+{
+  result.noise = estimate_scan_noise(scan);
+  result.noise_rms = used_bt ? std::sqrt(0.5 * (result.noise.Bn * result.noise.Bn +
+                                                result.noise.Bt * result.noise.Bt))
+                             : result.noise.Bn;
+}
+
 } // namespace
 
 PoleFitResult fit_poles(const Roller &nominal, const FluxScan &scan, double probe_radius,
                         const PoleFitOptions &options)
 {
+  if (options.shape == PoleFitOptions::Shape::automatic)
+    return fit_poles_choosing_shape(nominal, scan, probe_radius, options);
   check_starting_poles(nominal);
   PoleFitResult result;
+  result.shape = options.shape;
   result.harmonics = harmonics_for_fit(nominal.poles, options);
   const PoleProfileModel model(RingGeometry::from(nominal), probe_radius, result.harmonics);
 
@@ -528,7 +543,49 @@ PoleFitResult fit_poles(const Roller &nominal, const FluxScan &scan, double prob
   result.iterations = static_cast<int>(lm.iter);
 
   summarise(problem, x, scale, nominal, guess, result);
+  estimate_noise_of_fitted_values(scan, problem.use_bt_, result);
   return result;
+}
+
+FluxComparison compare_with_fitted_model(const FluxScan &scan, const PoleFitResult &fit,
+                                         double probe_radius,
+                                         const MultipoleRing::Options &ring_options)
+{
+  const FluxScan aligned = rotated_scan(scan, fit.offset);
+  std::vector<double> Bn, Bt;
+  MultipoleRing(fit.roller, ring_options).profile(probe_radius, aligned.angle, Bn, Bt);
+  return compare_flux(aligned, Bn, Bt, fit.roller.poles);
+}
+
+std::string residual_warning(const PoleFitResult &fit)
+{
+  if (!(fit.noise_rms > 0.0) || fit.rms <= residual_far_above_noise * fit.noise_rms)
+    return "";
+  std::ostringstream out;
+  out.precision(3);
+  out << "the residual RMS " << fit.rms * 1e3 << " mT is " << fit.rms / fit.noise_rms
+      << " times the noise estimated from the scan (" << fit.noise_rms * 1e3
+      << " mT): the pole model does not describe this scan, and the uncertainties above are "
+         "too small. Try: ";
+  if (fit.shape != PoleFitOptions::Shape::per_pole)
+    out << "one shape factor per pole (--fit-shape per-pole); ";
+  out << "the case's number, order and signs of the poles; the roller geometry (magnet and "
+         "shaft radii) and field.probe_radius; the scan's direction and sign conventions "
+         "(--clockwise, --flip-bt) and units; the residual plot, for a pole or feature the "
+         "model lacks";
+  return out.str();
+}
+
+std::string shape_name(PoleFitOptions::Shape shape)
+{
+  switch (shape)
+  {
+  case PoleFitOptions::Shape::fixed: return "fixed";
+  case PoleFitOptions::Shape::shared: return "shared";
+  case PoleFitOptions::Shape::per_pole: return "per-pole";
+  case PoleFitOptions::Shape::automatic: return "auto";
+  }
+  return "?";
 }
 
 } // namespace magbrush

@@ -64,6 +64,10 @@ FluxScan read_flux_scan(const std::string &path, const ScanReadOptions &options 
 FluxScan parse_flux_scan(std::istream &in, const std::string &name,
                          const ScanReadOptions &options = {});
 
+// The same scan with `angle` added to every roller-frame angle: an encoder offset found after
+// reading it (by the pole fit), so that θ_roller = θ_scan + angle_offset + angle.
+FluxScan rotated_scan(FluxScan scan, double angle);
+
 // Unit factors (throw ScanError naming the accepted units).
 double angle_unit_factor(const std::string &unit); // to rad
 double field_unit_factor(const std::string &unit); // to T

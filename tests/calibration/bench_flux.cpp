@@ -3,9 +3,9 @@
 //     the probe radius, and the time of one 360-point profile;
 //  2. the pole fit: harmonics of the forward model → parameter error and fit time;
 //  3. the pole fit: scan noise → parameter error (and the reported uncertainty) and fit time.
-#include "multipole_ring.h"
-#include "pole_fit.h"
-#include "test_support.h"
+#include "calibration/pole_fit.h"
+#include "coupling/multipole_ring.h"
+#include "tests/calibration/test_support.h"
 
 #include <chrono>
 #include <cmath>

@@ -7,8 +7,8 @@
 // least-squares parabola through the samples within ±3° of the largest one (robust to noise).
 #pragma once
 
-#include "case_model.h"
-#include "flux_scan.h"
+#include "calibration/flux_scan.h"
+#include "coupling/case_model.h"
 
 #include <string>
 #include <vector>

@@ -33,10 +33,12 @@
 //    be lost silently: magbrush_coupling is a static library, and the linker leaves out an
 //    object file that nothing refers to, so a program would run with a schema missing a
 //    module, and unknown-key errors would appear only in that program. An explicit list of
-//    functions cannot lose a module: a declaration file left out of the build is a link
-//    error, and a function left out of the list is caught by the schema's own checks
-//    (every key's parent declared before it, no key declared twice) and by
-//    tests/case/test_module_defaults.cpp (every declared key is in the schema, in order).
+//    functions cannot lose a module quietly: a declaration file left out of the build is a
+//    link error; a function left out of the list fails every case load, because the parser
+//    reads every key and an undeclared one is a logic error ("case parser: no schema key
+//    dem.magnetic_model"). The schema also checks on assembly that no key is declared twice
+//    and that every key's section comes before it, and tests/case/test_module_defaults.cpp
+//    checks that the schema is exactly the declarations, in order.
 #pragma once
 
 #include "coupling/case_schema.h"

@@ -8,8 +8,11 @@
 //    origin. Angles are measured counter-clockwise from +x (the sleeve-scan convention).
 //  * A positive rpm turns counter-clockwise seen from +z.
 //
-// The parser (case_parser.h) fills this struct; the schema (case_schema.h) is the single
-// place where each key's type, dimension, default, range and documentation live.
+// The parser (case_parser.h) fills this struct; the schema (case_schema.h, the keys each module
+// declares in case_keys_<module>.cpp) is the single place where each key's type, dimension,
+// default, range and documentation live. The member initialisers below repeat the schema's
+// defaults, so that a struct built in code is what a default case gives;
+// tests/case/test_module_defaults.cpp fails when they disagree.
 // Fields are only ever added to this header, never renamed, so that all stages stay in step.
 #pragma once
 
@@ -38,7 +41,7 @@ struct Pole
 struct Roller
 {
   double shaft_radius = 0.0;   // R_shaft [m]; 0 = no shaft
-  double shaft_mu_r = 1.0;     // iron shaft relative permeability (large = ideal iron)
+  double shaft_mu_r = 1000.0;  // iron shaft relative permeability (large = ideal iron)
   double magnet_radius = 0.0;  // R_magnet [m], outer radius of the magnet annulus
   double magnet_mu_r = 1.0;    // recoil permeability of the magnet material
   std::vector<Pole> poles;

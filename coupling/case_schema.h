@@ -1,13 +1,15 @@
 // The case-file schema: the single place where every key's type, dimension, default, range,
-// documentation and field dependency live. The parser validates against it, `magbrush check
-// --explain` prints it, docs/case_reference.md is generated from it, and the field hashes
-// (case_hash.h) select their inputs by its `affects` marks.
+// documentation and field dependency live. Each module declares its own keys in
+// coupling/case_keys_<module>.cpp; the schema is their union (case_keys.h lists the modules).
+// The parser validates against it, `magbrush check --explain` prints it,
+// docs/case_reference.md is generated from it, and the field hashes (case_hash.h) select their
+// inputs by its `affects` marks.
 //
 // Keys are written as patterns: "roller.poles[].angle" (an element of a list),
 // "materials.*.density" (an entry of a map keyed by a user-chosen name).
 #pragma once
 
-#include "units.h"
+#include "coupling/units.h"
 
 #include <optional>
 #include <string>
@@ -62,7 +64,8 @@ struct KeySpec
   std::string range_description() const; // "> 0", "in [0 deg, 360 deg)", "" if none
 };
 
-// All keys, parents before children, in the order of the reference documentation.
+// All keys, parents before children, in the order of the reference documentation: the
+// modules' declarations in the order of key_declarations() (case_keys.h).
 const std::vector<KeySpec> &case_schema();
 
 // The spec of a pattern, or nullptr.

@@ -1,6 +1,6 @@
-#include "magnetic_settings.h"
+#include "magnetics/magnetic_settings.h"
 
-#include "case_model.h"
+#include "coupling/case_model.h"
 
 #include <stdexcept>
 

@@ -40,10 +40,15 @@ struct Beads
   }
 };
 
+// The scene these tests were built for: a hard cutoff (no far field) and a full refresh when
+// a bead moved too far. MagneticSettings{} is what a default case runs (the cell-multipole far
+// field, relative staleness), so both are set here; the tolerance is far below the default.
 MagneticSettings settings_for(DipoleModel model, double cutoff_diameters = 8.0)
 {
   MagneticSettings s;
   s.model = model;
+  s.far_field = FarField::none;
+  s.staleness_mode = StalenessMode::absolute;
   s.cutoff_diameters = cutoff_diameters;
   s.tolerance = 1e-13;
   s.max_sweeps = 500;

@@ -1,0 +1,52 @@
+// Case keys of module "particles" (the list of modules and why it is explicit: case_keys.h).
+// The particles: materials (contact and bulk properties) and populations (sizes, amounts,
+// where they are inserted). Read by the DEM (dem/contact_parameters, dem/insertion) and by the
+// magnetics (the carrier's mu_r and saturation magnetisation).
+#include "coupling/case_keys.h"
+
+namespace magbrush::case_keys {
+
+std::vector<KeySpec> particle_keys()
+{
+  return {
+      map("materials", "Contact and bulk properties by name (carrier, toner, sleeve, drum, wall, ...)."),
+      quantity("materials.*.youngs_modulus", D::pressure, "Young's modulus E.").required().positive(),
+      number("materials.*.poisson_ratio", "Poisson's ratio.").def("0.3").min(-1.0, false).max(0.5, false),
+      quantity("materials.*.density", D::density, "Density (particles; unused for walls).")
+          .def("0 kg/m^3").non_negative(),
+      number("materials.*.mu_r", "Relative permeability (carrier beads).").def("1").min(1.0),
+      quantity("materials.*.saturation_magnetisation", D::magnetisation, "Saturation magnetisation (0 = linear).")
+          .def("0 kA/m").non_negative(),
+      number("materials.*.friction", "Sliding friction coefficient.").def("0").non_negative(),
+      number("materials.*.rolling_friction", "Rolling friction coefficient (0 = from polygon_angles).")
+          .def("0").non_negative(),
+      integer("materials.*.polygon_angles", "Kawamoto's polygon rule for rolling resistance (0 = off, else >= 3).")
+          .def("0").non_negative(),
+      number("materials.*.damping", "Kawamoto's Voigt damping constant alpha.").def("0").non_negative(),
+      number("materials.*.restitution", "Coefficient of restitution (LIGGGHTS form); -1 = unused.")
+          .def("-1").min(-1.0).max(1.0),
+      quantity("materials.*.hamaker", D::energy, "Hamaker constant for van der Waals adhesion.")
+          .def("0 J").non_negative(),
+
+      list("populations", "Particle populations (carrier, toner)."),
+      text("populations[].name", "Population name.").required(),
+      choice("populations[].kind", {"carrier", "toner"}, "Particle kind.").def("carrier"),
+      text("populations[].material", "Material (key in materials).").def("<kind>"),
+      quantity("populations[].diameter", D::length, "Mean diameter.").required().positive(),
+      quantity("populations[].diameter_std", D::length, "Standard deviation of the diameter (normal, truncated).")
+          .def("0 um").non_negative(),
+      integer("populations[].count", "Number of particles (give exactly one of count, mass, concentration).")
+          .def("0").non_negative(),
+      quantity("populations[].mass", D::mass, "Total mass of the population.").def("0 kg").non_negative(),
+      number("populations[].concentration", "Toner only: toner mass / carrier mass (e.g. 7 %).")
+          .def("0").non_negative().max(1.0, false),
+      quantity("populations[].charge_to_mass", D::charge_to_mass, "Charge-to-mass ratio q/m (toner: required).")
+          .def("0 uC/g"),
+      Key("populations[].insert_box", KeyType::box, "Insertion box [[xmin, ymin, zmin], [xmax, ymax, zmax]].")
+          .dim(D::length),
+      quantity("populations[].layer_thickness", D::length, "Insert as a layer of this thickness on the sleeve.")
+          .def("0 mm").non_negative(),
+  };
+}
+
+} // namespace magbrush::case_keys

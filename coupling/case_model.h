@@ -203,7 +203,7 @@ struct DemSettings
   // "relative" (close pairs whose vector changed by magnetic_staleness × the mean radius, or
   // beads that moved 5× that in the applied field: a local refresh around them), "local"
   // (beads that moved magnetic_staleness × their radius: a local refresh) or "absolute"
-  // (the same trigger, a full refresh: the behaviour before issue 5's refresh work).
+  // (the same trigger, a full refresh: the papers' behaviour).
   std::string magnetic_staleness_mode = "relative";
   double air_viscosity = 1.81e-5;    // η [Pa s] for Stokes drag (0 = no drag)
   Vec3 gravity{{0.0, -9.81, 0.0}};    // [m/s²]

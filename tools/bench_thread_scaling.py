@@ -13,7 +13,7 @@ case, where spinning threads hurt.
 e.g.
   tools/bench_thread_scaling.py new=build/bench/bench_dem_packing \
       new-passive=build/bench/bench_dem_packing:OMP_WAIT_POLICY=PASSIVE \
-      old=/work/main/build/bench/bench_dem_packing
+      old=../magbrush-old/build/bench/bench_dem_packing
 """
 import argparse
 import os

@@ -1,4 +1,4 @@
-// Benchmark of Kawamoto's compression test (issue 5). Two modes:
+// Benchmark of Kawamoto's compression test. Two modes:
 //
 //   bench_compression_study full [UNTIL_MS]
 //       the case cases/kawamoto_brush_compression.yaml at its defaults (60 um, 4,420 beads,

@@ -1,4 +1,4 @@
-// Kawamoto's compression test on a reduced scene: the acceptance of issue 5
+// Kawamoto's compression test on a reduced scene: the paper's findings as acceptance checks
 // (Kawamoto et al., "fundamental investigation", Fig. 5, 6, 10, 12), asserted
 // on the case file as users run it, shrunk to squares of ~12 bead diameters
 // (0.7 mm for 60 um, 0.5 mm for 42 um: the same finite-size effects for both

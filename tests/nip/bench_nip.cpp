@@ -1,4 +1,4 @@
-// Benchmark of the development nip (issue 6). Prints tables, asserts nothing, exits 0.
+// Benchmark of the development nip. Prints tables, asserts nothing, exits 0.
 //
 //   bench_nip [--case CASE] [--parts magnetics,diameters] [--set key=value ...]
 //

@@ -2,7 +2,7 @@
 // window (field_grid.h). This is what the DEM calls per charged particle per step.
 //
 // Φ is interpolated by a tensor-product cubic spline (not-a-knot at all four edges), so E is
-// C1 across cells; errors Φ O(h⁴), E O(h³) (measured in tests/fieldgrid).
+// C1 across cells; errors Φ O(h⁴), E O(h³) (measured in tests/coupling/field_grid).
 // The field is 2D: E_z = 0 and z is ignored.
 //
 // Outside the window the field is taken as zero: evaluate() returns false and E = 0, and

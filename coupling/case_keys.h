@@ -37,7 +37,7 @@
 //    link error; a function left out of the list fails every case load, because the parser
 //    reads every key and an undeclared one is a logic error ("case parser: no schema key
 //    dem.magnetic_model"). The schema also checks on assembly that no key is declared twice
-//    and that every key's section comes before it, and tests/case/test_module_defaults.cpp
+//    and that every key's section comes before it, and tests/coupling/case/test_module_defaults.cpp
 //    checks that the schema is exactly the declarations, in order.
 #pragma once
 

@@ -4,7 +4,7 @@
 // own neighbour list.
 //
 // These defaults are what a user's case runs. MagneticSettings' member initialisers (the
-// settings a test or a bench builds by hand) must equal them: tests/case/test_module_defaults
+// settings a test or a bench builds by hand) must equal them: tests/coupling/case/test_module_defaults
 // fails when they disagree.
 #include "coupling/case_keys.h"
 

@@ -12,7 +12,7 @@
 // declares in case_keys_<module>.cpp) is the single place where each key's type, dimension,
 // default, range and documentation live. The member initialisers below repeat the schema's
 // defaults, so that a struct built in code is what a default case gives;
-// tests/case/test_module_defaults.cpp fails when they disagree.
+// tests/coupling/case/test_module_defaults.cpp fails when they disagree.
 // Fields are only ever added to this header, never renamed, so that all stages stay in step.
 #pragma once
 

@@ -6,7 +6,7 @@
 //  * B is C1 and ∇B is continuous everywhere in the annulus, the seam θ = 0/2π included;
 //  * ∇·B = ∂²A/∂x∂y − ∂²A/∂y∂x = 0 exactly (to round-off), whatever the grid;
 //  * curl B = −∇²A vanishes in air only to interpolation accuracy (O(h²));
-//  * errors: A O(h⁴), B O(h³), ∇B O(h²) (measured in tests/fieldgrid).
+//  * errors: A O(h⁴), B O(h³), ∇B O(h²) (measured in tests/coupling/field_grid).
 //
 // Where the point lies:
 //  * r_min ≤ r ≤ r_max: the spline.

@@ -12,7 +12,7 @@
 //     phases in the same steps (robust to the machine's load).
 //
 // Scenes:
-//   nip:         tests/nip/kawamoto_nip_reduced.yaml (1,300 beads, 0.3 mm slab, roller field,
+//   nip:         tests/scenes/nip/kawamoto_nip_reduced.yaml (1,300 beads, 0.3 mm slab, roller field,
 //                40 ns steps) with the project's default far field (cell multipole); settled
 //                once for 0.3 ms, then every mode runs the same `flow` of turning from that
 //                checkpoint. The roller field is computed by `magbrush field` first.
@@ -280,7 +280,7 @@ void nip(const fs::path &dir, double flow_us, double sample_us, const std::vecto
          bool quick)
 {
   const std::string file = std::string(MAGBRUSH_SOURCE_DIR) +
-                           (quick ? "/cases/kawamoto_nip.yaml" : "/tests/nip/kawamoto_nip_reduced.yaml");
+                           (quick ? "/cases/kawamoto_nip.yaml" : "/tests/scenes/nip/kawamoto_nip_reduced.yaml");
   std::vector<std::string> overrides = {
     "dem.magnetic_far_field=cell_multipole", "field.output_dir=" + (dir / "fields").string(),
     "output.directory=" + dir.string(), "dem.output_interval=0 s"};
@@ -318,7 +318,7 @@ void nip(const fs::path &dir, double flow_us, double sample_us, const std::vecto
   std::snprintf(title, sizeof title,
                 "Flowing nip (%s, far field cell_multipole, %zu beads): "
                 "%.3g ms of turning after %.3g ms of settling, step %.3g ns, refresh %.3g us, staleness %.3g",
-                quick ? "cases/kawamoto_nip.yaml, tools/run quick default" : "tests/nip/kawamoto_nip_reduced.yaml",
+                quick ? "cases/kawamoto_nip.yaml, tools/run quick default" : "tests/scenes/nip/kawamoto_nip_reduced.yaml",
                 static_cast<std::size_t>(c.populations[0].count), flow_us * 1e-3, settle * 1e3, c.dem.time_step * 1e9,
                 c.dem.magnetic_refresh * 1e6, c.dem.magnetic_staleness);
   print(title, "drum", results);

@@ -46,7 +46,7 @@ std::string error_of(const std::string &text, const std::vector<std::string> &ov
   return "(no error)";
 }
 
-const std::string minimal = source_dir + "/tests/case/valid/minimal_roller.yaml";
+const std::string minimal = source_dir + "/tests/coupling/case/valid/minimal_roller.yaml";
 
 double nip_relative_speed(const Case &c)
 {
@@ -65,7 +65,7 @@ TEST(CaseFiles, EveryCaseInCasesLoads)
       ++n;
     }
   EXPECT_GE(n, 3);
-  for (const auto &entry : fs::directory_iterator(source_dir + "/tests/case/valid"))
+  for (const auto &entry : fs::directory_iterator(source_dir + "/tests/coupling/case/valid"))
   {
     SCOPED_TRACE(entry.path().string());
     EXPECT_NO_THROW(load_case(entry.path().string()));
@@ -268,7 +268,7 @@ TEST(CaseSchema, PrintedEntriesAndSchemaAgree)
 {
   // Every printed entry names a schema key, and a case using every key prints every leaf
   // (apart from the alternatives folded into others).
-  const Case c = load_case(source_dir + "/tests/case/valid/full_roller.yaml");
+  const Case c = load_case(source_dir + "/tests/coupling/case/valid/full_roller.yaml");
   std::set<std::string> printed;
   for (const auto &e : resolved_entries(c))
   {

@@ -1,4 +1,4 @@
-// THE BAD-INPUT COLLECTION: every tests/case/malformed/*.yaml is given to the real
+// THE BAD-INPUT COLLECTION: every tests/coupling/case/malformed/*.yaml is given to the real
 // `magbrush check` in a subprocess (with a time limit). Each must end with exit code 1 (no
 // crash, no hang) and print the fragments listed in its "# expect: ..." lines (file:line:col,
 // key path, expected/found). "# args: ..." lines add command-line arguments. A few inputs
@@ -20,7 +20,7 @@ namespace fs = std::filesystem;
 namespace {
 
 const std::string binary = std::string(MAGBRUSH_BINARY_DIR) + "/bin/magbrush";
-const std::string malformed_dir = std::string(MAGBRUSH_SOURCE_DIR) + "/tests/case/malformed";
+const std::string malformed_dir = std::string(MAGBRUSH_SOURCE_DIR) + "/tests/coupling/case/malformed";
 
 struct CheckRun
 {

@@ -14,7 +14,7 @@
 //             against the 60 um run (Kawamoto: density proportional to 1/d^2, pressure nearly
 //             independent of d; the bound: within +-20 %).
 //
-// Default CASE: tests/nip/kawamoto_nip_reduced.yaml (0.3 mm slab, about 1 min per run with
+// Default CASE: tests/scenes/nip/kawamoto_nip_reduced.yaml (0.3 mm slab, about 1 min per run with
 // the papers' magnetics). The full default scene: --case cases/kawamoto_nip.yaml (see
 // docs/nip.md for its measured times). Runs in build/bench_nip_runs/ (kept for inspection).
 #include "csv_columns.h"
@@ -122,7 +122,7 @@ double profile_difference(const Table &a, const Table &b, const std::string &col
 
 int main(int argc, char **argv)
 {
-  std::string case_path = source_dir + "/tests/nip/kawamoto_nip_reduced.yaml";
+  std::string case_path = source_dir + "/tests/scenes/nip/kawamoto_nip_reduced.yaml";
   std::string parts = "magnetics,diameters", extra;
   for (int i = 1; i < argc; ++i)
   {

@@ -1,4 +1,4 @@
-// The development nip end to end on a reduced scene (tests/nip/kawamoto_nip_reduced.yaml: a
+// The development nip end to end on a reduced scene (tests/scenes/nip/kawamoto_nip_reduced.yaml: a
 // 0.3 mm slab of 1,300 beads, the paper's magnetic cutoff), through `magbrush run` exactly as a
 // user runs it (field, DEM with the nip measurements, report), asserting Kawamoto's findings:
 //
@@ -68,7 +68,7 @@ ReducedNipRun run_reduced_nip()
   fs::create_directories(r.dir);
   const std::string cmd = "cd '" + r.dir.string() + "' && OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 '" +
                           binary_dir + "/bin/magbrush' run '" + source_dir +
-                          "/tests/nip/kawamoto_nip_reduced.yaml' --skip mesh --set output.directory=results "
+                          "/tests/scenes/nip/kawamoto_nip_reduced.yaml' --skip mesh --set output.directory=results "
                           "> run.log 2>&1";
   const int raw = std::system(cmd.c_str());
   r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;

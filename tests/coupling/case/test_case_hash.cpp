@@ -7,7 +7,7 @@
 using namespace magbrush;
 
 namespace {
-const std::string full = std::string(MAGBRUSH_SOURCE_DIR) + "/tests/case/valid/full_roller.yaml";
+const std::string full = std::string(MAGBRUSH_SOURCE_DIR) + "/tests/coupling/case/valid/full_roller.yaml";
 
 struct Hashes
 {

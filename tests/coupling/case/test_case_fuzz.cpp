@@ -58,7 +58,7 @@ TEST(CaseFuzz, DamagedCasesLoadOrFailCleanly)
   std::mt19937 rng(20261122);
   int valid = 0, invalid = 0;
   for (const char *file : {"/cases/kawamoto_nip.yaml", "/cases/kweon_full_roller.yaml",
-                           "/cases/kawamoto_brush_compression.yaml", "/tests/case/valid/full_roller.yaml"})
+                           "/cases/kawamoto_brush_compression.yaml", "/tests/coupling/case/valid/full_roller.yaml"})
   {
     const std::string text = read_file(std::string(MAGBRUSH_SOURCE_DIR) + file);
     ASSERT_FALSE(text.empty());

@@ -12,77 +12,53 @@
 
 namespace {
 
-const char *usage =
-    "Usage: magbrush check CASE.yaml [--set key=value ...] [--quiet | --inputs magnetic|electric]\n"
-    "       magbrush check --explain [--markdown]\n\n"
-    "Validates a case file (units, keys, ranges, geometry) and prints the resolved case with\n"
-    "units, derived numbers (surface speeds, relative nip speed, particle counts and masses,\n"
-    "pole field estimate) and the hashes of the magnetic and electric field inputs.\n\n"
-    "  --set key=value  override a key, e.g. --set drum.gap=0.3mm --set roller.poles.N1.angle=95deg\n"
-    "                   (list elements by name or [index]); validated like the file\n"
-    "  --quiet          print nothing when the case is valid\n"
-    "  --inputs KIND    print only the inputs the stored KIND field depends on (magnetic, electric),\n"
-    "                   i.e. what its hash covers\n"
-    "  --explain        print every key of the case schema: type, default, range, meaning\n"
-    "  --markdown       with --explain: Markdown table (docs/case_reference.md)\n\n"
-    "Exit status: 0 valid, 1 invalid case (errors on stderr), 2 usage error.\n";
-
-int usage_error(const std::string &message)
+// The options, declared once: the parser and `magbrush run` read them (common/command_line.h).
+const magbrush::cli::CommandSpec &check_command_line()
 {
-  std::cerr << "magbrush check: " << message << "\n\n" << usage;
-  return 2;
+  static const magbrush::cli::CommandSpec spec = [] {
+    magbrush::cli::CommandSpec s;
+    s.program = "magbrush check";
+    s.usage = "magbrush check CASE.yaml [--set key=value ...] [--quiet | --inputs magnetic|electric]\n"
+              "       magbrush check --explain [--markdown]";
+    s.description =
+        "Validates a case file (units, keys, ranges, geometry) and prints the resolved case with\n"
+        "units, derived numbers (surface speeds, relative nip speed, particle counts and masses,\n"
+        "pole field estimate) and the hashes of the magnetic and electric field inputs.\n";
+    s.positionals = {{"CASE.yaml", "the case file (not with --explain)", magbrush::cli::Positional::optional}};
+    s.options = {
+        {"--set", {"-s"}, "key=value",
+         "override a key, e.g. --set drum.gap=0.3mm --set roller.poles.N1.angle=95deg\n"
+         "(list elements by name or [index]); validated like the file",
+         /*repeatable=*/true},
+        {"--quiet", {"-q"}, "", "print nothing when the case is valid"},
+        {"--inputs", {}, "KIND",
+         "print only the inputs the stored KIND field depends on (magnetic, electric),\ni.e. what its hash covers",
+         false, {"magnetic", "electric"}, /*for_pipeline=*/false},
+        {"--explain", {}, "", "print every key of the case schema: type, default, range, meaning",
+         false, {}, /*for_pipeline=*/false},
+        {"--markdown", {}, "", "with --explain: Markdown table (docs/case_reference.md)", false, {}, false}};
+    s.epilog = "Exit status: 0 valid, 1 invalid case (errors on stderr), 2 usage error.\n";
+    return s;
+  }();
+  return spec;
 }
 
-int run_check(const std::vector<std::string> &args)
+int check(const magbrush::cli::ParsedArguments &args)
 {
-  std::string case_file;
-  std::vector<std::string> overrides;
-  bool explain = false, markdown = false, quiet = false;
-  std::string inputs;
-  for (size_t i = 1; i < args.size(); ++i)
-  {
-    const std::string &a = args[i];
-    if (a == "--help" || a == "-h")
-    {
-      std::cout << usage;
-      return 0;
-    }
-    if (a == "--explain")
-      explain = true;
-    else if (a == "--markdown")
-      markdown = true;
-    else if (a == "--quiet" || a == "-q")
-      quiet = true;
-    else if (a == "--inputs")
-    {
-      if (i + 1 >= args.size() || (args[i + 1] != "magnetic" && args[i + 1] != "electric"))
-        return usage_error("--inputs needs 'magnetic' or 'electric'");
-      inputs = args[++i];
-    }
-    else if (a == "--set" || a == "-s")
-    {
-      if (i + 1 >= args.size())
-        return usage_error("--set needs key=value (e.g. --set drum.gap=0.3mm)");
-      overrides.push_back(args[++i]);
-    }
-    else if (a.rfind("--set=", 0) == 0)
-      overrides.push_back(a.substr(6));
-    else if (!a.empty() && a[0] == '-')
-      return usage_error("unknown option '" + a + "'");
-    else if (case_file.empty())
-      case_file = a;
-    else
-      return usage_error("more than one case file given ('" + case_file + "' and '" + a + "')");
-  }
+  using magbrush::cli::UsageError;
+  const std::string case_file = args.positional(0);
+  const std::vector<std::string> overrides = args.values("--set");
+  const bool explain = args.has("--explain"), markdown = args.has("--markdown"), quiet = args.has("--quiet");
+  const std::string inputs = args.value("--inputs");
   if (explain)
   {
     std::cout << magbrush::format_schema(markdown);
     return 0;
   }
   if (markdown)
-    return usage_error("--markdown goes with --explain");
+    throw UsageError("--markdown goes with --explain");
   if (case_file.empty())
-    return usage_error("no case file given");
+    throw UsageError("no case file given");
   try
   {
     const magbrush::Case c = magbrush::load_case(case_file, overrides);
@@ -110,7 +86,13 @@ int run_check(const std::vector<std::string> &args)
   }
 }
 
+int run_check(const std::vector<std::string> &args)
+{
+  return magbrush::cli::run_command(check_command_line(), {args.begin() + 1, args.end()}, check);
+}
+
 const bool registered = magbrush::register_subcommand(
-    {"check", "validate a case and print it with units (--explain: the case-file reference)", run_check, 10});
+    {"check", "validate a case and print it with units (--explain: the case-file reference)", run_check,
+     check_command_line, 10});
 
 } // namespace

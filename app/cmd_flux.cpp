@@ -16,6 +16,7 @@
 #include "calibration/flux_compare.h"
 #include "calibration/flux_scan.h"
 #include "calibration/pole_fit.h"
+#include "common/child_process.h"
 #include "coupling/case_hash.h"
 #include "coupling/case_parser.h"
 #include "coupling/field_files.h"
@@ -35,7 +36,6 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
-#include <sys/wait.h>
 #include <vector>
 
 namespace magbrush {
@@ -44,10 +44,14 @@ namespace {
 namespace fs = std::filesystem;
 constexpr double to_deg = 180.0 / M_PI;
 
-const char *flux_help =
-    R"(Usage: magbrush flux CASE [--measured SCAN.csv] [-o DIR] [--set key=value ...] [options]
-
-Compares the sleeve flux profile of a case with a gaussmeter scan, and with --fit calibrates
+// The options, declared once: the parser and `magbrush run` read them (common/command_line.h).
+const cli::CommandSpec &flux_command_line()
+{
+  static const cli::CommandSpec spec = [] {
+    cli::CommandSpec s;
+    s.program = "magbrush flux";
+    s.usage = "magbrush flux CASE [--measured SCAN.csv] [-o DIR] [--set key=value ...] [options]";
+    s.description = R"(Compares the sleeve flux profile of a case with a gaussmeter scan, and with --fit calibrates
 the Gaussian pole model (strengths, angles, shape factors, encoder offset) to it.
 
 The computed profile is taken at field.probe_radius (0 = the sleeve radius): from the finite-
@@ -59,34 +63,43 @@ Scan (CSV): columns angle, Bn[, Bt] in any order (names like angle_deg/theta, Bn
 Bt/B_t/Btheta), units in the header (angle_deg, Bn_mT, "Bn [G]") or given below, '#' comments.
 Without --measured the case's measured_flux_file is used; without either only the computed
 profile is written.
-
-Options:
-  --measured FILE        the gaussmeter scan
-  -o, --output DIR       output directory (default: <output.directory>/<case name>/flux)
-  --set key=value        override a case value (repeatable), e.g. --set field.probe_radius=10mm
-  --angle-unit deg|rad   unit of the scan's angle column (overrides the header)
-  --field-unit T|mT|G|kG unit of the scan's Bn/Bt columns (overrides the header)
-  --angle-offset ANGLE   roller angle = scan angle + ANGLE (e.g. 2.5deg); default: the case's
-                         measured_flux_angle_origin (which --fit writes into the fitted case)
-  --clockwise            the scan's angle runs clockwise (Bt is then negated too)
-  --flip-bt              the probe's Bt is positive clockwise: negate it
-  --source auto|ring|fem computed profile from the FEM if present (auto), the exact ring, or
-                         the FEM only (error if missing)
-  --fit                  fit the pole model to the scan; writes <case>_fitted.yaml in DIR
-  --fit-shape auto|shared|per-pole|fixed   shape factors α: auto (default) fits one for all
-                         and one per pole and keeps per-pole when an F-test finds it significantly
-                         better (p < 0.001); or one for all, one per pole, held at the case's values
-  --no-offset            do not fit an encoder offset (every pole angle free)
-  --bn-only              fit Bn only (ignore Bt)
-  --no-fem-check         skip running magbrush-field on the fitted case
-  --no-plot              do not call tools/plot_flux.py (the plot needs python3 with
-                         matplotlib; $MAGBRUSH_PYTHON picks the interpreter)
-  --harmonics N          number of Fourier harmonics (default: from the decay of the series)
-
-Outputs in DIR: flux_profile.csv (computed, 0.25 deg), flux_residuals.csv, flux_overlay.png,
+)";
+    s.positionals = {{"CASE", "the case file"}};
+    s.options = {
+        {"--measured", {}, "FILE", "the gaussmeter scan"},
+        {"--output", {"-o"}, "DIR", "output directory (default: <output.directory>/<case name>/flux)", false, {},
+         /*for_pipeline=*/false},
+        cli::set_option("field.probe_radius=10mm"),
+        {"--angle-unit", {}, "deg|rad", "unit of the scan's angle column (overrides the header)"},
+        {"--field-unit", {}, "T|mT|G|kG", "unit of the scan's Bn/Bt columns (overrides the header)"},
+        {"--angle-offset", {}, "ANGLE",
+         "roller angle = scan angle + ANGLE (e.g. 2.5deg); default: the case's\n"
+         "measured_flux_angle_origin (which --fit writes into the fitted case)"},
+        {"--clockwise", {}, "", "the scan's angle runs clockwise (Bt is then negated too)"},
+        {"--flip-bt", {}, "", "the probe's Bt is positive clockwise: negate it"},
+        {"--source", {}, "auto|ring|fem",
+         "computed profile from the FEM if present (auto), the exact ring, or\nthe FEM only (error if missing)",
+         false, {"auto", "ring", "fem"}},
+        {"--fit", {}, "", "fit the pole model to the scan; writes <case>_fitted.yaml in DIR"},
+        {"--fit-shape", {}, "auto|shared|per-pole|fixed",
+         "shape factors α: auto (default) fits one for all and one per pole and\n"
+         "keeps per-pole when an F-test finds it significantly better (p < 0.001);\n"
+         "or one for all, one per pole, held at the case's values",
+         false, {"auto", "shared", "per-pole", "per_pole", "fixed"}},
+        {"--no-offset", {}, "", "do not fit an encoder offset (every pole angle free)"},
+        {"--bn-only", {}, "", "fit Bn only (ignore Bt)"},
+        {"--no-fem-check", {}, "", "skip running magbrush-field on the fitted case"},
+        {"--no-plot", {}, "",
+         "do not call tools/plot_flux.py (the plot needs python3 with\nmatplotlib; $MAGBRUSH_PYTHON picks the interpreter)"},
+        {"--harmonics", {}, "N", "number of Fourier harmonics (default: from the decay of the series)"}};
+    s.epilog = R"(Outputs in DIR: flux_profile.csv (computed, 0.25 deg), flux_residuals.csv, flux_overlay.png,
 and with --fit: flux_fit_residuals.csv, <case>_fitted.yaml, flux_fit.txt.
 Exit status: 0 done, 1 bad input (message says what and how to fix), 2 bad usage.
 )";
+    return s;
+  }();
+  return spec;
+}
 
 struct FluxOptions
 {
@@ -100,97 +113,41 @@ struct FluxOptions
   int harmonics = 0;
 };
 
-struct UsageError : std::invalid_argument
-{
-  using std::invalid_argument::invalid_argument;
-};
-
-FluxOptions parse_arguments(const std::vector<std::string> &args)
+// What the parsed command line asks for, in the terms of the steps below.
+FluxOptions flux_options(const cli::ParsedArguments &args)
 {
   FluxOptions o;
-  auto value = [&](size_t &i) -> std::string {
-    if (i + 1 >= args.size())
-      throw UsageError(args[i] + " needs a value (see magbrush flux --help)");
-    return args[++i];
-  };
-  for (size_t i = 1; i < args.size(); ++i)
-  {
-    const std::string &a = args[i];
-    if (a == "--measured")
-      o.measured = value(i);
-    else if (a == "-o" || a == "--output")
-      o.output_dir = value(i);
-    else if (a == "--set")
-      o.overrides.push_back(value(i));
-    else if (a.rfind("--set=", 0) == 0)
-      o.overrides.push_back(a.substr(6));
-    else if (a == "--angle-unit")
-      o.scan.angle_unit = value(i);
-    else if (a == "--field-unit")
-      o.scan.field_unit = value(i);
-    else if (a == "--angle-offset")
-    {
-      o.scan.angle_offset = parse_quantity(value(i), Dimension::angle);
-      o.angle_offset_given = true;
-    }
-    else if (a == "--clockwise")
-      o.scan.clockwise = true;
-    else if (a == "--flip-bt")
-      o.scan.flip_tangential = true;
-    else if (a == "--source")
-    {
-      o.source = value(i);
-      if (o.source != "auto" && o.source != "ring" && o.source != "fem")
-        throw UsageError("--source expects auto, ring or fem, found '" + o.source + "'");
-    }
-    else if (a == "--fit")
-      o.fit = true;
-    else if (a == "--fit-shape")
-    {
-      const std::string s = value(i);
-      if (s == "auto")
-        o.fit_options.shape = PoleFitOptions::Shape::automatic;
-      else if (s == "shared")
-        o.fit_options.shape = PoleFitOptions::Shape::shared;
-      else if (s == "per-pole" || s == "per_pole")
-        o.fit_options.shape = PoleFitOptions::Shape::per_pole;
-      else if (s == "fixed")
-        o.fit_options.shape = PoleFitOptions::Shape::fixed;
-      else
-        throw UsageError("--fit-shape expects auto, shared, per-pole or fixed, found '" + s + "'");
-    }
-    else if (a == "--no-offset")
-      o.fit_options.fit_offset = false;
-    else if (a == "--bn-only")
-      o.fit_options.use_tangential = false;
-    else if (a == "--no-fem-check")
-      o.no_fem_check = true;
-    else if (a == "--no-plot")
-      o.no_plot = true;
-    else if (a == "--harmonics")
-    {
-      const std::string s = value(i);
-      try
-      {
-        o.harmonics = std::stoi(s);
-      }
-      catch (const std::exception &)
-      {
-        o.harmonics = -1;
-      }
-      if (o.harmonics < 1 || o.harmonics > 4096)
-        throw UsageError("--harmonics expects a whole number in 1..4096, found '" + s + "'");
-      o.fit_options.harmonics = o.harmonics;
-    }
-    else if (!a.empty() && a[0] == '-')
-      throw UsageError("unknown option '" + a + "' (see magbrush flux --help)");
-    else if (o.case_path.empty())
-      o.case_path = a;
-    else
-      throw UsageError("more than one case given ('" + o.case_path + "' and '" + a + "')");
-  }
-  if (o.case_path.empty())
-    throw UsageError("no case file given (usage: magbrush flux CASE --measured SCAN.csv)");
+  o.case_path = args.positional(0);
+  o.measured = args.value("--measured");
+  o.output_dir = args.value("--output");
+  o.overrides = args.values("--set");
+  o.scan.angle_unit = args.value("--angle-unit", o.scan.angle_unit);
+  o.scan.field_unit = args.value("--field-unit", o.scan.field_unit);
+  o.angle_offset_given = args.has("--angle-offset");
+  if (o.angle_offset_given)
+    o.scan.angle_offset = parse_quantity(args.value("--angle-offset"), Dimension::angle);
+  o.scan.clockwise = args.has("--clockwise");
+  o.scan.flip_tangential = args.has("--flip-bt");
+  o.source = args.value("--source", "auto");
+  o.fit = args.has("--fit");
+  const std::string shape = args.value("--fit-shape");
+  if (shape == "auto")
+    o.fit_options.shape = PoleFitOptions::Shape::automatic;
+  else if (shape == "shared")
+    o.fit_options.shape = PoleFitOptions::Shape::shared;
+  else if (shape == "per-pole" || shape == "per_pole")
+    o.fit_options.shape = PoleFitOptions::Shape::per_pole;
+  else if (shape == "fixed")
+    o.fit_options.shape = PoleFitOptions::Shape::fixed;
+  if (args.has("--no-offset"))
+    o.fit_options.fit_offset = false;
+  if (args.has("--bn-only"))
+    o.fit_options.use_tangential = false;
+  o.no_fem_check = args.has("--no-fem-check");
+  o.no_plot = args.has("--no-plot");
+  o.harmonics = static_cast<int>(args.whole_number("--harmonics", 0, 1, 4096));
+  if (o.harmonics > 0)
+    o.fit_options.harmonics = o.harmonics;
   return o;
 }
 
@@ -346,21 +303,6 @@ std::string find_plot_script()
   return "";
 }
 
-std::string quoted(const std::string &s)
-{
-  std::string q = "'";
-  for (char ch : s)
-    q += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
-  return q + "'";
-}
-
-int exit_status(int raw)
-{
-  if (raw == -1)
-    return -1;
-  return WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-}
-
 void plot(const std::string &residuals, const std::string &fitted, const std::string &png,
           const std::string &title, const std::string &label)
 {
@@ -371,9 +313,10 @@ void plot(const std::string &residuals, const std::string &fitted, const std::st
                  "directory); no plot written\n";
     return;
   }
-  const std::string arguments = " " + quoted(script) + " --residuals " + quoted(residuals) +
-                              (fitted.empty() ? "" : " --fitted " + quoted(fitted)) + " --title " +
-                              quoted(title) + " --label " + quoted(label) + " -o " + quoted(png);
+  std::vector<std::string> arguments = {script, "--residuals", residuals};
+  if (!fitted.empty())
+    arguments.insert(arguments.end(), {"--fitted", fitted});
+  arguments.insert(arguments.end(), {"--title", title, "--label", label, "-o", png});
   // The first interpreter that has matplotlib: $MAGBRUSH_PYTHON, python3 on the PATH, then the
   // system's (a pyenv or venv python3 on the PATH often lacks the Debian matplotlib).
   // $MAGBRUSH_PYTHON, when set, is the only one tried.
@@ -386,12 +329,22 @@ void plot(const std::string &residuals, const std::string &fitted, const std::st
     if (fs::exists("/usr/bin/python3"))
       interpreters.push_back("/usr/bin/python3");
   }
+  // The script exits with 3 when matplotlib is missing; 127 stands for "could not start".
   int status = 127;
-  std::cout << std::flush;
+  ChildOutput quiet;
+  quiet.stderr_path = "/dev/null";
   for (const auto &python : interpreters)
   {
-    const std::string cmd = quoted(python) + arguments + " 2>/dev/null";
-    status = exit_status(std::system(cmd.c_str()));
+    std::vector<std::string> command = {python};
+    command.insert(command.end(), arguments.begin(), arguments.end());
+    try
+    {
+      status = run_program(command, quiet);
+    }
+    catch (const ChildProcessError &)
+    {
+      status = 127;
+    }
     if (status != 3 && status != 127)
       break;
   }
@@ -570,13 +523,23 @@ void fem_check(const std::string &fitted_case, const FluxScan &scan, const std::
   }
   std::cout << "FEM check: running magbrush-field on " << fitted_case << " ...\n" << std::flush;
   const std::string log = dir + "/flux_fem_check.log";
-  const std::string cmd = quoted(field_exe.string()) + " " + quoted(fitted_case) +
-                          " --only magnetic --no-vtu > " + quoted(log) + " 2>&1";
-  const int status = exit_status(std::system(cmd.c_str()));
-  if (status != 0)
+  ChildOutput to_log;
+  to_log.stdout_path = log;
+  to_log.stderr_to_stdout = true;
+  std::string failure;
+  try
   {
-    std::cout << "FEM check failed: magbrush-field exited with status " << status << " (see "
-              << log << ")\n";
+    const int status = run_program({field_exe.string(), fitted_case, "--only", "magnetic", "--no-vtu"}, to_log);
+    if (status != 0)
+      failure = "magbrush-field exited with status " + std::to_string(status);
+  }
+  catch (const ChildProcessError &e)
+  {
+    failure = e.what();
+  }
+  if (!failure.empty())
+  {
+    std::cout << "FEM check failed: " << failure << " (see " << log << ")\n";
     return;
   }
   const Case fitted = load_case(fitted_case);
@@ -813,28 +776,13 @@ private:
 
 int run_flux(const std::vector<std::string> &args)
 {
-  for (const auto &a : args)
-    if (a == "--help" || a == "-h")
-    {
-      std::cout << flux_help;
-      return 0;
-    }
-  FluxOptions options;
-  try
-  {
-    options = parse_arguments(args);
-  }
-  catch (const UsageError &e)
-  {
-    std::cerr << "magbrush flux: " << e.what() << "\n";
-    return 2;
-  }
-  return FluxCommand(options).run();
+  return cli::run_command(flux_command_line(), {args.begin() + 1, args.end()},
+                          [](const cli::ParsedArguments &parsed) { return FluxCommand(flux_options(parsed)).run(); });
 }
 
 const bool registered = register_subcommand(
     {"flux", "compare the sleeve flux with a gaussmeter scan; --fit calibrates the poles",
-     run_flux, 50});
+     run_flux, flux_command_line, 50});
 
 } // namespace
 } // namespace magbrush

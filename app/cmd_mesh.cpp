@@ -13,86 +13,45 @@
 
 namespace {
 
-const char *usage =
-    "Usage: magbrush mesh CASE.yaml [--set key=value ...] [-o DIR] [--only roller|nip]\n"
-    "                    [--verbose] [--gui-free]\n\n"
-    "Writes the quadrilateral meshes the field solver reads (MSH 2.2 ASCII, written atomically):\n"
-    "  DIR/roller.msh  shaft, magnet, sleeve wall, air, magnetic blades, open-boundary shell\n"
-    "                  (needs roller and sleeve)\n"
-    "  DIR/nip.msh     air, photoconductor layer, shell; sleeve, drum substrate and outer\n"
-    "                  boundaries (needs drum.present)\n"
-    "and prints, per region, the cells and the meshed area against the exact area, per boundary\n"
-    "the faces and the length. Region and boundary tags are listed in geometry/mesh_tags.h.\n"
-    "Element sizes: field.mesh_size_sleeve, field.mesh_size_gap, field.mesh_size_far; the shell\n"
-    "starts at field.outer_radius_factor times the radius enclosing the scene.\n\n"
-    "  --set key=value  override a case key (e.g. --set field.mesh_size_sleeve=0.2mm)\n"
-    "  -o, --output DIR where to write (default: meshes/<case name>)\n"
-    "  --only WHICH     only the roller or only the nip mesh\n"
-    "  --verbose        show Gmsh's progress messages\n"
-    "  --gui-free       accepted for scripts; magbrush never opens the Gmsh GUI\n\n"
-    "Exit status: 0 written, 1 invalid case or meshing failure, 2 usage error.\n";
-
-int usage_error(const std::string &message)
+// The options, declared once: the parser and `magbrush run` read them (common/command_line.h).
+const magbrush::cli::CommandSpec &mesh_command_line()
 {
-  std::cerr << "magbrush mesh: " << message << "\n\n" << usage;
-  return 2;
+  static const magbrush::cli::CommandSpec spec = [] {
+    magbrush::cli::CommandSpec s;
+    s.program = "magbrush mesh";
+    s.usage = "magbrush mesh CASE.yaml [--set key=value ...] [-o DIR] [--only roller|nip]\n"
+              "                    [--verbose] [--gui-free]";
+    s.description =
+        "Writes the quadrilateral meshes the field solver reads (MSH 2.2 ASCII, written atomically):\n"
+        "  DIR/roller.msh  shaft, magnet, sleeve wall, air, magnetic blades, open-boundary shell\n"
+        "                  (needs roller and sleeve)\n"
+        "  DIR/nip.msh     air, photoconductor layer, shell; sleeve, drum substrate and outer\n"
+        "                  boundaries (needs drum.present)\n"
+        "and prints, per region, the cells and the meshed area against the exact area, per boundary\n"
+        "the faces and the length. Region and boundary tags are listed in geometry/mesh_tags.h.\n"
+        "Element sizes: field.mesh_size_sleeve, field.mesh_size_gap, field.mesh_size_far; the shell\n"
+        "starts at field.outer_radius_factor times the radius enclosing the scene.\n";
+    s.positionals = {{"CASE.yaml", "the case file"}};
+    s.options = {
+        magbrush::cli::set_option("field.mesh_size_sleeve=0.2mm"),
+        {"--output", {"-o"}, "DIR", "where to write (default: meshes/<case name>)", false, {}, /*for_pipeline=*/false},
+        {"--only", {}, "WHICH", "only the roller or only the nip mesh", false, {"roller", "nip"}, false},
+        {"--verbose", {"-v"}, "", "show Gmsh's progress messages"},
+        {"--gui-free", {}, "", "accepted for scripts; magbrush never opens the Gmsh GUI"}};
+    s.epilog = "Exit status: 0 written, 1 invalid case or meshing failure, 2 usage error.\n";
+    return s;
+  }();
+  return spec;
 }
 
-int run_mesh(const std::vector<std::string> &args)
+int mesh(const magbrush::cli::ParsedArguments &args)
 {
-  std::string case_file, output_dir, only;
-  std::vector<std::string> overrides;
+  const std::string case_file = args.positional(0);
+  const std::vector<std::string> overrides = args.values("--set");
+  std::string output_dir = args.value("--output");
+  const std::string only = args.value("--only");
   magbrush::MeshOptions options;
-  for (size_t i = 1; i < args.size(); ++i)
-  {
-    const std::string &a = args[i];
-    auto value = [&](const std::string &what) -> const std::string * {
-      if (i + 1 >= args.size())
-        return nullptr;
-      (void)what;
-      return &args[++i];
-    };
-    if (a == "--help" || a == "-h")
-    {
-      std::cout << usage;
-      return 0;
-    }
-    if (a == "--set" || a == "-s")
-    {
-      const std::string *v = value("key=value");
-      if (!v)
-        return usage_error("--set needs key=value (e.g. --set field.mesh_size_far=3mm)");
-      overrides.push_back(*v);
-    }
-    else if (a.rfind("--set=", 0) == 0)
-      overrides.push_back(a.substr(6));
-    else if (a == "-o" || a == "--output")
-    {
-      const std::string *v = value("directory");
-      if (!v)
-        return usage_error(a + " needs a directory");
-      output_dir = *v;
-    }
-    else if (a == "--only")
-    {
-      const std::string *v = value("roller|nip");
-      if (!v || (*v != "roller" && *v != "nip"))
-        return usage_error("--only needs 'roller' or 'nip'");
-      only = *v;
-    }
-    else if (a == "--verbose" || a == "-v")
-      options.verbose = true;
-    else if (a == "--gui-free")
-      ; // never a GUI
-    else if (!a.empty() && a[0] == '-')
-      return usage_error("unknown option '" + a + "'");
-    else if (case_file.empty())
-      case_file = a;
-    else
-      return usage_error("more than one case file given ('" + case_file + "' and '" + a + "')");
-  }
-  if (case_file.empty())
-    return usage_error("no case file given");
+  options.verbose = args.has("--verbose");
 
   magbrush::Case c;
   try
@@ -142,7 +101,13 @@ int run_mesh(const std::vector<std::string> &args)
   return 0;
 }
 
+int run_mesh(const std::vector<std::string> &args)
+{
+  return magbrush::cli::run_command(mesh_command_line(), {args.begin() + 1, args.end()}, mesh);
+}
+
 const bool registered = magbrush::register_subcommand(
-    {"mesh", "write the Gmsh meshes of the roller and the nip (quadrilaterals, MSH 2.2)", run_mesh, 20});
+    {"mesh", "write the Gmsh meshes of the roller and the nip (quadrilaterals, MSH 2.2)", run_mesh,
+     mesh_command_line, 20});
 
 } // namespace

@@ -4,7 +4,7 @@
 // the last snapshot, the time series, and index.md / index.html with the key numbers and the
 // links to the ParaView files.
 //
-// The steps, as run_report() reads:
+// The steps, as report() reads:
 //   1. load the case (with --set overrides, exactly as the run did);
 //   2. check that the DEM outputs are there (clear error naming the missing file otherwise);
 //   3. write into <output.directory>/report/: the resolved case, the measured scan normalised
@@ -15,6 +15,8 @@
 #include "app/subcommand.h"
 
 #include "calibration/flux_scan.h"
+#include "common/atomic_file.h"
+#include "common/child_process.h"
 #include "coupling/case_format.h"
 #include "coupling/case_parser.h"
 #include "coupling/field_files.h"
@@ -28,7 +30,6 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
-#include <sys/wait.h>
 #include <vector>
 
 namespace magbrush {
@@ -36,10 +37,14 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const char *report_help =
-    R"(Usage: magbrush report CASE [--set key=value ...] [-o DIR]
-
-Writes the report of a finished run of CASE into <output.directory>/report/ (or DIR):
+// The options, declared once: the parser and `magbrush run` read them (common/command_line.h).
+const cli::CommandSpec &report_command_line()
+{
+  static const cli::CommandSpec spec = [] {
+    cli::CommandSpec s;
+    s.program = "magbrush report";
+    s.usage = "magbrush report CASE [--set key=value ...] [-o DIR]";
+    s.description = R"(Writes the report of a finished run of CASE into <output.directory>/report/ (or DIR):
   nip_slip.png, nip_pressure.png, nip_ratio.png, nip_density.png, nip_force_per_bead.png,
   chain_inclination.png   profiles along the nip (Kawamoto Fig. 17-20), when the scene has a drum
   flux_profile.png        the computed sleeve flux (over output.measured_flux_file's scan if given)
@@ -49,18 +54,19 @@ Writes the report of a finished run of CASE into <output.directory>/report/ (or 
                           speed, peak normal pressure against B^2/2mu0, tangential/normal,
                           touching density, beads in/out, run times per stage and force term)
                           with the plots and links to the ParaView files
-Needs the DEM outputs (<output.directory>/dem/: run `magbrush dem CASE` or `magbrush run CASE`
+)";
+    s.positionals = {{"CASE", "the case file of the run"}};
+    s.options = {cli::set_option(),
+                 {"--output", {"-o"}, "DIR", "write the report here instead of <output.directory>/report",
+                  false, {}, /*for_pipeline=*/false}};
+    s.epilog = R"(Needs the DEM outputs (<output.directory>/dem/: run `magbrush dem CASE` or `magbrush run CASE`
 first) and python3 with matplotlib, numpy and h5py (Debian: python3-matplotlib python3-h5py);
 $MAGBRUSH_PYTHON picks the interpreter, $MAGBRUSH_TOOLS the folder holding report.py.
 Exit status: 0 done, 1 missing outputs or a failed plot script, 2 bad usage.
 )";
-
-std::string quoted(const std::string &s)
-{
-  std::string q = "'";
-  for (char ch : s)
-    q += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
-  return q + "'";
+    return s;
+  }();
+  return spec;
 }
 
 // tools/report.py of the source tree this binary was built from (__FILE__ is the absolute
@@ -83,6 +89,23 @@ std::string find_report_script()
   return "";
 }
 
+// A number for the command line of the plot script, with all the digits it needs.
+std::string number(double value)
+{
+  char text[32];
+  std::snprintf(text, sizeof text, "%.9g", value);
+  return text;
+}
+
+// The command as one line, for messages only (it is never given to a shell).
+std::string command_text(const std::vector<std::string> &command)
+{
+  std::string text;
+  for (const auto &word : command)
+    text += (text.empty() ? "" : " ") + word;
+  return text;
+}
+
 std::string python_interpreter()
 {
   if (const char *env = std::getenv("MAGBRUSH_PYTHON"))
@@ -90,20 +113,6 @@ std::string python_interpreter()
   if (fs::exists("/usr/bin/python3"))
     return "/usr/bin/python3"; // the Debian one, with python3-matplotlib / python3-h5py
   return "python3";
-}
-
-void write_text_atomically(const fs::path &path, const std::string &text)
-{
-  const fs::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream o(tmp);
-    if (!o)
-      throw std::runtime_error("cannot write '" + tmp.string() + "': check that the folder is writable");
-    o << text;
-    if (!o)
-      throw std::runtime_error("writing '" + tmp.string() + "' failed (disk full?)");
-  }
-  fs::rename(tmp, path);
 }
 
 // The case's measured scan in the report's own simple format (angle_deg, Bn_mT, Bt_mT), so
@@ -132,55 +141,14 @@ std::string normalised_scan(const Case &c, const fs::path &report_dir)
     o << line;
   }
   const fs::path out = report_dir / "measured_flux.csv";
-  write_text_atomically(out, o.str());
+  write_text_atomically(out.string(), o.str());
   return out.string();
 }
 
-int run_report(const std::vector<std::string> &args)
+int report(const cli::ParsedArguments &args)
 {
-  std::string case_path, output_dir;
-  std::vector<std::string> overrides;
-  for (std::size_t i = 1; i < args.size(); ++i)
-  {
-    const std::string &a = args[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= args.size())
-        throw std::invalid_argument(a + " needs a value (see magbrush report --help)");
-      return args[++i];
-    };
-    if (a == "--help" || a == "-h")
-    {
-      std::cout << report_help;
-      return 0;
-    }
-    else if (a == "--set")
-      overrides.push_back(value());
-    else if (a.rfind("--set=", 0) == 0)
-      overrides.push_back(a.substr(6));
-    else if (a == "-o" || a == "--output")
-      output_dir = value();
-    else if (a == "-np" || a == "--np" || a == "--threads" || a == "--restart")
-      ++i; // options of other stages passed along by `magbrush run`
-    else if (a == "--force" || a == "--no-vtu")
-      ; // field-solver options passed along by `magbrush run`
-    else if (!a.empty() && a[0] == '-')
-    {
-      std::cerr << "magbrush report: unknown option '" << a << "'\n" << report_help;
-      return 2;
-    }
-    else if (case_path.empty())
-      case_path = a;
-    else
-    {
-      std::cerr << "magbrush report: expected one case file, found a second: '" << a << "'\n";
-      return 2;
-    }
-  }
-  if (case_path.empty())
-  {
-    std::cerr << report_help;
-    return 2;
-  }
+  const std::string case_path = args.positional(0), output_dir = args.value("--output");
+  const std::vector<std::string> overrides = args.values("--set");
 
   const Case c = load_case(case_path, overrides);
   const fs::path results = c.output.directory;
@@ -205,7 +173,7 @@ int run_report(const std::vector<std::string> &args)
     return 1;
   }
   fs::create_directories(report_dir);
-  write_text_atomically(report_dir / "case_resolved.txt",
+  write_text_atomically((report_dir / "case_resolved.txt").string(),
                         "# case " + c.name + " as resolved for this report (" + case_path + ")\n" + format_case(c));
   const std::string scan = normalised_scan(c, report_dir);
 
@@ -216,24 +184,38 @@ int run_report(const std::vector<std::string> &args)
                  "the folder that holds it\n";
     return 1;
   }
-  std::ostringstream cmd;
-  char geometry[256];
   const Vec2 drum_centre = c.drum.present && c.sleeve ? c.drum.center(c.sleeve->radius) : Vec2{0, 0};
-  std::snprintf(geometry, sizeof geometry,
-                " --sleeve-radius %.9g --drum-radius %.9g --drum-center %.9g,%.9g --sleeve-sense %d",
-                c.sleeve ? c.sleeve->radius : 0.0, c.drum.present ? c.drum.radius : 0.0, drum_centre[0],
-                drum_centre[1], c.sleeve && c.sleeve->rpm < 0.0 ? -1 : 1);
-  cmd << quoted(python_interpreter()) << " " << quoted(script) << " --case-name " << quoted(c.name) << " --dem-dir "
-      << quoted(dem_dir.string()) << " --field-prefix " << quoted(field::field_file(c, "")) << " --out "
-      << quoted(report_dir.string()) << " --run-times " << quoted((results / "run_times.csv").string()) << geometry;
+  std::vector<std::string> command = {python_interpreter(),
+                                      script,
+                                      "--case-name", c.name,
+                                      "--dem-dir", dem_dir.string(),
+                                      "--field-prefix", field::field_file(c, ""),
+                                      "--out", report_dir.string(),
+                                      "--run-times", (results / "run_times.csv").string(),
+                                      "--sleeve-radius", number(c.sleeve ? c.sleeve->radius : 0.0),
+                                      "--drum-radius", number(c.drum.present ? c.drum.radius : 0.0),
+                                      "--drum-center", number(drum_centre[0]) + "," + number(drum_centre[1]),
+                                      "--sleeve-sense", c.sleeve && c.sleeve->rpm < 0.0 ? "-1" : "1"};
   if (!scan.empty())
-    cmd << " --measured-flux " << quoted(scan);
+  {
+    command.push_back("--measured-flux");
+    command.push_back(scan);
+  }
   std::cout << "magbrush report: writing " << report_dir.string() << "/ ..." << std::endl;
-  const int raw = std::system(cmd.str().c_str());
-  const int status = raw == -1 ? -1 : (WIFEXITED(raw) ? WEXITSTATUS(raw) : -1);
+  int status = -1;
+  std::string why;
+  try
+  {
+    status = run_program(command);
+    why = "exit " + std::to_string(status);
+  }
+  catch (const ChildProcessError &e)
+  {
+    why = e.what();
+  }
   if (status != 0)
   {
-    std::cerr << "magbrush report: the plot script failed (exit " << status << "): " << cmd.str()
+    std::cerr << "magbrush report: the plot script failed (" << why << "): " << command_text(command)
               << "\n  It needs python3 with numpy, matplotlib and h5py (Debian: apt-get install python3-matplotlib "
                  "python3-h5py), or set MAGBRUSH_PYTHON to an interpreter that has them.\n";
     return 1;
@@ -242,21 +224,14 @@ int run_report(const std::vector<std::string> &args)
   return 0;
 }
 
-int report_main(const std::vector<std::string> &args)
+int run_report(const std::vector<std::string> &args)
 {
-  try
-  {
-    return run_report(args);
-  }
-  catch (const std::invalid_argument &e)
-  {
-    std::cerr << "magbrush report: " << e.what() << "\n";
-    return 2;
-  }
+  return cli::run_command(report_command_line(), {args.begin() + 1, args.end()}, report);
 }
 
 const bool registered = register_subcommand(
-    {"report", "plots, key numbers and ParaView links of a finished run (index.html)", report_main, 50});
+    {"report", "plots, key numbers and ParaView links of a finished run (index.html)", run_report,
+     report_command_line, 50});
 
 } // namespace
 } // namespace magbrush

@@ -11,6 +11,7 @@
 #include "subcommand.h"
 
 #include "case_parser.h"
+#include "common/atomic_file.h"
 #include "field_files.h"
 
 #include <chrono>
@@ -30,22 +31,6 @@ namespace magbrush {
 namespace {
 
 namespace fs = std::filesystem;
-
-const char *run_help =
-    R"(Usage: magbrush run CASE [--set key=value ...] [--only STAGE[,STAGE]] [--skip STAGE[,STAGE]]
-
-Runs the whole pipeline on one case, in order:
-  check   validate the case (file, line, key, unit, range)
-  mesh    write the Gmsh meshes of the roller and the nip
-  field   solve the magnetic and electric fields, store them as grids (reused when
-          the field-relevant inputs are unchanged)
-  dem     run the particles on the stored fields (its log is kept in <output.directory>/dem/dem.log)
-  report  plots, key numbers and ParaView links: <output.directory>/report/index.html
-Options after CASE are passed to every stage (e.g. --set drum.gap=0.3mm).
-Each stage is announced with the wall time it took in the last run of this case (its ETA); the
-DEM prints its own progress with an ETA. Stage times go to <output.directory>/run_times.csv. At
-the end: the time per stage and where every output is.
-)";
 
 std::vector<std::string> split_commas(const std::string &s)
 {
@@ -68,14 +53,6 @@ bool contains(const std::vector<std::string> &v, const std::string &s)
     if (x == s)
       return true;
   return false;
-}
-
-const Subcommand *find_stage(const std::string &name)
-{
-  for (const auto &c : subcommands())
-    if (c.name == name)
-      return &c;
-  return nullptr;
 }
 
 // Copies everything this process (and its children) write to stdout/stderr into a log file
@@ -158,14 +135,11 @@ std::map<std::string, double> read_run_times(const fs::path &path)
 void write_run_times(const fs::path &path, const std::vector<std::pair<std::string, double>> &timings)
 {
   fs::create_directories(path.parent_path());
-  const fs::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream o(tmp);
-    o << "stage,seconds\n";
+  write_file_atomically(path.string(), [&](std::ostream &out) {
+    out << "stage,seconds\n";
     for (const auto &[name, dt] : timings)
-      o << name << "," << dt << "\n";
-  }
-  fs::rename(tmp, path);
+      out << name << "," << dt << "\n";
+  });
 }
 
 // Where everything is, with a mark for what this run produced or found.
@@ -194,41 +168,67 @@ void print_outputs(const Case &c)
       std::printf("  %-28s %s\n", what.c_str(), path.string().c_str());
 }
 
-} // namespace
-
-int run_pipeline(const std::vector<std::string> &args)
+// Stage names from --only / --skip ("field,dem"), each checked against the pipeline.
+std::vector<std::string> stage_list(const cli::ParsedArguments &args, const std::string &option)
 {
-  std::vector<std::string> stage_args; // CASE and the options every stage understands
-  std::vector<std::string> only, skip, overrides;
-  for (size_t i = 1; i < args.size(); ++i)
-  {
-    if (args[i] == "--help" || args[i] == "-h")
-    {
-      std::cout << run_help;
-      return 0;
-    }
-    if ((args[i] == "--only" || args[i] == "--skip") && i + 1 < args.size())
-    {
-      (args[i] == "--only" ? only : skip) = split_commas(args[i + 1]);
-      ++i;
-      continue;
-    }
-    if (args[i] == "--set" && i + 1 < args.size())
-      overrides.push_back(args[i + 1]);
-    else if (args[i].rfind("--set=", 0) == 0)
-      overrides.push_back(args[i].substr(6));
-    stage_args.push_back(args[i]);
-  }
-  if (stage_args.empty() || stage_args[0].empty() || stage_args[0][0] == '-')
-  {
-    std::cerr << run_help;
-    return 2;
-  }
+  if (!args.has(option))
+    return {};
+  const std::vector<std::string> names = split_commas(args.value(option));
+  for (const auto &name : names)
+    if (!contains(pipeline_stages(), name))
+      throw cli::UsageError(option + ": unknown stage '" + name + "' (the stages: check, mesh, field, dem, report)");
+  return names;
+}
+
+// The words a stage is run with: its name, the case, and the options it declares.
+std::vector<std::string> stage_arguments(const Subcommand &stage, const cli::ParsedArguments &args)
+{
+  std::vector<std::string> words = {stage.name, args.positional(0)};
+  const auto options = cli::forward_options(args, stage.command_line());
+  words.insert(words.end(), options.begin(), options.end());
+  return words;
+}
+
+const cli::CommandSpec &run_command_line()
+{
+  static const cli::CommandSpec spec = [] {
+    cli::CommandSpec s;
+    s.program = "magbrush run";
+    s.usage = "magbrush run CASE [--set key=value ...] [--only STAGE[,STAGE]] [--skip STAGE[,STAGE]]\n"
+              "                    [options of the stages]";
+    s.description = R"(Runs the whole pipeline on one case, in order:
+  check   validate the case (file, line, key, unit, range)
+  mesh    write the Gmsh meshes of the roller and the nip
+  field   solve the magnetic and electric fields, store them as grids (reused when
+          the field-relevant inputs are unchanged)
+  dem     run the particles on the stored fields (its log is kept in <output.directory>/dem/dem.log)
+  report  plots, key numbers and ParaView links: <output.directory>/report/index.html
+--set goes to every stage (e.g. --set drum.gap=0.3mm); every other option only to the stages
+that declare it, named in brackets below (e.g. -np 2 to the field solver, --threads 4 to the DEM).
+Each stage is announced with the wall time it took in the last run of this case (its ETA); the
+DEM prints its own progress with an ETA. Stage times go to <output.directory>/run_times.csv. At
+the end: the time per stage and where every output is.
+)";
+    s.positionals = {{"CASE", "the case file"}};
+    s.options = {cli::set_option(),
+                 {"--only", {}, "STAGE[,STAGE]", "run only these stages"},
+                 {"--skip", {}, "STAGE[,STAGE]", "skip these stages"}};
+    const auto of_stages = stage_options();
+    s.options.insert(s.options.end(), of_stages.begin(), of_stages.end());
+    return s;
+  }();
+  return spec;
+}
+
+int run_stages(const cli::ParsedArguments &args)
+{
+  const std::vector<std::string> only = stage_list(args, "--only"), skip = stage_list(args, "--skip");
+  const std::vector<std::string> overrides = args.values("--set");
   // The resolved case tells where the outputs go (a bad case is reported by `check` below).
   std::optional<Case> resolved;
   try
   {
-    resolved = load_case(stage_args[0], overrides);
+    resolved = load_case(args.positional(0), overrides);
   }
   catch (const std::exception &)
   {
@@ -236,7 +236,7 @@ int run_pipeline(const std::vector<std::string> &args)
   const fs::path times_file = resolved ? fs::path(resolved->output.directory) / "run_times.csv" : fs::path();
   const auto last_times = resolved ? read_run_times(times_file) : std::map<std::string, double>{};
 
-  const std::vector<std::string> pipeline = {"check", "mesh", "field", "dem", "report"};
+  const std::vector<std::string> &pipeline = pipeline_stages();
   std::vector<std::pair<std::string, double>> timings;
   std::vector<std::string> unavailable;
   const auto t_start = std::chrono::steady_clock::now();
@@ -245,7 +245,7 @@ int run_pipeline(const std::vector<std::string> &args)
     const std::string &name = pipeline[k];
     if ((!only.empty() && !contains(only, name)) || contains(skip, name))
       continue;
-    const Subcommand *stage = find_stage(name);
+    const Subcommand *stage = find_subcommand(name);
     if (!stage)
     {
       unavailable.push_back(name);
@@ -260,8 +260,7 @@ int run_pipeline(const std::vector<std::string> &args)
     if (name == "dem" && resolved && resolved->dem.settle_time > 0.0)
       std::cout << "(the engine settles the beads for " << resolved->dem.settle_time * 1e3
                 << " ms with the walls at rest before its progress lines start)" << std::endl;
-    std::vector<std::string> a = {name};
-    a.insert(a.end(), stage_args.begin(), stage_args.end());
+    const std::vector<std::string> a = stage_arguments(*stage, args);
     const auto t0 = std::chrono::steady_clock::now();
     int rc = 0;
     if (name == "dem" && resolved)
@@ -301,9 +300,60 @@ int run_pipeline(const std::vector<std::string> &args)
   return 0;
 }
 
+} // namespace
+
+const std::vector<std::string> &pipeline_stages()
+{
+  static const std::vector<std::string> stages = {"check", "mesh", "field", "dem", "report"};
+  return stages;
+}
+
+std::vector<cli::Option> stage_options()
+{
+  std::vector<cli::Option> options;
+  std::vector<std::vector<std::string>> declared_by; // the stages of options[k]
+  auto taken = [&](const cli::Option &o) -> cli::Option * {
+    for (auto &existing : options)
+      if (existing.is_called(o.name))
+        return &existing;
+    return nullptr;
+  };
+  for (const auto &name : pipeline_stages())
+  {
+    const Subcommand *stage = find_subcommand(name);
+    if (!stage)
+      continue;
+    for (const cli::Option &o : stage->command_line().options)
+    {
+      if (!o.for_pipeline || o.name == "--set")
+        continue;
+      if (cli::Option *existing = taken(o))
+        declared_by[static_cast<std::size_t>(existing - options.data())].push_back(name);
+      else
+      {
+        options.push_back(o);
+        declared_by.push_back({name});
+      }
+    }
+  }
+  for (std::size_t k = 0; k < options.size(); ++k)
+  {
+    std::string stages;
+    for (const auto &name : declared_by[k])
+      stages += (stages.empty() ? "" : ", ") + name;
+    options[k].help += " [" + stages + "]";
+  }
+  return options;
+}
+
+int run_pipeline(const std::vector<std::string> &args)
+{
+  return cli::run_command(run_command_line(), {args.begin() + 1, args.end()}, run_stages);
+}
+
 namespace {
 const bool registered = register_subcommand(
-    {"run", "the whole pipeline: check, mesh, field, dem, report", run_pipeline, 90});
+    {"run", "the whole pipeline: check, mesh, field, dem, report", run_pipeline, run_command_line, 90});
 } // namespace
 
 } // namespace magbrush

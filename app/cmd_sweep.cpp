@@ -11,6 +11,8 @@
 #include "subcommand.h"
 
 #include "case_parser.h"
+#include "common/atomic_file.h"
+#include "common/child_process.h"
 
 #include <cmath>
 #include <cstdio>
@@ -23,7 +25,6 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
-#include <sys/wait.h>
 #include <vector>
 
 namespace magbrush {
@@ -31,11 +32,16 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const char *sweep_help =
-    R"(Usage: magbrush sweep CASE --vary key=v1,v2[,...] [--vary key=...] [--set key=value ...]
-                      [--name NAME] [--no-keep-layer] [--skip STAGE[,STAGE]]
-
-Runs the pipeline (check, field, dem, report; the Gmsh meshes are not needed per point) once
+// The options, declared once: the parser reads them (common/command_line.h). Besides its
+// own, sweep accepts the options of the pipeline's stages and hands them to `magbrush run`.
+const cli::CommandSpec &sweep_command_line()
+{
+  static const cli::CommandSpec spec = [] {
+    cli::CommandSpec s;
+    s.program = "magbrush sweep";
+    s.usage = "magbrush sweep CASE --vary key=v1,v2[,...] [--vary key=...] [--set key=value ...]\n"
+              "                      [--name NAME] [--no-keep-layer] [--skip STAGE[,STAGE]] [options of the stages]";
+    s.description = R"(Runs the pipeline (check, field, dem, report; the Gmsh meshes are not needed per point) once
 for every combination of the --vary values, each point in
 <output.directory>/sweep_<NAME>/<point>/ (its own fields/, dem/, report/), then compares the
 nip profiles of all points:
@@ -49,11 +55,33 @@ Varying a population's diameter also scales its count by (d0/d)^3 and its diamet
 d/d0, so that the supplied carrier volume (the layer) stays the same, as in the paper's
 42/50/60 um comparison, and a fixed dem.time_step by d/d0 (the stable step is proportional to
 the bead size); --no-keep-layer switches that off.
-Examples (Fig. 22-27):
+The options of the stages (named in brackets) go to the stages that declare them, at every point.
+)";
+    s.positionals = {{"CASE", "the case file"}};
+    s.options = {{"--vary", {}, "key=v1,v2", "the values of one key to run (repeatable: every combination)", true},
+                 cli::set_option(),
+                 {"--name", {}, "NAME", "the sweep's folder is sweep_NAME (default: the varied keys' names)"},
+                 {"--no-keep-layer", {}, "", "do not rescale the count, diameter_std and time step with a diameter"},
+                 {"--skip", {}, "STAGE[,STAGE]", "stages not run at each point (default: mesh)"}};
+    const auto of_stages = stage_options();
+    s.options.insert(s.options.end(), of_stages.begin(), of_stages.end());
+    s.epilog = R"(Examples (Fig. 22-27):
   magbrush sweep cases/kawamoto_nip.yaml --vary populations.carrier.diameter=42um,50um,60um
   magbrush sweep cases/kawamoto_nip.yaml --vary populations.carrier.count=9000,12300,15000
   magbrush sweep cases/kawamoto_nip.yaml --vary drum.gap=0.3mm,0.4mm,0.5mm
 )";
+    return s;
+  }();
+  return spec;
+}
+
+// The stages' options given to the sweep, as words for `magbrush run`.
+std::vector<std::string> options_for_the_stages(const cli::ParsedArguments &args)
+{
+  cli::CommandSpec stages;
+  stages.options = stage_options();
+  return cli::forward_options(args, stages);
+}
 
 struct Vary
 {
@@ -122,73 +150,26 @@ std::map<std::string, std::string> read_summary(const fs::path &path)
   return values;
 }
 
-void write_atomically(const fs::path &path, const std::string &text)
+// "key=v1,v2,..." of one --vary.
+Vary parse_vary(const std::string &v)
 {
-  const fs::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream o(tmp);
-    o << text;
-  }
-  fs::rename(tmp, path);
+  const auto eq = v.find('=');
+  if (eq == std::string::npos || eq == 0 || eq + 1 >= v.size())
+    throw cli::UsageError("--vary expects key=v1,v2,... (e.g. --vary drum.gap=0.3mm,0.4mm), found '" + v + "'");
+  return {v.substr(0, eq), split(v.substr(eq + 1), ',')};
 }
 
-std::string quoted(const std::string &s)
+int sweep(const cli::ParsedArguments &args)
 {
-  std::string q = "'";
-  for (char ch : s)
-    q += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
-  return q + "'";
-}
-
-int run_sweep(const std::vector<std::string> &args)
-{
-  std::string case_path, name, skip = "mesh";
-  std::vector<std::string> overrides;
+  const std::string case_path = args.positional(0), skip = args.value("--skip", "mesh");
+  std::string name = args.value("--name");
+  const std::vector<std::string> overrides = args.values("--set");
+  const bool keep_layer = !args.has("--no-keep-layer");
   std::vector<Vary> vary;
-  bool keep_layer = true;
-  for (std::size_t i = 1; i < args.size(); ++i)
-  {
-    const std::string &a = args[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= args.size())
-        throw std::invalid_argument(a + " needs a value (see magbrush sweep --help)");
-      return args[++i];
-    };
-    if (a == "--help" || a == "-h")
-    {
-      std::cout << sweep_help;
-      return 0;
-    }
-    else if (a == "--vary")
-    {
-      const std::string v = value();
-      const auto eq = v.find('=');
-      if (eq == std::string::npos || eq == 0 || eq + 1 >= v.size())
-        throw std::invalid_argument("--vary expects key=v1,v2,... (e.g. --vary drum.gap=0.3mm,0.4mm), found '" + v + "'");
-      vary.push_back({v.substr(0, eq), split(v.substr(eq + 1), ',')});
-    }
-    else if (a == "--set")
-      overrides.push_back(value());
-    else if (a.rfind("--set=", 0) == 0)
-      overrides.push_back(a.substr(6));
-    else if (a == "--name")
-      name = value();
-    else if (a == "--skip")
-      skip = value();
-    else if (a == "--no-keep-layer")
-      keep_layer = false;
-    else if (!a.empty() && a[0] == '-')
-      throw std::invalid_argument("unknown option '" + a + "'");
-    else if (case_path.empty())
-      case_path = a;
-    else
-      throw std::invalid_argument("expected one case file, found a second: '" + a + "'");
-  }
-  if (case_path.empty() || vary.empty())
-  {
-    std::cerr << sweep_help;
-    return 2;
-  }
+  for (const auto &v : args.values("--vary"))
+    vary.push_back(parse_vary(v));
+  if (vary.empty())
+    throw cli::UsageError("nothing to vary: give --vary key=v1,v2,...");
   const Case base = load_case(case_path, overrides);
   if (name.empty())
     for (const auto &v : vary)
@@ -267,6 +248,8 @@ int run_sweep(const std::vector<std::string> &args)
       run_args.push_back("--set");
       run_args.push_back(o);
     }
+    const auto stage_words = options_for_the_stages(args);
+    run_args.insert(run_args.end(), stage_words.begin(), stage_words.end());
     const int rc = run_pipeline(run_args);
     if (rc != 0)
       ++failures;
@@ -305,8 +288,8 @@ int run_sweep(const std::vector<std::string> &args)
       profiles << label << "," << line << "\n";
     }
   }
-  write_atomically(sweep_dir / "sweep_summary.csv", summary.str());
-  write_atomically(sweep_dir / "sweep_profiles.csv", profiles.str());
+  write_text_atomically((sweep_dir / "sweep_summary.csv").string(), summary.str());
+  write_text_atomically((sweep_dir / "sweep_profiles.csv").string(), profiles.str());
   std::cout << "\nmagbrush sweep: " << (sweep_dir / "sweep_summary.csv").string() << "\n" << summary.str();
 
   // The comparison plots (tools/plot_sweep.py, next to the sources of this build).
@@ -315,10 +298,20 @@ int run_sweep(const std::vector<std::string> &args)
   const fs::path chosen = env_tools ? fs::path(env_tools) / "plot_sweep.py" : script;
   const char *env_python = std::getenv("MAGBRUSH_PYTHON");
   const std::string python = env_python ? env_python : (fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3");
-  const std::string cmd = quoted(python) + " " + quoted(chosen.string()) + " --dir " + quoted(sweep_dir.string());
-  const int raw = std::system(cmd.c_str());
-  if (raw != 0)
-    std::cerr << "magbrush sweep: the comparison plots failed (" << cmd << "); the CSV files are written\n";
+  const std::vector<std::string> command = {python, chosen.string(), "--dir", sweep_dir.string()};
+  std::string failure;
+  try
+  {
+    if (const int status = run_program(command); status != 0)
+      failure = "exit " + std::to_string(status);
+  }
+  catch (const ChildProcessError &e)
+  {
+    failure = e.what();
+  }
+  if (!failure.empty())
+    std::cerr << "magbrush sweep: the comparison plots failed (" << failure << ": " << python << " " << chosen.string()
+              << " --dir " << sweep_dir.string() << "); the CSV files are written\n";
   if (failures > 0)
   {
     std::cerr << "magbrush sweep: " << failures << " of " << points.size()
@@ -328,21 +321,14 @@ int run_sweep(const std::vector<std::string> &args)
   return 0;
 }
 
-int sweep_main(const std::vector<std::string> &args)
+int run_sweep(const std::vector<std::string> &args)
 {
-  try
-  {
-    return run_sweep(args);
-  }
-  catch (const std::invalid_argument &e)
-  {
-    std::cerr << "magbrush sweep: " << e.what() << "\n";
-    return 2;
-  }
+  return cli::run_command(sweep_command_line(), {args.begin() + 1, args.end()}, sweep);
 }
 
 const bool registered = register_subcommand(
-    {"sweep", "the pipeline over a parameter sweep, with the nip profiles compared (Fig. 22-27)", sweep_main, 95});
+    {"sweep", "the pipeline over a parameter sweep, with the nip profiles compared (Fig. 22-27)", run_sweep,
+     sweep_command_line, 95});
 
 } // namespace
 } // namespace magbrush

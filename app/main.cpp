@@ -28,6 +28,14 @@ bool register_subcommand(const Subcommand &command)
 
 const std::vector<Subcommand> &subcommands() { return table(); }
 
+const Subcommand *find_subcommand(const std::string &name)
+{
+  for (const auto &c : table())
+    if (c.name == name)
+      return &c;
+  return nullptr;
+}
+
 std::string executable_dir()
 {
   char buffer[PATH_MAX];

@@ -28,7 +28,7 @@ const Option *CommandSpec::find(const std::string &spelling) const
 Option set_option(const std::string &example)
 {
   return {"--set", {"-s"}, "key=value",
-          "override a case key, validated like the file (repeatable), e.g. --set " + example,
+          "override a case key, validated like the file (repeatable),\ne.g. --set " + example,
           /*repeatable=*/true};
 }
 
@@ -97,6 +97,13 @@ std::string join(const std::vector<std::string> &words, const std::string &separ
   for (const auto &w : words)
     out += (out.empty() ? "" : separator) + w;
   return out;
+}
+// "a, b or c"
+std::string one_of(const std::vector<std::string> &choices)
+{
+  if (choices.size() < 2)
+    return join(choices, "");
+  return join({choices.begin(), choices.end() - 1}, ", ") + " or " + choices.back();
 }
 } // namespace
 
@@ -176,7 +183,7 @@ private:
     if (!option->choices.empty() &&
         std::find(option->choices.begin(), option->choices.end(), value) == option->choices.end())
     {
-      fail(spelling + " expects " + join(option->choices, " or ") + ", found '" + value + "'");
+      fail(spelling + " expects " + one_of(option->choices) + ", found '" + value + "'");
       return;
     }
     result_.given_.push_back({option, value});
@@ -365,13 +372,13 @@ int run_command(const CommandSpec &spec, const std::vector<std::string> &args,
   }
 }
 
-std::vector<std::string> forward_options(const ParsedArguments &arguments, const CommandSpec &stage)
+std::vector<std::string> forward_options(const ParsedArguments &arguments, const CommandSpec &stage, Forward which)
 {
   std::vector<std::string> words;
   for (const auto &given : arguments.given())
   {
     const Option *theirs = stage.find(given.option->name);
-    if (!theirs || !theirs->for_pipeline)
+    if (!theirs || (which == Forward::pipeline_options && !theirs->for_pipeline))
       continue;
     words.push_back(theirs->name);
     if (theirs->takes_value())

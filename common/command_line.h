@@ -134,11 +134,18 @@ std::string usage_error_text(const CommandSpec &spec, const std::string &message
 int run_command(const CommandSpec &spec, const std::vector<std::string> &args,
                 const std::function<int(const ParsedArguments &)> &body);
 
-// The options in `arguments` that `stage` declares (and allows from the pipeline), written
-// back as words ("--set", "drum.gap=0.3mm", "--force"), in the order given. This is how
-// `magbrush run` hands each stage only what it understands.
-std::vector<std::string> forward_options(const ParsedArguments &arguments,
-                                         const CommandSpec &stage);
+// The options in `arguments` that `stage` declares, written back as words ("--set",
+// "drum.gap=0.3mm", "--force"), in the order given. With Forward::pipeline_options (how
+// `magbrush run` hands each stage only what it understands) the stage's options marked
+// for_pipeline = false are left out; with Forward::every_option (a wrapper handing its own
+// arguments to the program behind it) none is.
+enum class Forward
+{
+  pipeline_options,
+  every_option
+};
+std::vector<std::string> forward_options(const ParsedArguments &arguments, const CommandSpec &stage,
+                                         Forward which = Forward::pipeline_options);
 
 // The spelling closest to `word` among the options of `spec`, or "" when none is close
 // enough to be a likely typo.

@@ -5,6 +5,7 @@
 // Reads the case, then for each field it needs: if the stored grid carries the case's hash the
 // field is up to date and nothing is done; otherwise it is solved and stored (field_app.h).
 #include "field_app.h"
+#include "field_command_line.h"
 
 #include "case_parser.h"
 
@@ -12,21 +13,43 @@
 
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <vector>
 
 namespace {
 
-const char *usage =
-  R"(Usage: magbrush-field CASE [--set key=value ...] [--only magnetic|electric] [--force] [--no-vtu]
+// The solver's options, declared once for it and for `magbrush field` (field_command_line.h).
+const magbrush::cli::CommandSpec &command_line()
+{
+  static const magbrush::cli::CommandSpec spec = [] {
+    magbrush::cli::CommandSpec s = magbrush::field::solver_command_line("magbrush-field");
+    s.epilog = "Run in parallel with: mpirun -np N magbrush-field CASE (or magbrush field CASE -np N)\n";
+    return s;
+  }();
+  return spec;
+}
 
-Solves the fields of a case and stores them as grids in field.output_dir:
-  magnetic  A_z of the magnet roller (shell-transformed open boundary), polar grid, sleeve
-            and probe flux profiles (CSV), VTU for ParaView
-  electric  the nip potential Φ on a window over the nip, VTU
-A stored field whose case hash matches is reused ("up to date"); --force recomputes.
-Run in parallel with: mpirun -np N magbrush-field CASE
-)";
+// What the command line asks for; only the first process prints help and mistakes.
+std::optional<magbrush::cli::ParsedArguments> parse_command_line(int argc, char **argv, bool root, int &exit_code)
+{
+  try
+  {
+    auto arguments = magbrush::cli::parse(command_line(), {argv + 1, argv + argc});
+    if (!arguments.help_requested())
+      return arguments;
+    if (root)
+      std::cout << magbrush::cli::help_text(command_line());
+    exit_code = 0;
+  }
+  catch (const magbrush::cli::UsageError &e)
+  {
+    if (root)
+      std::cerr << magbrush::cli::usage_error_text(command_line(), e.what());
+    exit_code = 2;
+  }
+  return std::nullopt;
+}
 
 } // namespace
 
@@ -35,55 +58,20 @@ int main(int argc, char **argv)
   dealii::Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
   const bool root = dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0;
 
-  std::string case_path;
-  std::vector<std::string> overrides;
+  int exit_code = 0;
+  const auto arguments = parse_command_line(argc, argv, root, exit_code);
+  if (!arguments)
+    return exit_code;
+  const std::string case_path = arguments->positional(0);
+  const std::vector<std::string> overrides = arguments->values("--set");
   magbrush::field::FieldRunOptions options;
-  const std::vector<std::string> args(argv + 1, argv + argc);
-  for (std::size_t i = 0; i < args.size(); ++i)
+  if (arguments->has("--only"))
   {
-    const std::string &a = args[i];
-    if (a == "--help" || a == "-h")
-    {
-      if (root)
-        std::cout << usage;
-      return 0;
-    }
-    else if (a == "--set" && i + 1 < args.size())
-      overrides.push_back(args[++i]);
-    else if (a.rfind("--set=", 0) == 0)
-      overrides.push_back(a.substr(6));
-    else if (a == "--only" && i + 1 < args.size())
-    {
-      const std::string which = args[++i];
-      if (which != "magnetic" && which != "electric")
-      {
-        if (root)
-          std::cerr << "magbrush-field: --only expects 'magnetic' or 'electric', found '"
-                    << which << "'\n";
-        return 2;
-      }
-      options.magnetic = which == "magnetic";
-      options.electric = which == "electric";
-    }
-    else if (a == "--force")
-      options.force = true;
-    else if (a == "--no-vtu")
-      options.vtu = false;
-    else if (!a.empty() && a[0] != '-' && case_path.empty())
-      case_path = a;
-    else
-    {
-      if (root)
-        std::cerr << "magbrush-field: unknown argument '" << a << "'\n\n" << usage;
-      return 2;
-    }
+    options.magnetic = arguments->value("--only") == "magnetic";
+    options.electric = arguments->value("--only") == "electric";
   }
-  if (case_path.empty())
-  {
-    if (root)
-      std::cerr << usage;
-    return 2;
-  }
+  options.force = arguments->has("--force");
+  options.vtu = !arguments->has("--no-vtu");
 
   try
   {

@@ -1,0 +1,80 @@
+// The command lines of the built programs: every subcommand's --help exits 0, `magbrush run`
+// offers the stages' options, and an option of another stage is an error where it does not
+// belong (magbrush-dem rejects the field solver's -np like any unknown option).
+#include "common/child_process.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Result
+{
+  int status;
+  std::string output; // stdout and stderr together
+};
+
+Result run(const std::vector<std::string> &command)
+{
+  const fs::path log = fs::temp_directory_path() / ("magbrush_cli_" + std::to_string(::getpid()) + ".log");
+  magbrush::ChildOutput output;
+  output.stdout_path = log.string();
+  output.stderr_to_stdout = true;
+  Result r{magbrush::run_program(command, output), {}};
+  std::ifstream in(log);
+  std::ostringstream text;
+  text << in.rdbuf();
+  r.output = text.str();
+  fs::remove(log);
+  return r;
+}
+
+const std::string bin = std::string(MAGBRUSH_BINARY_DIR) + "/bin/";
+const std::string nip_case = std::string(MAGBRUSH_SOURCE_DIR) + "/cases/kawamoto_nip.yaml";
+
+TEST(ProgramCommandLines, EverySubcommandHelpExitsZero)
+{
+  for (const char *command : {"check", "mesh", "field", "flux", "dem", "report", "run", "sweep"})
+  {
+    const Result r = run({bin + "magbrush", command, "--help"});
+    EXPECT_EQ(r.status, 0) << command << "\n" << r.output;
+    EXPECT_NE(r.output.find(std::string("Usage: magbrush ") + command), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("--help"), std::string::npos) << r.output;
+  }
+  EXPECT_EQ(run({bin + "magbrush-dem", "--help"}).status, 0);
+}
+
+TEST(ProgramCommandLines, RunOffersTheOptionsOfItsStages)
+{
+  const Result r = run({bin + "magbrush", "run", "--help"});
+  ASSERT_EQ(r.status, 0) << r.output;
+  for (const char *option : {"--only STAGE", "--skip STAGE", "--set key=value", "-np, --np N", "--force", "--no-vtu",
+                             "--threads N", "--restart FILE"})
+    EXPECT_NE(r.output.find(option), std::string::npos) << option << "\n" << r.output;
+}
+
+TEST(ProgramCommandLines, DemRejectsTheFieldSolversOptions)
+{
+  const Result r = run({bin + "magbrush-dem", nip_case, "-np", "2"});
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("magbrush-dem: unknown option '-np'"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("Usage: magbrush-dem CASE"), std::string::npos) << r.output;
+  const Result wrapped = run({bin + "magbrush", "dem", nip_case, "--no-vtu"});
+  EXPECT_EQ(wrapped.status, 2) << wrapped.output;
+  EXPECT_NE(wrapped.output.find("magbrush dem: unknown option '--no-vtu'"), std::string::npos) << wrapped.output;
+}
+
+TEST(ProgramCommandLines, TyposGetASuggestion)
+{
+  const Result r = run({bin + "magbrush", "run", nip_case, "--thraeds", "2"});
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("magbrush run: unknown option '--thraeds' (did you mean '--threads'?)"), std::string::npos)
+      << r.output;
+}
+
+} // namespace

@@ -54,9 +54,8 @@ void AtomicFile::commit()
   {
     const std::string why = std::strerror(errno);
     std::remove(temp_path_.c_str());
-    throw AtomicFileError("cannot write '" + path_ + "': renaming the finished temporary file '" +
-                          temp_path_ + "' onto it failed (" + why +
-                          "); is the path a folder, or the folder read-only?");
+    throw AtomicFileError("cannot write '" + path_ + "': cannot rename the finished temporary file '" +
+                          temp_path_ + "' onto it (" + why + "); is the path a folder, or the folder read-only?");
   }
   committed_ = true;
 }

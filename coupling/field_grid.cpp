@@ -2,6 +2,8 @@
 // The file layout is documented in docs/field_grid_format.md; keep the two in step.
 #include "field_grid.h"
 
+#include "common/atomic_file.h"
+
 #include "cartesian_field_interpolator.h"
 #include "polar_field_interpolator.h"
 
@@ -433,33 +435,31 @@ void write_provenance(const Writer &w, hid_t root, const std::string &kind,
   w.double_attribute(root, "error_estimate", {p.error_estimate});
 }
 
-// Creates `path`.tmp, lets `fill` write into its root group, then renames it onto `path`.
-// Any failure removes the temporary file, so no partial file is ever left behind.
+// Creates a temporary file next to `path` (AtomicFile), lets `fill` write into its root
+// group, then renames it onto `path`. Any failure removes the temporary file, so no partial
+// file is ever left behind.
 template <typename Fill>
 void write_atomically(const std::string &path, Fill fill)
 {
-  const std::string tmp = path + ".tmp";
+  AtomicFile file(path);
   QuietHdf5 quiet;
+  {
+    Handle h5(H5Fcreate(file.temp_path().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
+    if (!h5.valid())
+      throw FieldGridError("file " + path + ": cannot create '" + file.temp_path() +
+                           "' (does the directory exist and is it writable?)");
+    Writer w{path};
+    fill(w, h5);
+    if (H5Fflush(h5, H5F_SCOPE_GLOBAL) < 0)
+      throw FieldGridError("file " + path + ": HDF5 failed to flush '" + file.temp_path() + "'");
+  }
   try
   {
-    {
-      Handle file(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
-      if (!file.valid())
-        throw FieldGridError("file " + path + ": cannot create '" + tmp +
-                             "' (does the directory exist and is it writable?)");
-      Writer w{path};
-      fill(w, file);
-      if (H5Fflush(file, H5F_SCOPE_GLOBAL) < 0)
-        throw FieldGridError("file " + path + ": HDF5 failed to flush '" + tmp + "'");
-    }
-    if (std::rename(tmp.c_str(), path.c_str()) != 0)
-      throw FieldGridError("file " + path + ": cannot rename '" + tmp + "' onto it (" +
-                           std::strerror(errno) + "); is the path a directory or read-only?");
+    file.commit();
   }
-  catch (...)
+  catch (const AtomicFileError &e)
   {
-    std::remove(tmp.c_str());
-    throw;
+    throw FieldGridError("file " + path + ": " + e.what());
   }
 }
 

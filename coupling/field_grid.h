@@ -10,7 +10,7 @@
 //    (cartesian_field_interpolator.h).
 //
 // The file layout is documented in docs/field_grid_format.md. Files are written atomically
-// (NAME.tmp, then rename), and the reader checks everything it relies on (format name and
+// (a temporary file, then a rename), and the reader checks everything it relies on (format name and
 // version, kind, shapes, units, finite values, uniform axes) with errors that name the file,
 // the dataset and what was expected.
 //
@@ -229,9 +229,9 @@ struct ElectricGridFile
 inline constexpr const char *field_grid_format_name = "magbrush-field-grid";
 inline constexpr int field_grid_format_version = 1;
 
-// Write atomically: `path`.tmp first, renamed onto `path` only when complete. On failure
-// (unwritable directory, invalid grid, ...) throws FieldGridError and leaves no file behind;
-// an existing `path` is untouched.
+// Write atomically: a temporary file next to `path` first (common/atomic_file.h), renamed onto
+// `path` only when complete. On failure (unwritable directory, invalid grid, ...) throws
+// FieldGridError and leaves no file behind; an existing `path` is untouched.
 void write_magnetic_grid(const std::string &path, const PolarGrid &grid,
                          const GridProvenance &provenance);
 void write_electric_grid(const std::string &path, const CartesianGrid &grid,

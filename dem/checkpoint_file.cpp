@@ -10,32 +10,24 @@ namespace {
 constexpr char checkpoint_magic[9] = "MBDEMCK2";
 }
 
-CheckpointWriter::CheckpointWriter(const std::string &path) : path_(path), temp_(path + ".tmp")
+CheckpointWriter::CheckpointWriter(const std::string &path) : file_(path)
 {
-  out_.open(temp_, std::ios::binary | std::ios::trunc);
+  out_.open(file_.temp_path(), std::ios::binary | std::ios::trunc);
   if (!out_)
-    throw std::runtime_error("cannot write checkpoint '" + temp_ +
+    throw std::runtime_error("cannot write checkpoint '" + file_.temp_path() +
                              "': check that the directory exists and is writable");
   out_.write(checkpoint_magic, 8);
 }
 
-CheckpointWriter::~CheckpointWriter()
-{
-  if (!committed_)
-  {
-    out_.close();
-    std::remove(temp_.c_str());
-  }
-}
+// The stream closes first, then file_ removes the temporary file unless commit() renamed it.
+CheckpointWriter::~CheckpointWriter() = default;
 
 void CheckpointWriter::commit()
 {
   out_.close();
   if (!out_)
-    throw std::runtime_error("writing checkpoint '" + temp_ + "' failed (disk full?)");
-  if (std::rename(temp_.c_str(), path_.c_str()) != 0)
-    throw std::runtime_error("cannot rename '" + temp_ + "' to '" + path_ + "'");
-  committed_ = true;
+    throw std::runtime_error("writing checkpoint '" + file_.temp_path() + "' failed (disk full?)");
+  file_.commit();
 }
 
 CheckpointReader::CheckpointReader(const std::string &path) : path_(path), in_(path, std::ios::binary)

@@ -9,6 +9,8 @@
 // good one survives. The reader names the file and what is wrong with it.
 #pragma once
 
+#include "common/atomic_file.h"
+
 #include <cstdint>
 #include <fstream>
 #include <string>
@@ -37,9 +39,8 @@ public:
   void commit();
 
 private:
-  std::string path_, temp_;
-  std::ofstream out_;
-  bool committed_ = false;
+  AtomicFile file_;   // the temporary file and its rename (common/atomic_file.h)
+  std::ofstream out_; // declared after file_: closed before file_ removes an uncommitted file
 };
 
 class CheckpointReader

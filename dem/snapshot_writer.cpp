@@ -1,6 +1,8 @@
 // HDF5/XDMF snapshots and the CSV time series (see snapshot_writer.h).
 #include "snapshot_writer.h"
 
+#include "common/atomic_file.h"
+
 #include <hdf5.h>
 
 #include <cstdio>
@@ -15,17 +17,7 @@ namespace fs = std::filesystem;
 
 void write_file_atomically(const std::string &path, const std::string &text)
 {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream o(tmp, std::ios::trunc);
-    if (!o)
-      throw std::runtime_error("cannot write '" + tmp + "': check that the directory exists and is writable");
-    o << text;
-    if (!o)
-      throw std::runtime_error("writing '" + tmp + "' failed (disk full?)");
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0)
-    throw std::runtime_error("cannot rename '" + tmp + "' to '" + path + "'");
+  write_text_atomically(path, text);
 }
 
 namespace {
@@ -104,8 +96,9 @@ void SnapshotWriter::write(const DemSystem &system)
   char name[64];
   std::snprintf(name, sizeof name, "snapshots/particles_%08ld.h5", system.step_count());
   const std::string path = (fs::path(directory_) / name).string();
+  AtomicFile file(path);
   {
-    H5File h5(path + ".tmp");
+    H5File h5(file.temp_path());
     h5.attribute("time", system.time());
     h5.attribute("step", static_cast<double>(system.step_count()));
     h5.dataset("position", vec3(s.x, s.y, s.z), n, 3);
@@ -117,8 +110,7 @@ void SnapshotWriter::write(const DemSystem &system)
     h5.dataset("id", scalar(s.id), n, 1);
     h5.dataset("contact_count", scalar(system.contact_count()), n, 1);
   }
-  if (std::rename((path + ".tmp").c_str(), path.c_str()) != 0)
-    throw std::runtime_error("cannot rename '" + path + ".tmp'");
+  file.commit();
   snapshots_.emplace_back(system.time(), name);
   write_index();
 }

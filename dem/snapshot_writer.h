@@ -1,6 +1,7 @@
 // Run output: HDF5 particle snapshots with an XDMF index that ParaView opens as a time
-// series, and a CSV time series of global quantities. Every file is written to <name>.tmp and
-// renamed into place, so a reader (or a crash) never sees half a file.
+// series, and a CSV time series of global quantities. Every file is written to a temporary
+// file and renamed into place (common/atomic_file.h), so a reader (or a crash) never sees half
+// a file.
 #pragma once
 
 #include "dem_system.h"
@@ -10,7 +11,7 @@
 
 namespace magbrush::dem {
 
-// Writes `text` to `path` atomically (tmp + rename).
+// Writes `text` to `path` atomically (common/atomic_file.h; kept here for the measurements).
 void write_file_atomically(const std::string &path, const std::string &text);
 
 class SnapshotWriter

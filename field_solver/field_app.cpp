@@ -1,6 +1,7 @@
 #include "field_app.h"
 
 #include "case_hash.h"
+#include "common/atomic_file.h"
 #include "field_grid.h"
 #include "multipole_ring.h"
 #include "nip_electrostatics.h"
@@ -70,12 +71,7 @@ bool stored_field_is_current(const std::string &path, const std::string &hash,
 void write_profile_csv(const std::string &path, double radius,
                        const RollerMagnetostatics::Profile &p, const Case &c)
 {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp);
-    if (!out)
-      throw std::runtime_error("cannot write '" + tmp + "': check that field.output_dir (" +
-                               c.field.output_dir + ") is writable");
+  write_file_atomically(path, [&](std::ostream &out) {
     out << "# Computed sleeve flux profile of case '" << c.name << "' (magbrush-field, FE_Q("
         << c.field.element_degree << ")), radius " << radius * 1e3 << " mm.\n"
         << "# angle counter-clockwise from +x; Bn positive outward, Bt positive "
@@ -84,8 +80,7 @@ void write_profile_csv(const std::string &path, double radius,
     out.precision(10);
     for (std::size_t k = 0; k < p.angle.size(); ++k)
       out << p.angle[k] * 180.0 / pi << "," << p.Bn[k] << "," << p.Bt[k] << "\n";
-  }
-  std::filesystem::rename(tmp, path);
+  });
 }
 
 // Largest |ΔB| on a circle between the FE solution and the exact multipole ring, relative to

@@ -4,6 +4,8 @@
 
 #include "mesh_tags.h"
 
+#include "common/atomic_file.h"
+
 #include <gmsh.h>
 
 #include <algorithm>
@@ -430,22 +432,12 @@ void write_msh_atomically(const std::string &path)
   if (target.has_parent_path())
     fs::create_directories(target.parent_path());
   // Gmsh picks the format from the extension, so the temporary name ends in .msh as well.
-  const fs::path tmp = target.parent_path() / ("." + target.filename().string() + ".tmp-" +
-                                               std::to_string(::getpid()) + ".msh");
+  AtomicFile file(path, AtomicFile::Extension::kept);
   gmsh::option::setNumber("Mesh.MshFileVersion", 2.2);
   gmsh::option::setNumber("Mesh.Binary", 0);
   gmsh::option::setNumber("Mesh.SaveAll", 0); // only the elements of physical groups
-  try
-  {
-    gmsh::write(tmp.string());
-    fs::rename(tmp, target);
-  }
-  catch (...)
-  {
-    std::error_code ignored;
-    fs::remove(tmp, ignored);
-    throw;
-  }
+  gmsh::write(file.temp_path());
+  file.commit();
 }
 
 } // namespace gmsh_blocks

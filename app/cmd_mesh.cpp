@@ -35,7 +35,7 @@ const magbrush::cli::CommandSpec &mesh_command_line()
     s.options = {
         magbrush::cli::set_option("field.mesh_size_sleeve=0.2mm"),
         {"--output", {"-o"}, "DIR", "where to write (default: meshes/<case name>)", false, {}, /*for_pipeline=*/false},
-        {"--only", {}, "WHICH", "only the roller or only the nip mesh", false, {"roller", "nip"}, false},
+        {"--only", {}, "roller|nip", "only the roller or only the nip mesh", false, {"roller", "nip"}, false},
         {"--verbose", {"-v"}, "", "show Gmsh's progress messages"},
         {"--gui-free", {}, "", "accepted for scripts; magbrush never opens the Gmsh GUI"}};
     s.epilog = "Exit status: 0 written, 1 invalid case or meshing failure, 2 usage error.\n";

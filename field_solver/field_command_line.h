@@ -27,7 +27,7 @@ inline cli::CommandSpec solver_command_line(const std::string &program)
   spec.positionals = {{"CASE", "the case file"}};
   spec.options = {
       cli::set_option(),
-      {"--only", {}, "WHICH", "solve only the magnetic or only the electric field",
+      {"--only", {}, "magnetic|electric", "solve only the magnetic or only the electric field",
        /*repeatable=*/false, /*choices=*/{"magnetic", "electric"}, /*for_pipeline=*/false},
       {"--force", {}, "", "recompute even when the stored field is up to date"},
       {"--no-vtu", {}, "", "write no ParaView (VTU) files"}};

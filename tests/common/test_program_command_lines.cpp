@@ -69,6 +69,17 @@ TEST(ProgramCommandLines, DemRejectsTheFieldSolversOptions)
   EXPECT_NE(wrapped.output.find("magbrush dem: unknown option '--no-vtu'"), std::string::npos) << wrapped.output;
 }
 
+TEST(ProgramCommandLines, RunHandsEachStageOnlyItsOwnOptions)
+{
+  // check declares neither -np (field) nor --threads (dem): it must not receive them.
+  const std::string out = (fs::temp_directory_path() / ("magbrush_cli_run_" + std::to_string(::getpid()))).string();
+  const Result r = run({bin + "magbrush", "run", nip_case, "--only", "check", "-np", "2", "--threads", "3", "--force",
+                        "-q", "--set", "output.directory=" + out});
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("stage 1/5: check"), std::string::npos) << r.output;
+  fs::remove_all(out);
+}
+
 TEST(ProgramCommandLines, TyposGetASuggestion)
 {
   const Result r = run({bin + "magbrush", "run", nip_case, "--thraeds", "2"});

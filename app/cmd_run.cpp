@@ -176,7 +176,12 @@ std::vector<std::string> stage_list(const cli::ParsedArguments &args, const std:
   const std::vector<std::string> names = split_commas(args.value(option));
   for (const auto &name : names)
     if (!contains(pipeline_stages(), name))
-      throw cli::UsageError(option + ": unknown stage '" + name + "' (the stages: check, mesh, field, dem, report)");
+    {
+      std::string stages;
+      for (const auto &stage : pipeline_stages())
+        stages += (stages.empty() ? "" : ", ") + stage;
+      throw cli::UsageError(option + ": unknown stage '" + name + "' (the stages: " + stages + ")");
+    }
   return names;
 }
 

@@ -86,7 +86,8 @@ public:
   using std::runtime_error::runtime_error;
 };
 
-// What was given, in the order it was given.
+// What was given, in the order it was given. It points into the CommandSpec it was parsed
+// with, so that spec must outlive it (every command keeps its spec in a function's static).
 class ParsedArguments
 {
 public:

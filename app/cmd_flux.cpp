@@ -16,6 +16,7 @@
 #include "calibration/flux_compare.h"
 #include "calibration/flux_scan.h"
 #include "calibration/pole_fit.h"
+#include "common/atomic_file.h"
 #include "common/child_process.h"
 #include "coupling/case_hash.h"
 #include "coupling/case_parser.h"
@@ -279,7 +280,7 @@ void write_profile_csv(const std::string &path, const Case &c, double r,
                   p.Bt[k] * 1e3);
     out << buf;
   }
-  write_file_atomically(path, out.str());
+  write_text_atomically(path, out.str());
 }
 
 // Candidate locations of tools/plot_flux.py: next to this source file's repository, or
@@ -738,9 +739,9 @@ private:
     const std::string stem = fs::path(case_.source_file).stem().string();
     fitted_case_ = dir_ + "/" + stem + "_fitted.yaml";
     const double origin = std::remainder(o_.scan.angle_offset + fit_->offset, 2.0 * M_PI);
-    write_file_atomically(fitted_case_, fitted_case_text(case_, o_, *fit_, origin, scan_path_,
+    write_text_atomically(fitted_case_, fitted_case_text(case_, o_, *fit_, origin, scan_path_,
                                                          case_.name + "_fitted"));
-    write_file_atomically(dir_ + "/flux_fit.txt", fit_report(*fit_, o_));
+    write_text_atomically(dir_ + "/flux_fit.txt", fit_report(*fit_, o_));
     try
     {
       load_case(fitted_case_);

@@ -1,16 +1,16 @@
 // Profile comparison: errors, per-pole peaks, residual file (see flux_compare.h).
 #include "calibration/flux_compare.h"
 
+#include "common/atomic_file.h"
+
 #include <Eigen/Dense>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <sstream>
 #include <stdexcept>
 
-#include <unistd.h>
 
 namespace magbrush {
 
@@ -250,25 +250,6 @@ std::string format_peaks(const FluxComparison &c)
   return out.str();
 }
 
-void write_file_atomically(const std::string &path, const std::string &text)
-{
-  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
-  {
-    std::ofstream out(tmp);
-    if (!out)
-      throw std::runtime_error("cannot write " + tmp + " (does the directory exist, is it writable?)");
-    out << text;
-    out.flush();
-    if (!out)
-      throw std::runtime_error("error while writing " + tmp + " (disk full?)");
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0)
-  {
-    std::remove(tmp.c_str());
-    throw std::runtime_error("cannot move " + tmp + " to " + path);
-  }
-}
-
 void write_residuals_csv(const std::string &path, const FluxComparison &c)
 {
   std::ostringstream out;
@@ -290,7 +271,7 @@ void write_residuals_csv(const std::string &path, const FluxComparison &c)
     }
     out << "\n";
   }
-  write_file_atomically(path, out.str());
+  write_text_atomically(path, out.str());
 }
 
 } // namespace magbrush

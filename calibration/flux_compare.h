@@ -66,7 +66,4 @@ std::string format_peaks(const FluxComparison &c);
 // angle_deg, Bn/Bt measured and computed and residual (measured − computed), mT. Atomic write.
 void write_residuals_csv(const std::string &path, const FluxComparison &c);
 
-// Write `text` to `path` through a temporary file and a rename (no half-written outputs).
-void write_file_atomically(const std::string &path, const std::string &text);
-
 } // namespace magbrush

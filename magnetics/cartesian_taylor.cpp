@@ -1,6 +1,6 @@
-#include "cartesian_taylor.h"
+#include "magnetics/cartesian_taylor.h"
 
-#include "dipole_physics.h"
+#include "magnetics/dipole_physics.h"
 
 #include <cmath>
 #include <stdexcept>

@@ -1,6 +1,6 @@
-#include "cell_multipole_field.h"
+#include "magnetics/cell_multipole_field.h"
 
-#include "dipole_physics.h"
+#include "magnetics/dipole_physics.h"
 
 #include <algorithm>
 #include <climits>

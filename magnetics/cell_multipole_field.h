@@ -26,8 +26,8 @@
 // for any number of threads.
 #pragma once
 
-#include "cartesian_taylor.h"
-#include "magnetic_neighbour_list.h"
+#include "magnetics/cartesian_taylor.h"
+#include "magnetics/magnetic_neighbour_list.h"
 
 #include <array>
 #include <cstddef>

@@ -38,14 +38,14 @@ class JacobiSolver
 public:
   JacobiSolver(double tolerance, int max_sweeps) : tolerance_(tolerance), max_sweeps_(max_sweeps) {}
 
-  // Sweeps p (3 per bead) to the tolerance, over all beads or over `subset` only (the other
-  // dipoles held). local_field(b, p, B) writes bead b's local field from the dipoles p;
-  // before_sweep() runs before every sweep (the slab tail follows the dipoles). B_local gets
-  // the last gathered local fields; p_next is work space (3 per bead).
+  // Sweeps the dipoles (3 per bead) to the tolerance, over all beads or over `subset` only
+  // (the other dipoles held). local_field(b, p, B) writes bead b's local field from the
+  // dipoles p; before_sweep() runs before every sweep (the slab tail follows the dipoles).
+  // B_local gets the last gathered local fields; next is work space (3 per bead).
   template <class LocalField, class BeforeSweep>
   JacobiResult solve(const BeadArrays &beads, const std::vector<double> &beta,
-                     const std::vector<double> &Ms, std::vector<double> &p,
-                     std::vector<double> &p_next, std::vector<double> &B_local,
+                     const std::vector<double> &Ms, std::vector<double> &dipoles,
+                     std::vector<double> &next, std::vector<double> &B_local,
                      const LocalField &local_field, const BeforeSweep &before_sweep,
                      const std::vector<std::uint32_t> *subset = nullptr) const;
 

@@ -1,6 +1,6 @@
-#include "cell_multipole_field.h"
+#include "magnetics/cell_multipole_field.h"
 
-#include "dipole_physics.h"
+#include "magnetics/dipole_physics.h"
 
 #include <algorithm>
 #include <climits>
@@ -26,8 +26,9 @@ bool adjacent(const std::array<long, 3> &d, long reach = 1)
 }
 } // namespace
 
-CellMultipoleField::CellMultipoleField(int order, const std::array<double, 3> &box, int near_reach)
-  : taylor_(order), box_(box), near_reach_(near_reach)
+CellMultipoleField::CellMultipoleField(int order, const std::array<double, 3> &box, int near_reach,
+                                       SourceKind kind)
+  : taylor_(order, kind), box_(box), near_reach_(near_reach)
 {
   if (near_reach < 1 || near_reach > 2)
     throw std::invalid_argument("cell multipole: the near field reaches 1 or 2 fine cells; found " +
@@ -43,6 +44,12 @@ CellMultipoleField::CellMultipoleField(int order, const std::array<double, 3> &b
       "cell multipole: a box periodic along all three axes has a shape-dependent dipole sum "
       "(it needs Ewald summation with a stated boundary condition), which is not implemented; "
       "found three periodic axes. Leave one axis open or use magnetic_far_field: none.");
+  if (kind == SourceKind::charges && periodic_axes_ > 0)
+    throw std::invalid_argument(
+      "cell multipole: periodic images of charges are not implemented (the lattice sums of the "
+      "monopole and dipole tensors do not converge without a neutralising background and "
+      "Ewald-type summation); found " + std::to_string(periodic_axes_) +
+      " periodic axes for a charge expansion. Use open axes.");
 }
 
 std::uint64_t CellMultipoleField::key_of(const std::array<long, 3> &I) const
@@ -633,29 +640,78 @@ std::size_t CellMultipoleField::interactions() const
 
 void CellMultipoleField::evaluate(const double *p, double *B, double *gradB)
 {
-  const int top = static_cast<int>(levels_.size()) - 1;
-  const std::size_t nm = taylor_.multipole_size(), nl = taylor_.local_size();
-
-  // 1. P2M.
-  {
-    Level &fine = levels_[0];
-    const long nc = static_cast<long>(fine.keys.size());
-#pragma omp parallel for schedule(static) if (nc >= static_cast<long>(parallel_threshold))
-    for (long c = 0; c < nc; ++c)
+  if (taylor_.source_kind() != SourceKind::dipoles)
+    throw std::logic_error("cell multipole: evaluate(p, B, gradB) is the dipole field; this "
+                           "expansion is for charges (evaluate(sources, targets)).");
+  form_multipoles([&](const double s[3], std::uint32_t b, double *M) { taylor_.add_dipole(s, &p[3 * b], M); });
+  translate();
+  evaluate_at_beads([&](const double u[3], std::uint32_t b, const double *L) {
+    double Bb[3] = {0.0, 0.0, 0.0}, G[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+    taylor_.evaluate(u, L, Bb, G);
+    for (int a = 0; a < 3; ++a)
     {
-      double *M = &fine.M[c * nm];
-      std::fill(M, M + nm, 0.0);
-      const auto centre_c = centre(0, fine.index[c]);
-      for (std::uint32_t k = bead_begin_[c]; k < bead_begin_[c + 1]; ++k)
-      {
-        const std::uint32_t b = bead_order_[k];
-        const double s[3] = {xw_[3 * b] - centre_c[0], xw_[3 * b + 1] - centre_c[1],
-                             xw_[3 * b + 2] - centre_c[2]};
-        taylor_.add_dipole(s, &p[3 * b], M);
-      }
+      B[3 * b + a] = Bb[a];
+      for (int d = 0; d < 3; ++d)
+        gradB[9 * b + 3 * a + d] = G[a][d];
+    }
+  });
+}
+
+void CellMultipoleField::evaluate(const FarFieldSources &sources, const FarFieldTargets &targets)
+{
+  if (taylor_.source_kind() != SourceKind::charges)
+    throw std::logic_error("cell multipole: evaluate(sources, targets) needs an expansion built "
+                           "for charges (SourceKind::charges); this one is for dipoles.");
+  form_multipoles([&](const double s[3], std::uint32_t b, double *M) {
+    if (sources.charge)
+      taylor_.add_charge(s, sources.charge[b], M);
+    if (sources.dipole)
+      taylor_.add_dipole(s, &sources.dipole[3 * b], M);
+  });
+  translate();
+  evaluate_at_beads([&](const double u[3], std::uint32_t b, const double *L) {
+    double phi = 0.0, grad[3] = {0, 0, 0}, hessian[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+    taylor_.evaluate_potential(u, L, targets.potential ? &phi : nullptr, targets.field ? grad : nullptr,
+                               targets.gradient ? hessian : nullptr);
+    if (targets.potential)
+      targets.potential[b] = phi;
+    if (targets.field)
+      for (int a = 0; a < 3; ++a)
+        targets.field[3 * b + a] = -grad[a];
+    if (targets.gradient)
+      for (int a = 0; a < 9; ++a)
+        targets.gradient[9 * b + a] = -hessian[a];
+  });
+}
+
+template <class AddSources>
+void CellMultipoleField::form_multipoles(const AddSources &add_sources)
+{
+  // P2M: every fine cell sums the moments of its beads about its centre.
+  const std::size_t nm = taylor_.multipole_size();
+  Level &fine = levels_[0];
+  const long nc = static_cast<long>(fine.keys.size());
+#pragma omp parallel for schedule(static) if (nc >= static_cast<long>(parallel_threshold))
+  for (long c = 0; c < nc; ++c)
+  {
+    double *M = &fine.M[c * nm];
+    std::fill(M, M + nm, 0.0);
+    const auto centre_c = centre(0, fine.index[c]);
+    for (std::uint32_t k = bead_begin_[c]; k < bead_begin_[c + 1]; ++k)
+    {
+      const std::uint32_t b = bead_order_[k];
+      const double s[3] = {xw_[3 * b] - centre_c[0], xw_[3 * b + 1] - centre_c[1],
+                           xw_[3 * b + 2] - centre_c[2]};
+      add_sources(s, b, M);
     }
   }
-  // 2. M2M.
+}
+
+void CellMultipoleField::translate()
+{
+  const int top = static_cast<int>(levels_.size()) - 1;
+  const std::size_t nm = taylor_.multipole_size(), nl = taylor_.local_size();
+  // M2M.
   for (int level = 1; level <= top; ++level)
   {
     Level &l = levels_[level];
@@ -684,7 +740,7 @@ void CellMultipoleField::evaluate(const double *p, double *B, double *gradB)
       for (std::size_t c = 0; c < l.keys.size(); ++c)
         taylor_.scaled_moments(&l.M[c * nm], l.scale, &l.Mf[c * nm]);
     }
-  // 3–4. M2L at every level, L2L downwards.
+  // M2L at every level, L2L downwards.
   for (int level = top; level >= 0; --level)
   {
     Level &l = levels_[level];
@@ -717,28 +773,25 @@ void CellMultipoleField::evaluate(const double *p, double *B, double *gradB)
           taylor_.apply_translation(l.list_matrix[k], &l.M[l.list_source[k] * nm], L);
     }
   }
-  // 5. L2P.
-  {
-    const Level &fine = levels_[0];
-    const long nc = static_cast<long>(fine.keys.size());
+}
+
+template <class AtBead>
+void CellMultipoleField::evaluate_at_beads(const AtBead &at_bead) const
+{
+  // L2P: every bead reads its fine cell's local expansion at its offset from the centre.
+  const std::size_t nl = taylor_.local_size();
+  const Level &fine = levels_[0];
+  const long nc = static_cast<long>(fine.keys.size());
 #pragma omp parallel for schedule(static) if (nc >= static_cast<long>(parallel_threshold))
-    for (long c = 0; c < nc; ++c)
+  for (long c = 0; c < nc; ++c)
+  {
+    const auto centre_c = centre(0, fine.index[c]);
+    for (std::uint32_t k = bead_begin_[c]; k < bead_begin_[c + 1]; ++k)
     {
-      const auto centre_c = centre(0, fine.index[c]);
-      for (std::uint32_t k = bead_begin_[c]; k < bead_begin_[c + 1]; ++k)
-      {
-        const std::uint32_t b = bead_order_[k];
-        const double u[3] = {xw_[3 * b] - centre_c[0], xw_[3 * b + 1] - centre_c[1],
-                             xw_[3 * b + 2] - centre_c[2]};
-        double Bb[3] = {0.0, 0.0, 0.0}, G[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
-        taylor_.evaluate(u, &fine.L[c * nl], Bb, G);
-        for (int a = 0; a < 3; ++a)
-        {
-          B[3 * b + a] = Bb[a];
-          for (int d = 0; d < 3; ++d)
-            gradB[9 * b + 3 * a + d] = G[a][d];
-        }
-      }
+      const std::uint32_t b = bead_order_[k];
+      const double u[3] = {xw_[3 * b] - centre_c[0], xw_[3 * b + 1] - centre_c[1],
+                           xw_[3 * b + 2] - centre_c[2]};
+      at_bead(u, b, &fine.L[c * nl]);
     }
   }
 }

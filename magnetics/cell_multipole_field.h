@@ -1,13 +1,17 @@
-// The far field of the induced dipoles without a cutoff: a cell multipole method (a uniform
+// The far field of point sources without a cutoff: a cell multipole method (a uniform
 // octree of occupied cells, Cartesian Taylor expansions, periodic images to convergence).
+// The sources are the induced magnetic dipoles (SourceKind::dipoles, the field B and its
+// gradient) or charges, optionally with dipoles (SourceKind::charges, open boxes: the
+// potential Φ = Σ q/r, the field E = −∇Φ = Σ q r/r³ and its gradient, without the physical
+// prefactor 1/(4πε0)); cartesian_taylor.h has the expansions of both.
 //
 // The beads are sorted into cubic-ish fine cells of size h (a few diameters). Pairs of beads
-// in ADJACENT fine cells (|ΔI|∞ ≤ 1, periodic images included) are the near field: this
-// class lists them (near_pairs()) and the solver treats them exactly, in every sweep, with
-// the `corrected` short range. Everything else — the whole domain, every periodic image —
-// is the far field, evaluated like the classical fast multipole method:
+// in ADJACENT fine cells (|ΔI|∞ ≤ near_reach, periodic images included) are the near field:
+// this class lists them (near_pairs()) and the caller treats them exactly (the magnetics in
+// every sweep, with the `corrected` short range). Everything else — the whole domain, every
+// periodic image — is the far field, evaluated like the classical fast multipole method:
 //
-//   1. P2M  every fine cell sums the Taylor moments of its dipoles about its centre;
+//   1. P2M  every fine cell sums the Taylor moments of its sources about its centre;
 //   2. M2M  moments move up the levels (cells of 2h, 4h, …; exact shifts);
 //   3. M2L  at every level a cell receives, as a local Taylor expansion about its centre,
 //           the field of the cells that are children of its parent's neighbours but not its
@@ -18,7 +22,8 @@
 //           ~1e-6; 2 periodic axes: images in a disc of radius 64 periods plus the analytic
 //           continuum beyond it for the field and its gradient);
 //   4. L2L  the local expansions move down to the fine cells;
-//   5. L2P  every bead gets B_far and ∇B_far from its fine cell's expansion.
+//   5. L2P  every bead gets the far field and its gradient (and, for charges, the potential)
+//           from its fine cell's expansion.
 //
 // Cost O(N) per evaluation (plus the one-time lattice sums of the top level, cached). The
 // translation tensors depend only on the integer cell offset and are tabulated per level.
@@ -26,8 +31,8 @@
 // for any number of threads.
 #pragma once
 
-#include "cartesian_taylor.h"
-#include "magnetic_neighbour_list.h"
+#include "magnetics/cartesian_taylor.h"
+#include "magnetics/magnetic_neighbour_list.h"
 
 #include <array>
 #include <cstddef>
@@ -37,14 +42,34 @@
 
 namespace magbrush::magnetics {
 
+// Charge sources (SourceKind::charges): per bead a charge q (1 per bead) and/or a dipole p
+// (3 per bead); a null pointer is no source of that kind. Units are the caller's.
+struct FarFieldSources
+{
+  const double *charge = nullptr;
+  const double *dipole = nullptr;
+};
+
+// What a charge far field returns per bead, OVERWRITTEN where the pointer is not null: the
+// potential Φ (1 per bead), the field E = −∇Φ (3) and its gradient ∂_c E_a (9, 9b + 3a + c).
+struct FarFieldTargets
+{
+  double *potential = nullptr;
+  double *field = nullptr;
+  double *gradient = nullptr;
+};
+
 class CellMultipoleField
 {
 public:
   // order: Taylor order p (cartesian_taylor.h); box[d] = periodic length (0 = open);
   // near_reach: the near field is the fine cells within ±near_reach (1: 27 cells, the
   // classical FMM; 2: 125 cells, which moves the nearest — strongest, for a 1/r³ kernel —
-  // far interactions from a separation ratio of 0.87 to 0.58: far more accurate per order).
-  CellMultipoleField(int order, const std::array<double, 3> &box, int near_reach = 2);
+  // far interactions from a separation ratio of 0.87 to 0.58: far more accurate per order);
+  // kind: dipoles (the magnetics) or charges (open boxes only: periodic charges need a
+  // neutralising background and an Ewald-type lattice sum, not implemented).
+  CellMultipoleField(int order, const std::array<double, 3> &box, int near_reach = 2,
+                     SourceKind kind = SourceKind::dipoles);
 
   // Sorts the beads into fine cells of target size `cell_size` [m] (periodic axes get k·2^m
   // cells exactly, k = 1 or 3), builds the levels, interaction lists and the near pair list.
@@ -60,9 +85,12 @@ public:
   // r = x_j − x_i + shift with the raw positions given to build().
   const std::vector<MagneticNeighbourList::Pair> &near_pairs() const { return near_pairs_; }
 
-  // B_far [T] (3 per bead) and ∇B_far [T/m] (9 per bead, gradB[9b + 3a + c] = ∂B_a/∂x_c)
-  // of the dipoles p (3 per bead, A m²), excluding the near pairs. Overwrites B and gradB.
+  // Dipoles: B_far [T] (3 per bead) and ∇B_far [T/m] (9 per bead, gradB[9b + 3a + c] =
+  // ∂B_a/∂x_c) of the dipoles p (3 per bead, A m²), excluding the near pairs. Overwrites B
+  // and gradB.
   void evaluate(const double *p, double *B, double *gradB);
+  // Charges: the far potential, field and gradient of the sources, excluding the near pairs.
+  void evaluate(const FarFieldSources &sources, const FarFieldTargets &targets);
 
   // M2L in single precision (default) or double (for the error table).
   void set_single_precision(bool single) { single_precision_ = single; }
@@ -138,6 +166,11 @@ private:
   void build_near_pairs(const double *const coord[3]);
   bool near(int level, const std::array<long, 3> &D) const;
   const std::vector<double> &lattice_matrix(int level, const std::array<long, 3> &offset);
+  // The passes of an evaluation: P2M (add_sources(s, bead, M) adds a bead's moments at
+  // offset s), M2M + M2L + L2L, and L2P (at_bead(u, bead, L) reads the cell's expansion).
+  template <class AddSources> void form_multipoles(const AddSources &add_sources);
+  void translate();
+  template <class AtBead> void evaluate_at_beads(const AtBead &at_bead) const;
 };
 
 } // namespace magbrush::magnetics

@@ -1,4 +1,4 @@
-#include "magnetic_neighbour_list.h"
+#include "magnetics/magnetic_neighbour_list.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,6 +1,6 @@
-#include "two_sphere_exact.h"
+#include "magnetics/two_sphere_exact.h"
 
-#include "dipole_physics.h"
+#include "magnetics/dipole_physics.h"
 
 #include <Eigen/Dense>
 

@@ -1,6 +1,6 @@
-#include "two_sphere_table.h"
+#include "magnetics/two_sphere_table.h"
 
-#include "dipole_physics.h"
+#include "magnetics/dipole_physics.h"
 
 #include <algorithm>
 #include <cmath>

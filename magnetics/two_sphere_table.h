@@ -9,7 +9,7 @@
 // force varies fastest, and interpolated with cubic Catmull–Rom splines (C¹).
 #pragma once
 
-#include "two_sphere_exact.h"
+#include "magnetics/two_sphere_exact.h"
 
 #include <memory>
 #include <vector>

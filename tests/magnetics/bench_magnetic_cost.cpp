@@ -9,8 +9,8 @@
 //
 //   bench_magnetic_cost [chains] [reference_cutoff_diameters]
 #include "brush_configuration.h"
-#include "dipole_physics.h"
-#include "induced_dipoles.h"
+#include "magnetics/dipole_physics.h"
+#include "magnetics/induced_dipoles.h"
 
 #include <omp.h>
 

@@ -12,8 +12,8 @@
 //
 //   bench_magnetic_far_field [chains_small] [chains_large] [cost]   (cost: only table 4)
 #include "brush_configuration.h"
-#include "dipole_physics.h"
-#include "induced_dipoles.h"
+#include "magnetics/dipole_physics.h"
+#include "magnetics/induced_dipoles.h"
 
 #include <omp.h>
 

@@ -1,9 +1,9 @@
 // The exact two-sphere force against the dipole models over D = d/a and μr: ratios to the
 // point-dipole force for the three coefficients, the series orders needed, and the cost of
 // one exact evaluation and of building the correction table. Prints tables; asserts nothing.
-#include "dipole_physics.h"
-#include "two_sphere_exact.h"
-#include "two_sphere_table.h"
+#include "magnetics/dipole_physics.h"
+#include "magnetics/two_sphere_exact.h"
+#include "magnetics/two_sphere_table.h"
 
 #include <chrono>
 #include <cstdio>

@@ -2,8 +2,8 @@
 // the field and gradient of ALL other dipoles (and all periodic images), for open boxes,
 // one periodic axis (the nip slab) and two (the compression box), with the error falling
 // as the expansion order grows.
-#include "cell_multipole_field.h"
-#include "dipole_physics.h"
+#include "magnetics/cell_multipole_field.h"
+#include "magnetics/dipole_physics.h"
 
 #include <gtest/gtest.h>
 

@@ -1,9 +1,9 @@
 // The many-body induced-dipole solver against closed forms: two spheres (point and mutual
 // dipoles, any field direction), the exact series (corrected model), the infinite chain, a
 // bead in a field gradient, Newton's third law, thread independence, saturation.
-#include "dipole_physics.h"
-#include "induced_dipoles.h"
-#include "two_sphere_exact.h"
+#include "magnetics/dipole_physics.h"
+#include "magnetics/induced_dipoles.h"
+#include "magnetics/two_sphere_exact.h"
 
 #include <gtest/gtest.h>
 #include <omp.h>

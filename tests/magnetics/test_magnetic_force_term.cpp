@@ -4,7 +4,7 @@
 // move; the ramp (held forces ∝ s²) and the local refresh through the engine; the
 // staleness-mode key.
 #include "dem/force_terms/magnetic_force_term.h"
-#include "two_sphere_exact.h"
+#include "magnetics/two_sphere_exact.h"
 
 #include "applied_magnetic_field.h"
 #include "case_parser.h"

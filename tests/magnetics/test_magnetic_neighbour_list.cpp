@@ -1,5 +1,5 @@
 // The magnetic neighbour list against brute force over all pairs and images.
-#include "magnetic_neighbour_list.h"
+#include "magnetics/magnetic_neighbour_list.h"
 
 #include <gtest/gtest.h>
 

@@ -16,7 +16,7 @@
 //  * no applied field: nothing solved, no force; a ramped field rescales the held state
 //    exactly (p ∝ B, F ∝ B²).
 #include "brush_configuration.h"
-#include "induced_dipoles.h"
+#include "magnetics/induced_dipoles.h"
 
 #include <gtest/gtest.h>
 #include <omp.h>

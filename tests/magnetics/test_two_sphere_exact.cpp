@@ -1,8 +1,8 @@
 // The exact two-sphere force (multipole series): two independent force evaluations agree,
 // the known figures at contact are reproduced, and the far field tends to the dipole forms.
-#include "dipole_physics.h"
-#include "two_sphere_exact.h"
-#include "two_sphere_table.h"
+#include "magnetics/dipole_physics.h"
+#include "magnetics/two_sphere_exact.h"
+#include "magnetics/two_sphere_table.h"
 
 #include <gtest/gtest.h>
 

@@ -1,0 +1,120 @@
+#include "magnetics/near_pairs.h"
+
+namespace magbrush::magnetics {
+
+namespace {
+void store_tensor(const DipoleTensor &T, double *t)
+{
+  t[0] = T.xx;
+  t[1] = T.yy;
+  t[2] = T.zz;
+  t[3] = T.xy;
+  t[4] = T.xz;
+  t[5] = T.yz;
+}
+} // namespace
+
+std::size_t NearPairs::evaluate_tensors(const BeadArrays &beads, double cutoff)
+{
+  const std::size_t np = list_.pairs().size();
+  tensor_.resize(np);
+  r_.resize(3 * np);
+  active_.resize(np);
+  cutoff_ = cutoff;
+  std::size_t count = 0;
+#pragma omp parallel for schedule(static) reduction(+ : count) if (np >= bead_parallel_threshold)
+  for (long k = 0; k < static_cast<long>(np); ++k)
+  {
+    evaluate_tensor(beads, k);
+    count += active_[k];
+  }
+  return count;
+}
+
+void NearPairs::evaluate_tensor(const BeadArrays &beads, std::size_t k)
+{
+  const auto &p = list_.pairs()[k];
+  double r[3] = {beads.x[p.j] - beads.x[p.i] + p.shift[0],
+                 beads.y[p.j] - beads.y[p.i] + p.shift[1],
+                 beads.z[p.j] - beads.z[p.i] + p.shift[2]};
+  const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+  for (int d = 0; d < 3; ++d)
+    r_[3 * k + d] = r[d];
+  // Hard cutoff (as Kawamoto): pairs beyond it do not interact at all. Coincident
+  // centres (r = 0) cannot occur between non-overlapping beads; they are skipped.
+  active_[k] = (r2 < cutoff_ * cutoff_ && r2 > 0.0);
+  if (active_[k])
+    tensor_[k] = DipoleTensor::at(r);
+  else
+    tensor_[k] = {0, 0, 0, 0, 0, 0};
+}
+
+void NearPairs::update_rows(std::size_t k)
+{
+  if (row_entry_.size() != 2 * list_.pairs().size())
+    return; // no rows (hard cutoff)
+  for (int side = 0; side < 2; ++side)
+    store_tensor(tensor_[k], &row_tensor_[6 * row_entry_[2 * k + side]]);
+}
+
+void NearPairs::build_rows()
+{
+  const auto &begin = list_.incident_begin();
+  const auto &pair_of = list_.incident_pair();
+  const auto &first = list_.incident_first();
+  const auto &pairs = list_.pairs();
+  const std::size_t n = begin.size() - 1;
+  row_begin_.assign(begin.begin(), begin.end());
+  row_other_.resize(begin[n]);
+  row_tensor_.resize(6 * begin[n]);
+  // Where each pair sits in the two beads' rows (a self-image pair twice in one row).
+  row_entry_.resize(2 * pairs.size());
+  for (std::size_t b = 0; b < n; ++b)
+    for (std::size_t q = begin[b]; q < begin[b + 1]; ++q)
+      row_entry_[2 * pair_of[q] + (first[q] ? 0 : 1)] = q;
+#pragma omp parallel for schedule(static) if (n >= bead_parallel_threshold)
+  for (long b = 0; b < static_cast<long>(n); ++b)
+    for (std::size_t q = begin[b]; q < begin[b + 1]; ++q)
+    {
+      const std::uint32_t k = pair_of[q];
+      row_other_[q] = first[q] ? pairs[k].j : pairs[k].i;
+      store_tensor(tensor_[k], &row_tensor_[6 * q]); // zero for an inactive (coincident) pair
+    }
+}
+
+void NearPairs::add_row_field(std::size_t b, const std::vector<double> &p, double s[3]) const
+{
+  double sx = s[0], sy = s[1], sz = s[2];
+  const std::size_t q0 = row_begin_[b], q1 = row_begin_[b + 1];
+  const std::uint32_t *other = row_other_.data();
+  const double *t = row_tensor_.data();
+  for (std::size_t q = q0; q < q1; ++q)
+  {
+    const double *pk = &p[3 * other[q]];
+    const double *T = &t[6 * q];
+    sx += T[0] * pk[0] + T[3] * pk[1] + T[4] * pk[2];
+    sy += T[3] * pk[0] + T[1] * pk[1] + T[5] * pk[2];
+    sz += T[4] * pk[0] + T[5] * pk[1] + T[2] * pk[2];
+  }
+  s[0] = sx;
+  s[1] = sy;
+  s[2] = sz;
+}
+
+void NearPairs::add_list_field(std::size_t b, const std::vector<double> &p, double B[3]) const
+{
+  const auto &begin = list_.incident_begin();
+  const auto &pair_of = list_.incident_pair();
+  const auto &first = list_.incident_first();
+  const auto &pairs = list_.pairs();
+  for (std::size_t q = begin[b]; q < begin[b + 1]; ++q)
+  {
+    const std::uint32_t k = pair_of[q];
+    if (!active_[k])
+      continue;
+    const std::uint32_t other = first[q] ? pairs[k].j : pairs[k].i;
+    tensor_[k].add_field(&p[3 * other], B);
+  }
+}
+
+} // namespace magbrush::magnetics

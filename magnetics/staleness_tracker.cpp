@@ -1,0 +1,148 @@
+#include "magnetics/staleness_tracker.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace magbrush::magnetics {
+
+StalenessTracker::StalenessTracker(const MagneticSettings &settings, const std::array<double, 3> &box)
+  : settings_(settings), box_(box)
+{
+}
+
+double StalenessTracker::move_limit(const BeadArrays &beads, std::size_t b) const
+{
+  const double factor = settings_.staleness_mode == StalenessMode::relative ? settings_.absolute_factor : 1.0;
+  return factor * settings_.staleness_fraction * beads.radius[b];
+}
+
+void StalenessTracker::evaluated_all(const BeadArrays &beads, double time)
+{
+  limit2_.resize(beads.n);
+  inv_radius2_.resize(beads.n);
+  for (std::size_t b = 0; b < beads.n; ++b)
+  {
+    const double limit = move_limit(beads, b);
+    limit2_[b] = limit * limit;
+    inv_radius2_[b] = 1.0 / (beads.radius[b] * beads.radius[b]);
+  }
+  for (std::size_t b = 0; b < beads.n; ++b)
+    evaluated(beads, b);
+  t_last_ = time;
+}
+
+void StalenessTracker::evaluated(const BeadArrays &beads, std::size_t b)
+{
+  x_last_.resize(3 * beads.n);
+  x_last_[3 * b] = beads.x[b];
+  x_last_[3 * b + 1] = beads.y[b];
+  x_last_[3 * b + 2] = beads.z[b];
+}
+
+void StalenessTracker::watch_close_pairs(const BeadArrays &beads, const NearPairs &near, double skin)
+{
+  const auto &pairs = near.pairs();
+  close_.clear();
+  close_of_pair_.assign(pairs.size(), -1);
+  min_radius_ = *std::min_element(beads.radius, beads.radius + beads.n);
+  max_radius_ = *std::max_element(beads.radius, beads.radius + beads.n);
+  const double f = settings_.staleness_fraction;
+  for (std::size_t k = 0; k < pairs.size(); ++k)
+  {
+    if (!near.active(k))
+      continue;
+    const double a = 0.5 * (beads.radius[pairs[k].i] + beads.radius[pairs[k].j]);
+    const double reach = settings_.relative_check_radius * a + skin;
+    const double *r = near.r(k);
+    if (r[0] * r[0] + r[1] * r[1] + r[2] * r[2] >= reach * reach)
+      continue;
+    close_of_pair_[k] = static_cast<std::int32_t>(close_.size());
+    close_.push_back({pairs[k].i, pairs[k].j, {0, 0, 0}, f * f * a * a});
+    pair_reevaluated(near, k);
+  }
+}
+
+void StalenessTracker::pair_reevaluated(const NearPairs &near, std::size_t k)
+{
+  if (close_of_pair_.size() != near.pairs().size() || close_of_pair_[k] < 0)
+    return;
+  ClosePair &c = close_[static_cast<std::size_t>(close_of_pair_[k])];
+  for (int d = 0; d < 3; ++d)
+    c.c[d] = near.pairs()[k].shift[d] - near.r(k)[d];
+}
+
+StalenessCheck StalenessTracker::check(const BeadArrays &beads, double time, bool list_current) const
+{
+  StalenessCheck c;
+  if (x_last_.size() != 3 * beads.n)
+  {
+    c.reason = RefreshReason::bead_count;
+    return c;
+  }
+  if (settings_.refresh_interval <= 0.0 ||
+      time - t_last_ >= settings_.refresh_interval * (1.0 - 1e-9))
+  {
+    c.reason = RefreshReason::interval;
+    return c;
+  }
+  // A bead is stale when it moved more than its limit since its force was evaluated. The
+  // minimum image: a bead wrapped across a periodic face by the caller did not move (the
+  // neighbour lists see the jump and are rebuilt at the next full evaluation).
+  const bool relative = settings_.staleness_mode == StalenessMode::relative && list_current;
+  if (relative)
+    move2_.resize(beads.n);
+  std::size_t stale = 0;
+  double worst2 = 0.0;
+  for (std::size_t b = 0; b < beads.n; ++b)
+  {
+    const double move2 = squared_move(beads, b);
+    stale += move2 > limit2_[b];
+    worst2 = std::max(worst2, move2 * inv_radius2_[b]);
+    if (relative)
+      move2_[b] = move2;
+  }
+  c.stale_beads = stale;
+  c.max_move = std::sqrt(worst2);
+  // relative: a pair can only be stale if one of its beads moved half its limit: the pair
+  // loop is skipped while no bead has.
+  if (relative && 2.0 * c.max_move * max_radius_ > settings_.staleness_fraction * min_radius_)
+    c.stale_pairs = count_stale_pairs(beads);
+  if (stale > 0 || c.stale_pairs > 0)
+    c.reason = RefreshReason::moved;
+  return c;
+}
+
+std::size_t StalenessTracker::count_stale_pairs(const BeadArrays &beads) const
+{
+  // Pairs of beads that have not moved half the pair's limit are skipped.
+  std::size_t stale_pairs = 0;
+  for (const ClosePair &p : close_)
+    if (4.0 * std::max(move2_[p.i], move2_[p.j]) > p.limit2)
+      stale_pairs += drift2(beads, p) > p.limit2;
+  return stale_pairs;
+}
+
+double StalenessTracker::squared_move(const BeadArrays &beads, std::size_t b) const
+{
+  double d[3] = {beads.x[b] - x_last_[3 * b], beads.y[b] - x_last_[3 * b + 1],
+                 beads.z[b] - x_last_[3 * b + 2]};
+  for (int a = 0; a < 3; ++a)
+    if (box_[a] > 0.0 && std::abs(d[a]) > 0.5 * box_[a])
+      d[a] -= box_[a] * std::round(d[a] / box_[a]);
+  return d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+}
+
+void StalenessTracker::particles_reordered(const std::vector<std::int32_t> &order)
+{
+  if (x_last_.size() == 3 * order.size())
+  {
+    const std::vector<double> old(x_last_);
+    for (std::size_t k = 0; k < order.size(); ++k)
+      for (int d = 0; d < 3; ++d)
+        x_last_[3 * k + d] = old[3 * static_cast<std::size_t>(order[k]) + d];
+  }
+  close_.clear();
+  close_of_pair_.clear();
+}
+
+} // namespace magbrush::magnetics

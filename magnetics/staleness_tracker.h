@@ -1,0 +1,106 @@
+// When do the held magnetic forces go stale? The bookkeeping of a DEM that evaluates the
+// magnetics at an interval and holds the forces in between.
+//
+// The forces depend on where the beads are, so the tracker keeps every bead's position at
+// its last force evaluation and says a refresh is due when
+//   * nothing was evaluated yet or the bead count changed;
+//   * the refresh interval has elapsed since the last full evaluation;
+//   * beads moved: by StalenessMode,
+//       absolute, local: some bead moved more than staleness_fraction × its radius;
+//       relative:        the dipole–dipole forces depend on RELATIVE positions, so the
+//                        watched pairs (closer than relative_check_radius mean radii plus the
+//                        skin at the last full evaluation) are stale when their pair vector
+//                        changed by more than staleness_fraction × the mean radius; a bead
+//                        alone (the applied field, which varies on the mm scale) only when it
+//                        moved absolute_factor times that.
+// Moves are minimum-image along periodic axes: a bead wrapped by the caller did not move.
+// A check costs one pass over the beads; the relative mode reads its watched pairs only
+// once some bead has moved half the limit (|Δr| ≤ |Δx_i| + |Δx_j|).
+#pragma once
+
+#include "magnetics/bead_arrays.h"
+#include "magnetics/magnetic_settings.h"
+#include "magnetics/near_pairs.h"
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace magbrush::magnetics {
+
+// Why a refresh is due (InducedDipoles::check_staleness).
+enum class RefreshReason { none, first, bead_count, interval, moved };
+
+struct StalenessCheck
+{
+  RefreshReason reason = RefreshReason::none;
+  std::size_t stale_beads = 0; // beads past the staleness limit
+  std::size_t stale_pairs = 0; // relative mode: watched pairs past it
+  double max_move = 0.0;       // largest displacement since the bead's last evaluation / radius
+};
+
+class StalenessTracker
+{
+public:
+  // A watched pair, compact for the per-step check: drift = x_j − x_i + c with
+  // c = image shift − the pair vector at the tensor's evaluation; stale when
+  // |drift|² > limit2 = (staleness_fraction × mean radius)².
+  struct ClosePair
+  {
+    std::uint32_t i, j;
+    double c[3];
+    double limit2;
+  };
+
+  StalenessTracker(const MagneticSettings &settings, const std::array<double, 3> &box);
+
+  // A full evaluation at `time`: every bead's reference position and move limit.
+  void evaluated_all(const BeadArrays &beads, double time);
+  // A local refresh re-evaluated bead b (the interval still counts from the full one).
+  void evaluated(const BeadArrays &beads, std::size_t b);
+  // relative: watch the near pairs that can come within relative_check_radius mean radii
+  // before the list expires (`skin` [m]).
+  void watch_close_pairs(const BeadArrays &beads, const NearPairs &near, double skin);
+  // Near pair k's tensor was evaluated again: its drift restarts from the current vector.
+  void pair_reevaluated(const NearPairs &near, std::size_t k);
+
+  // The interval and the moves since the reference (not "first": the caller knows whether it
+  // ever evaluated). `list_current`: the near pairs still refer to these beads.
+  StalenessCheck check(const BeadArrays &beads, double time, bool list_current) const;
+
+  std::size_t reference_count() const { return x_last_.size() / 3; }
+  // |x_b − x_last,b|² (minimum image along periodic axes) and its limit [m²].
+  double squared_move(const BeadArrays &beads, std::size_t b) const;
+  double limit2(std::size_t b) const { return limit2_[b]; }
+  const std::vector<ClosePair> &close_pairs() const { return close_; }
+  // relative: |Δr|² of a watched pair since its tensor was evaluated [m²].
+  static double drift2(const BeadArrays &beads, const ClosePair &c)
+  {
+    const double d[3] = {beads.x[c.j] - beads.x[c.i] + c.c[0], beads.y[c.j] - beads.y[c.i] + c.c[1],
+                         beads.z[c.j] - beads.z[c.i] + c.c[2]};
+    return d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+  }
+
+  // The caller re-sorted its beads (new[k] = old[order[k]]): the reference positions follow;
+  // the watched pairs are dropped until the next full evaluation.
+  void particles_reordered(const std::vector<std::int32_t> &order);
+
+private:
+  MagneticSettings settings_;
+  std::array<double, 3> box_;
+  std::vector<double> x_last_; // per bead: position at its last force evaluation
+  double t_last_ = 0.0;         // time of the last full evaluation
+  std::vector<double> limit2_, inv_radius2_; // per bead: move limit², 1/radius²
+  std::vector<ClosePair> close_;
+  std::vector<std::int32_t> close_of_pair_; // the record of near pair k (−1 = not watched)
+  double min_radius_ = 0.0, max_radius_ = 0.0;
+  mutable std::vector<double> move2_; // per-check scratch: |Δx_b|²
+
+  // Bead b's limit on its absolute move [m]: staleness_fraction × radius, times
+  // absolute_factor in the relative mode.
+  double move_limit(const BeadArrays &beads, std::size_t b) const;
+  std::size_t count_stale_pairs(const BeadArrays &beads) const;
+};
+
+} // namespace magbrush::magnetics

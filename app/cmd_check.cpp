@@ -2,11 +2,11 @@
 // units, and the numbers a designer derives from it. `--explain [--markdown]` prints the
 // schema instead (docs/case_reference.md is `magbrush check --explain --markdown`).
 // Exit codes: 0 valid, 1 invalid case, 2 usage error.
-#include "subcommand.h"
+#include "app/subcommand.h"
 
-#include "case_format.h"
-#include "case_hash.h"
-#include "case_parser.h"
+#include "coupling/case_format.h"
+#include "coupling/case_hash.h"
+#include "coupling/case_parser.h"
 
 #include <iostream>
 

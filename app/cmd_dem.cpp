@@ -2,7 +2,7 @@
 // runs the OpenMP particle engine bin/magbrush-dem on a case. The driver never links the
 // engine; it checks the arguments against the engine's own declaration
 // (dem/dem_command_line.h) and starts the sibling executable with them.
-#include "subcommand.h"
+#include "app/subcommand.h"
 
 #include "common/child_process.h"
 #include "dem/dem_command_line.h"

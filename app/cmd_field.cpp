@@ -2,7 +2,7 @@
 // runs the deal.II field solver bin/magbrush-field (under `mpirun -np N` when N > 1). The
 // driver itself never links deal.II; the solver is a sibling executable, and its options are
 // declared once, in field_solver/field_command_line.h, for both programs.
-#include "subcommand.h"
+#include "app/subcommand.h"
 
 #include "common/child_process.h"
 #include "field_solver/field_command_line.h"

@@ -2,12 +2,12 @@
 // (magnetostatics) and of the development nip (electrostatics) the field solver reads, and
 // print per region the cells and the area against the exact area.
 // Exit codes: 0 written, 1 invalid case or meshing failure, 2 usage error.
-#include "subcommand.h"
+#include "app/subcommand.h"
 
-#include "case_parser.h"
-#include "mesh_common.h"
-#include "mesh_nip.h"
-#include "mesh_roller.h"
+#include "coupling/case_parser.h"
+#include "geometry/mesh_common.h"
+#include "geometry/mesh_nip.h"
+#include "geometry/mesh_roller.h"
 
 #include <iostream>
 

@@ -7,12 +7,12 @@
 //   output is also kept in <output.directory>/dem/dem.log (the report reads its timing table)
 //   → record the stage's wall time in <output.directory>/run_times.csv
 //   then: the table of times, and the list of outputs with their paths.
-#include "run_pipeline.h"
-#include "subcommand.h"
+#include "app/run_pipeline.h"
+#include "app/subcommand.h"
 
-#include "case_parser.h"
+#include "coupling/case_parser.h"
 #include "common/atomic_file.h"
-#include "field_files.h"
+#include "coupling/field_files.h"
 
 #include <chrono>
 #include <cstdio>

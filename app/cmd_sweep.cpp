@@ -7,10 +7,10 @@
 //   same) → `magbrush run` with output.directory and field.output_dir inside the point's
 //   folder → gather nip_summary.csv and nip_profile.csv of every point into
 //   sweep_summary.csv / sweep_profiles.csv → tools/plot_sweep.py draws the comparison.
-#include "run_pipeline.h"
-#include "subcommand.h"
+#include "app/run_pipeline.h"
+#include "app/subcommand.h"
 
-#include "case_parser.h"
+#include "coupling/case_parser.h"
 #include "common/atomic_file.h"
 #include "common/child_process.h"
 

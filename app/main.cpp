@@ -1,5 +1,5 @@
 // magbrush — the user-facing driver. `magbrush <subcommand> --help` explains each step.
-#include "subcommand.h"
+#include "app/subcommand.h"
 
 #include <algorithm>
 #include <climits>

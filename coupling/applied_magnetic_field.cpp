@@ -1,8 +1,8 @@
 // Construction of the applied magnetic field from the case (see applied_magnetic_field.h).
-#include "applied_magnetic_field.h"
+#include "coupling/applied_magnetic_field.h"
 
-#include "case_hash.h"
-#include "field_grid.h"
+#include "coupling/case_hash.h"
+#include "coupling/field_grid.h"
 
 #include <algorithm>
 #include <cmath>

@@ -17,8 +17,8 @@
 // from many OpenMP threads at once.
 #pragma once
 
-#include "case_model.h"
-#include "polar_field_interpolator.h"
+#include "coupling/case_model.h"
+#include "coupling/polar_field_interpolator.h"
 
 #include <array>
 #include <memory>

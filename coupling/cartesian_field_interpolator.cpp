@@ -1,5 +1,5 @@
 // E = −∇Φ from the spline of Φ on the Cartesian nip window.
-#include "cartesian_field_interpolator.h"
+#include "coupling/cartesian_field_interpolator.h"
 
 #include <cmath>
 #include <limits>

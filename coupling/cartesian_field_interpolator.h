@@ -14,8 +14,8 @@
 // Cost: a 4×4 Hermite patch; no allocation, no virtual call.
 #pragma once
 
-#include "case_model.h"
-#include "field_grid.h"
+#include "coupling/case_model.h"
+#include "coupling/field_grid.h"
 
 #include <vector>
 

@@ -1,9 +1,9 @@
 // Printing a resolved case, its derived numbers, and the schema reference.
-#include "case_format.h"
+#include "coupling/case_format.h"
 
-#include "case_schema.h"
-#include "multipole_ring.h"
-#include "units.h"
+#include "coupling/case_schema.h"
+#include "coupling/multipole_ring.h"
+#include "coupling/units.h"
 
 #include <algorithm>
 #include <cmath>

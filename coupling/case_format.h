@@ -2,7 +2,7 @@
 // designer derives from it, and the schema reference (`magbrush check --explain`).
 #pragma once
 
-#include "case_model.h"
+#include "coupling/case_model.h"
 
 #include <string>
 #include <vector>

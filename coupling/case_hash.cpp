@@ -1,8 +1,8 @@
 // Field inputs and their digest: the schema's `affects` marks select the resolved entries.
-#include "case_hash.h"
+#include "coupling/case_hash.h"
 
-#include "case_format.h"
-#include "case_schema.h"
+#include "coupling/case_format.h"
+#include "coupling/case_schema.h"
 
 #include <cstdint>
 #include <cstdio>

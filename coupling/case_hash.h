@@ -3,7 +3,7 @@
 // differs (and can say which key changed by comparing field_inputs()).
 #pragma once
 
-#include "case_model.h"
+#include "coupling/case_model.h"
 
 #include <string>
 #include <utility>

@@ -1,5 +1,5 @@
 // Derived quantities of the case model (see case_model.h for conventions).
-#include "case_model.h"
+#include "coupling/case_model.h"
 
 #include <cmath>
 #include <stdexcept>

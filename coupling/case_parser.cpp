@@ -6,11 +6,11 @@
 //      checked for geometric sense (case_validation.h).
 // The walk only descends where the schema has keys, so YAML alias cycles and absurd nesting
 // are never followed.
-#include "case_parser.h"
+#include "coupling/case_parser.h"
 
-#include "case_schema.h"
-#include "case_validation.h"
-#include "units.h"
+#include "coupling/case_schema.h"
+#include "coupling/case_validation.h"
+#include "coupling/units.h"
 
 #include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/yaml.h>

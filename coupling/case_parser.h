@@ -7,7 +7,7 @@
 // can be found are collected into one CaseError, one per line.
 #pragma once
 
-#include "case_model.h"
+#include "coupling/case_model.h"
 
 #include <stdexcept>
 #include <string>

@@ -1,9 +1,9 @@
 // Consistency checks on a resolved case. Each check is about one thing a designer can get
 // wrong, and its message says what is wrong, by how much, and what would be right.
-#include "case_validation.h"
+#include "coupling/case_validation.h"
 
-#include "case_schema.h"
-#include "units.h"
+#include "coupling/case_schema.h"
+#include "coupling/units.h"
 
 #include <algorithm>
 #include <cmath>

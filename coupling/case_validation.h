@@ -3,7 +3,7 @@
 // the sleeve, a size distribution must stay positive, toner needs a charge, ...).
 #pragma once
 
-#include "case_model.h"
+#include "coupling/case_model.h"
 
 #include <string>
 #include <vector>

@@ -8,7 +8,7 @@
 //   <field.output_dir>/<case name>_magnetic_0.pvtu, _electric_0.pvtu (+ .vtu)   ParaView
 #pragma once
 
-#include "case_model.h"
+#include "coupling/case_model.h"
 
 #include <string>
 

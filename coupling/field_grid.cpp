@@ -1,11 +1,11 @@
 // Field grids: sampling, validation, the spline node data, and the HDF5 writer and reader.
 // The file layout is documented in docs/field_grid_format.md; keep the two in step.
-#include "field_grid.h"
+#include "coupling/field_grid.h"
 
 #include "common/atomic_file.h"
 
-#include "cartesian_field_interpolator.h"
-#include "polar_field_interpolator.h"
+#include "coupling/cartesian_field_interpolator.h"
+#include "coupling/polar_field_interpolator.h"
 
 #include <hdf5.h>
 

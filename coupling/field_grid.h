@@ -18,8 +18,8 @@
 // its finite-element solution at the nodes (sample_polar_grid), the DEM reads it back.
 #pragma once
 
-#include "case_hash.h"
-#include "case_model.h"
+#include "coupling/case_hash.h"
+#include "coupling/case_model.h"
 
 #include <functional>
 #include <limits>

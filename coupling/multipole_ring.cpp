@@ -1,5 +1,5 @@
 // The exact multipole-ring solution (see multipole_ring.h for the derivation).
-#include "multipole_ring.h"
+#include "coupling/multipole_ring.h"
 
 #include <Eigen/Dense>
 

@@ -40,7 +40,7 @@
 // thousands of harmonics.
 #pragma once
 
-#include "case_model.h"
+#include "coupling/case_model.h"
 
 #include <limits>
 #include <vector>

@@ -1,5 +1,5 @@
 // B and ∇B from the spline of A_z on the polar grid; the multipole tail beyond it.
-#include "polar_field_interpolator.h"
+#include "coupling/polar_field_interpolator.h"
 
 #include <algorithm>
 #include <cmath>

@@ -24,8 +24,8 @@
 // Cost: one atan2, one sqrt and a 4×4 Hermite patch; no allocation, no virtual call.
 #pragma once
 
-#include "case_model.h"
-#include "field_grid.h"
+#include "coupling/case_model.h"
+#include "coupling/field_grid.h"
 
 #include <array>
 #include <complex>

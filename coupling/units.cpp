@@ -1,7 +1,7 @@
 // Units by dimensional analysis: every unit symbol carries exponents over the base
 // dimensions (m, kg, s, A, rad) and a factor to SI. A unit expression multiplies them out,
 // and the result is accepted only when its exponents equal those of the expected dimension.
-#include "units.h"
+#include "coupling/units.h"
 
 #include <array>
 #include <cctype>

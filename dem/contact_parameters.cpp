@@ -1,5 +1,5 @@
 // Mixing rules, damping forms and the polygon rule (see contact_parameters.h).
-#include "contact_parameters.h"
+#include "dem/contact_parameters.h"
 
 #include <cmath>
 #include <cstdio>

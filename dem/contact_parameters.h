@@ -2,9 +2,9 @@
 // Kawamoto's polygon rule for the rolling-friction coefficient.
 #pragma once
 
-#include "contact_law.h"
+#include "dem/contact_law.h"
 
-#include "case_model.h"
+#include "coupling/case_model.h"
 
 #include <string>
 #include <vector>

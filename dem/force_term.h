@@ -10,7 +10,7 @@
 // guarantee is lost.
 #pragma once
 
-#include "particle_state.h"
+#include "dem/particle_state.h"
 
 #include <cstdint>
 #include <vector>

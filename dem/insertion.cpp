@@ -1,5 +1,5 @@
 // Population sampling and random sequential insertion (see insertion.h).
-#include "insertion.h"
+#include "dem/insertion.h"
 
 #include <algorithm>
 #include <functional>

@@ -5,11 +5,11 @@
 // them settle (DemSettings::settle_time).
 #pragma once
 
-#include "neighbour_list.h"
-#include "particle_state.h"
-#include "wall_contacts.h"
+#include "dem/neighbour_list.h"
+#include "dem/particle_state.h"
+#include "dem/wall_contacts.h"
 
-#include "case_model.h"
+#include "coupling/case_model.h"
 
 #include <random>
 #include <vector>

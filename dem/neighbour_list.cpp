@@ -1,5 +1,5 @@
 // Cell-list Verlet neighbour list with spatial sorting and id-keyed history (neighbour_list.h).
-#include "neighbour_list.h"
+#include "dem/neighbour_list.h"
 
 #include <algorithm>
 #include <cmath>

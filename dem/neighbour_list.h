@@ -12,7 +12,7 @@
 // * Periodic directions use the minimum image; each pair stores which image it uses.
 #pragma once
 
-#include "particle_state.h"
+#include "dem/particle_state.h"
 
 #include <array>
 #include <cstdint>

@@ -1,4 +1,4 @@
-#include "openmp_waiting.h"
+#include "dem/openmp_waiting.h"
 
 #include <algorithm>
 #include <atomic>

@@ -1,5 +1,5 @@
 // Structure-of-arrays particle storage (see particle_state.h).
-#include "particle_state.h"
+#include "dem/particle_state.h"
 
 #include <algorithm>
 #include <cmath>

@@ -7,7 +7,7 @@
 // cache locality. `id` is the stable name of a particle (0 .. N-1, dense).
 #pragma once
 
-#include "vector3.h"
+#include "dem/vector3.h"
 
 #include <cstdint>
 #include <vector>

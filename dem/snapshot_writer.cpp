@@ -1,5 +1,5 @@
 // HDF5/XDMF snapshots and the CSV time series (see snapshot_writer.h).
-#include "snapshot_writer.h"
+#include "dem/snapshot_writer.h"
 
 #include "common/atomic_file.h"
 

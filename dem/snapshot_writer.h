@@ -4,7 +4,7 @@
 // a file.
 #pragma once
 
-#include "dem_system.h"
+#include "dem/dem_system.h"
 
 #include <string>
 #include <vector>

@@ -1,5 +1,5 @@
 // Rayleigh/Hertz time-step criterion (see time_step.h).
-#include "time_step.h"
+#include "dem/time_step.h"
 
 #include <algorithm>
 #include <cmath>

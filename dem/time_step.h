@@ -12,10 +12,10 @@
 // times the limit; a user step above the limit is refused with the limit in the message.
 #pragma once
 
-#include "contact_parameters.h"
-#include "particle_state.h"
+#include "dem/contact_parameters.h"
+#include "dem/particle_state.h"
 
-#include "case_model.h"
+#include "coupling/case_model.h"
 
 #include <string>
 #include <vector>

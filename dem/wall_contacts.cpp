@@ -1,5 +1,5 @@
 // Sphere–wall contact geometry for the analytic primitives (see wall_contacts.h).
-#include "wall_contacts.h"
+#include "dem/wall_contacts.h"
 
 #include <algorithm>
 #include <cmath>

@@ -3,9 +3,9 @@
 // overlap, normal, and the velocity of the wall's surface at the contact point.
 #pragma once
 
-#include "vector3.h"
+#include "dem/vector3.h"
 
-#include "wall_primitives.h"
+#include "geometry/wall_primitives.h"
 
 #include <array>
 #include <string>

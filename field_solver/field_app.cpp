@@ -1,11 +1,11 @@
-#include "field_app.h"
+#include "field_solver/field_app.h"
 
-#include "case_hash.h"
+#include "coupling/case_hash.h"
 #include "common/atomic_file.h"
-#include "field_grid.h"
-#include "multipole_ring.h"
-#include "nip_electrostatics.h"
-#include "roller_magnetostatics.h"
+#include "coupling/field_grid.h"
+#include "coupling/multipole_ring.h"
+#include "field_solver/nip_electrostatics.h"
+#include "field_solver/roller_magnetostatics.h"
 
 #include <deal.II/base/mpi.h>
 

@@ -3,8 +3,8 @@
 // regenerated only when the inputs it depends on changed (coupling/case_hash.h).
 #pragma once
 
-#include "case_model.h"
-#include "field_files.h"
+#include "coupling/case_model.h"
+#include "coupling/field_files.h"
 
 #include <mpi.h>
 

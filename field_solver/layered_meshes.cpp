@@ -1,4 +1,4 @@
-#include "layered_meshes.h"
+#include "field_solver/layered_meshes.h"
 
 #include <deal.II/base/point.h>
 #include <deal.II/grid/grid_generator.h>

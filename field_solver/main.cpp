@@ -4,10 +4,10 @@
 //
 // Reads the case, then for each field it needs: if the stored grid carries the case's hash the
 // field is up to date and nothing is done; otherwise it is solved and stored (field_app.h).
-#include "field_app.h"
+#include "field_solver/field_app.h"
 #include "field_solver/field_command_line.h"
 
-#include "case_parser.h"
+#include "coupling/case_parser.h"
 
 #include <deal.II/base/mpi.h>
 

@@ -1,4 +1,4 @@
-#include "nip_electrostatics.h"
+#include "field_solver/nip_electrostatics.h"
 
 #include <cmath>
 #include <stdexcept>

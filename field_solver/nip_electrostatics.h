@@ -9,9 +9,9 @@
 // themselves.
 #pragma once
 
-#include "case_model.h"
-#include "layered_meshes.h"
-#include "potential_problem.h"
+#include "coupling/case_model.h"
+#include "field_solver/layered_meshes.h"
+#include "field_solver/potential_problem.h"
 
 #include <memory>
 #include <vector>

@@ -10,7 +10,7 @@
 // Header-only, no deal.II.
 #pragma once
 
-#include "case_model.h"
+#include "coupling/case_model.h"
 
 #include <cmath>
 #include <vector>

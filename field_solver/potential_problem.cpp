@@ -1,4 +1,4 @@
-#include "potential_problem.h"
+#include "field_solver/potential_problem.h"
 
 #include <deal.II/base/function.h>
 #include <deal.II/base/mpi.h>

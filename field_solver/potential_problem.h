@@ -17,7 +17,7 @@
 // linear system is a Trilinos matrix solved by CG with algebraic multigrid.
 #pragma once
 
-#include "shell_transformation.h"
+#include "field_solver/shell_transformation.h"
 
 #include <deal.II/base/index_set.h>
 #include <deal.II/base/point.h>

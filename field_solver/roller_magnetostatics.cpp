@@ -1,9 +1,9 @@
-#include "roller_magnetostatics.h"
+#include "field_solver/roller_magnetostatics.h"
 
-#include "layered_meshes.h"
-#include "mesh_roller.h"
-#include "mesh_tags.h"
-#include "pole_magnetisation.h"
+#include "field_solver/layered_meshes.h"
+#include "geometry/mesh_roller.h"
+#include "geometry/mesh_tags.h"
+#include "field_solver/pole_magnetisation.h"
 
 #include <deal.II/base/mpi.h>
 #include <deal.II/grid/grid_in.h>

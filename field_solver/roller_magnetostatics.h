@@ -13,9 +13,9 @@
 // SphericalManifold per circle.
 #pragma once
 
-#include "case_model.h"
-#include "mesh_common.h"
-#include "potential_problem.h"
+#include "coupling/case_model.h"
+#include "geometry/mesh_common.h"
+#include "field_solver/potential_problem.h"
 
 #include <array>
 #include <functional>

@@ -1,8 +1,8 @@
 // The Gmsh session guard, the mesh building blocks and the summary of a written mesh
 // (see mesh_common.h).
-#include "mesh_common.h"
+#include "geometry/mesh_common.h"
 
-#include "mesh_tags.h"
+#include "geometry/mesh_tags.h"
 
 #include "common/atomic_file.h"
 

@@ -1,8 +1,8 @@
 // The nip mesh (see mesh_nip.h): sleeve and drum as holes in the air, the photoconductor as a
 // structured graded layer, a structured open-boundary shell, quadrilaterals only.
-#include "mesh_nip.h"
+#include "geometry/mesh_nip.h"
 
-#include "mesh_tags.h"
+#include "geometry/mesh_tags.h"
 
 #include <gmsh.h>
 

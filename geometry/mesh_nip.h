@@ -13,9 +13,9 @@
 // the gap has opened to 3× its width), graded to mesh_size_far.
 #pragma once
 
-#include "case_model.h"
-#include "mesh_common.h"
-#include "mesh_size.h"
+#include "coupling/case_model.h"
+#include "geometry/mesh_common.h"
+#include "geometry/mesh_size.h"
 
 #include <string>
 #include <utility>

@@ -1,9 +1,9 @@
 // The roller mesh (see mesh_roller.h): concentric layers, embedded magnetic blades, a
 // structured open-boundary shell, quadrilaterals only.
-#include "mesh_roller.h"
+#include "geometry/mesh_roller.h"
 
-#include "mesh_tags.h"
-#include "wall_primitives.h"
+#include "geometry/mesh_tags.h"
+#include "geometry/wall_primitives.h"
 
 #include <gmsh.h>
 

@@ -13,9 +13,9 @@
 // edge of the DEM region (the polar field grid), graded to mesh_size_far away from it.
 #pragma once
 
-#include "case_model.h"
-#include "mesh_common.h"
-#include "mesh_size.h"
+#include "coupling/case_model.h"
+#include "geometry/mesh_common.h"
+#include "geometry/mesh_size.h"
 
 #include <string>
 #include <vector>

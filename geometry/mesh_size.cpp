@@ -1,7 +1,7 @@
 // Analytic mesh size function (see mesh_size.h).
-#include "mesh_size.h"
+#include "geometry/mesh_size.h"
 
-#include "wall_primitives.h"
+#include "geometry/wall_primitives.h"
 
 #include <algorithm>
 #include <cmath>

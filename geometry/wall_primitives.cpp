@@ -1,5 +1,5 @@
 // Builds the DEM's analytic walls from the case (see wall_primitives.h).
-#include "wall_primitives.h"
+#include "geometry/wall_primitives.h"
 
 #include <algorithm>
 #include <cmath>

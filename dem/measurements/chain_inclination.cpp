@@ -1,9 +1,9 @@
 // Chain inclination from the contact fabric along the sleeve (see chain_inclination.h).
-#include "chain_inclination.h"
+#include "dem/measurements/chain_inclination.h"
 
-#include "dem_system.h"
-#include "measurement_registry.h"
-#include "snapshot_writer.h" // write_file_atomically
+#include "dem/dem_system.h"
+#include "dem/measurements/measurement_registry.h"
+#include "dem/snapshot_writer.h" // write_file_atomically
 
 #include <algorithm>
 #include <cmath>

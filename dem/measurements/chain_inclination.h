@@ -17,11 +17,11 @@
 // by their small in-plane length squared. File: chain_inclination.csv.
 #pragma once
 
-#include "measurement.h"
-#include "nip_frame.h"
-#include "vector3.h"
+#include "dem/measurement.h"
+#include "dem/measurements/nip_frame.h"
+#include "dem/vector3.h"
 
-#include "case_model.h"
+#include "coupling/case_model.h"
 
 #include <string>
 #include <vector>

@@ -1,6 +1,6 @@
-#include "measurement_registry.h"
+#include "dem/measurements/measurement_registry.h"
 
-#include "dem_run.h"
+#include "dem/dem_run.h"
 
 namespace magbrush::dem {
 

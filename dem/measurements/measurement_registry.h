@@ -11,9 +11,9 @@
 // linker keeps every registration.
 #pragma once
 
-#include "measurement.h"
+#include "dem/measurement.h"
 
-#include "case_model.h"
+#include "coupling/case_model.h"
 
 #include <functional>
 #include <memory>

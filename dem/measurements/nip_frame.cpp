@@ -1,5 +1,5 @@
 // The nip coordinate frame (see nip_frame.h).
-#include "nip_frame.h"
+#include "dem/measurements/nip_frame.h"
 
 #include <algorithm>
 #include <cmath>

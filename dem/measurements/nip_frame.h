@@ -17,9 +17,9 @@
 // The roller axis is z; everything here works in the x-y plane of the case.
 #pragma once
 
-#include "vector3.h"
+#include "dem/vector3.h"
 
-#include "case_model.h"
+#include "coupling/case_model.h"
 
 namespace magbrush::dem {
 

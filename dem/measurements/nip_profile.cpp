@@ -1,11 +1,11 @@
 // Profiles of the beads touching the drum along the nip (see nip_profile.h).
-#include "nip_profile.h"
+#include "dem/measurements/nip_profile.h"
 
-#include "measurement_registry.h"
-#include "snapshot_writer.h" // write_file_atomically
+#include "dem/measurements/measurement_registry.h"
+#include "dem/snapshot_writer.h" // write_file_atomically
 
-#include "applied_magnetic_field.h"
-#include "field_files.h"
+#include "coupling/applied_magnetic_field.h"
+#include "coupling/field_files.h"
 
 #include <algorithm>
 #include <cmath>

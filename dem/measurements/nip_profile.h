@@ -20,12 +20,12 @@
 // normal, touching density, samples and averaging window).
 #pragma once
 
-#include "dem_system.h"
-#include "measurement.h"
-#include "nip_frame.h"
-#include "vector3.h"
+#include "dem/dem_system.h"
+#include "dem/measurement.h"
+#include "dem/measurements/nip_frame.h"
+#include "dem/vector3.h"
 
-#include "case_model.h"
+#include "coupling/case_model.h"
 
 #include <string>
 #include <vector>

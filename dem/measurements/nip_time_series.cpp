@@ -1,9 +1,9 @@
 // Bead budget and drum load of the nip over time (see nip_time_series.h).
-#include "nip_time_series.h"
+#include "dem/measurements/nip_time_series.h"
 
-#include "measurement_registry.h"
-#include "nip_profile.h" // resolve_drum_contact
-#include "snapshot_writer.h"
+#include "dem/measurements/measurement_registry.h"
+#include "dem/measurements/nip_profile.h" // resolve_drum_contact
+#include "dem/snapshot_writer.h"
 
 #include <cmath>
 #include <cstdio>

@@ -14,11 +14,11 @@
 //    nip_profile.h), and the mean slip of the touching beads within one bin of the gap centre.
 #pragma once
 
-#include "dem_system.h"
-#include "measurement.h"
-#include "nip_frame.h"
+#include "dem/dem_system.h"
+#include "dem/measurement.h"
+#include "dem/measurements/nip_frame.h"
 
-#include "case_model.h"
+#include "coupling/case_model.h"
 
 #include <cstdint>
 #include <string>

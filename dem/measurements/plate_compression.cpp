@@ -1,8 +1,8 @@
 // Kawamoto's compression test measured at the plate (see plate_compression.h).
-#include "plate_compression.h"
+#include "dem/measurements/plate_compression.h"
 
-#include "measurement_registry.h"
-#include "snapshot_writer.h"
+#include "dem/measurements/measurement_registry.h"
+#include "dem/snapshot_writer.h"
 
 #include <cmath>
 #include <cstdio>

@@ -21,12 +21,12 @@
 // of window means (⟨F_n⟩/⟨n⟩), so that pressure = density × mean force per bead holds exactly.
 #pragma once
 
-#include "measurement.h"
+#include "dem/measurement.h"
 
-#include "applied_magnetic_field.h"
-#include "case_model.h"
-#include "dem_system.h"
-#include "wall_primitives.h"
+#include "coupling/applied_magnetic_field.h"
+#include "coupling/case_model.h"
+#include "dem/dem_system.h"
+#include "geometry/wall_primitives.h"
 
 #include <array>
 #include <string>

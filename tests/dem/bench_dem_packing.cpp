@@ -15,9 +15,9 @@
 // wait at the step's barriers, which only a quiet machine shows (the wall-time speed-up). With repeats > 1
 // every configuration runs `repeats` times (1 and 2 threads back to back, so that the
 // speed-up compares runs under the same load) and a summary gives medians and ranges.
-#include "dem_system.h"
-#include "openmp_waiting.h"
-#include "snapshot_writer.h"
+#include "dem/dem_system.h"
+#include "dem/openmp_waiting.h"
+#include "dem/snapshot_writer.h"
 
 #include <omp.h>
 

@@ -2,7 +2,7 @@
 // spheres, 20 m/s approach; and test 3 with damping, e = 0.5 calibrated) against the closed
 // forms, for steps from t_c/12.5 to t_c/1600, with the run time and the observed order.
 // The automatic step (0.2 × the stable limit) is marked, so a user sees what it buys.
-#include "dem_system.h"
+#include "dem/dem_system.h"
 
 #include <omp.h>
 

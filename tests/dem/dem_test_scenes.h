@@ -1,9 +1,9 @@
 // Small scenes built in code for the DEM tests (no case files, no parser).
 #pragma once
 
-#include "dem_system.h"
+#include "dem/dem_system.h"
 
-#include "case_model.h"
+#include "coupling/case_model.h"
 
 #include <cmath>
 #include <string>

@@ -10,7 +10,7 @@
 //   test 4  alumina sphere on an Al-alloy plate (70 GPa, 0.33), |v| = 3.9 m/s at 0–90° from
 //           the normal, μ = 0.092, e = 0.98: gross sliding for tan θ ≥ 3.5 μ (1 + e), where
 //           ω' = 2.5 μ (1 + e) V_n / R and v_t'/v_t = 1 − μ (1 + e) / tan θ.
-#include "dem_test_scenes.h"
+#include "tests/dem/dem_test_scenes.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // Unit tests of the contact sub-models and the material-to-coefficient rules.
-#include "contact_law.h"
-#include "contact_parameters.h"
+#include "dem/contact_law.h"
+#include "dem/contact_parameters.h"
 
 #include <gtest/gtest.h>
 

@@ -2,13 +2,13 @@
 // continue bit-identically, contact history that survives neighbour-list rebuilds and
 // re-sorting, stability guards that stop with a useful message, refusal of unstable user
 // time steps, insertion, and the contact-law building blocks.
-#include "dem_test_scenes.h"
+#include "tests/dem/dem_test_scenes.h"
 #include "dem/force_terms/gravity.h"
 #include "dem/force_terms/stokes_drag.h"
 
-#include "insertion.h"
-#include "dem_run.h"
-#include "snapshot_writer.h"
+#include "dem/insertion.h"
+#include "dem/dem_run.h"
+#include "dem/snapshot_writer.h"
 
 #include <gtest/gtest.h>
 #include <hdf5.h>

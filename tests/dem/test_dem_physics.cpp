@@ -2,7 +2,7 @@
 //  * energy conservation of an undamped, frictionless periodic Hertz gas over 10⁵ steps;
 //  * a sphere rolling on a plane, decelerated by rolling friction at a = (5/7) μ_r g;
 //  * a particle in a rotating drum brought to the wall's surface speed by friction.
-#include "dem_test_scenes.h"
+#include "tests/dem/dem_test_scenes.h"
 #include "dem/force_terms/gravity.h"
 
 #include <gtest/gtest.h>

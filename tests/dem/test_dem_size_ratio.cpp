@@ -6,7 +6,7 @@
 // (Checked by experiment: LAMMPS's magnitude-preserving history rescale passes this too; the
 // test guards the large-ratio kinematics — contact-plane lever arms, history carried through
 // a fast-turning frame — rather than reproducing the LAMMPS bug itself.)
-#include "dem_test_scenes.h"
+#include "tests/dem/dem_test_scenes.h"
 
 #include <gtest/gtest.h>
 

@@ -2,10 +2,10 @@
 // planes on a prescribed path and extruded polygons (faces, corners, penetration), and two
 // dynamic checks: a particle carried along by a plate sliding sideways (Kawamoto's shear
 // step) and a particle resting on a blade face at the Hertz static overlap.
-#include "dem_test_scenes.h"
+#include "tests/dem/dem_test_scenes.h"
 #include "dem/force_terms/gravity.h"
 
-#include "wall_contacts.h"
+#include "dem/wall_contacts.h"
 
 #include <gtest/gtest.h>
 

@@ -2,11 +2,11 @@
 // degrees 1–3 and mesh levels, for the roller (B on the sleeve vs the exact multipole ring)
 // and the nip (E across the gap of two cylinders vs the bipolar solution); and the time from a
 // pole-angle change to a new stored field. Prints tables, asserts nothing, exits 0.
-#include "field_app.h"
-#include "layered_meshes.h"
-#include "multipole_ring.h"
-#include "potential_problem.h"
-#include "roller_magnetostatics.h"
+#include "field_solver/field_app.h"
+#include "field_solver/layered_meshes.h"
+#include "coupling/multipole_ring.h"
+#include "field_solver/potential_problem.h"
+#include "field_solver/roller_magnetostatics.h"
 
 #include <deal.II/base/mpi.h>
 #include <deal.II/distributed/shared_tria.h>

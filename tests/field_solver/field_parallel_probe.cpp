@@ -1,7 +1,7 @@
 // Solves the five-pole roller and writes B on the sleeve circle to a file (rank 0), so that
 // test_parallel can compare a serial run with an `mpirun -np 2` run of the same problem.
 //   field_parallel_probe OUTPUT_FILE
-#include "roller_magnetostatics.h"
+#include "field_solver/roller_magnetostatics.h"
 
 #include <deal.II/base/mpi.h>
 

@@ -1,11 +1,11 @@
 // Verification of the nip electrostatics (−∇·(ε∇Φ) = 0, Dirichlet electrodes, surface charge
 // on the photoconductor as a face integral) against exact solutions.
-#include "convergence.h"
-#include "mpi_environment.h"
+#include "tests/field_solver/convergence.h"
+#include "tests/field_solver/mpi_environment.h"
 
-#include "layered_meshes.h"
-#include "nip_electrostatics.h"
-#include "potential_problem.h"
+#include "field_solver/layered_meshes.h"
+#include "field_solver/nip_electrostatics.h"
+#include "field_solver/potential_problem.h"
 
 #include <deal.II/distributed/shared_tria.h>
 

@@ -1,7 +1,7 @@
 // The production field stage end to end (bin/magbrush-field on a paper case, coarse mesh):
 // the first run stores both fields; an unchanged case is "up to date" and rewrites nothing;
 // moving a pole regenerates only the magnetic field; changing the bias only the electric one.
-#include "field_grid.h"
+#include "coupling/field_grid.h"
 
 #include <gtest/gtest.h>
 

@@ -2,11 +2,11 @@
 // FE_Q(2) with MappingQ(2)) against exact solutions. Each test checks an error bound at the
 // finest level AND the observed order under uniform refinement (B is a derivative of A, so
 // O(h^p) = O(h²) is expected).
-#include "convergence.h"
-#include "mpi_environment.h"
+#include "tests/field_solver/convergence.h"
+#include "tests/field_solver/mpi_environment.h"
 
-#include "multipole_ring.h"
-#include "roller_magnetostatics.h"
+#include "coupling/multipole_ring.h"
+#include "field_solver/roller_magnetostatics.h"
 
 #include <gtest/gtest.h>
 

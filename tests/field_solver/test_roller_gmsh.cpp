@@ -11,11 +11,11 @@
 //      each cell and A is continuous), H_t = B_t/μ is continuous only weakly (within 50 %
 //      20 µm either side: B_t jumps by about μr), and the field on the sleeve on the far side
 //      of the roller (45°–135°, the blade is at 270°) changes by less than 1 % of its peak.
-#include "convergence.h"
-#include "mpi_environment.h"
+#include "tests/field_solver/convergence.h"
+#include "tests/field_solver/mpi_environment.h"
 
-#include "multipole_ring.h"
-#include "roller_magnetostatics.h"
+#include "coupling/multipole_ring.h"
+#include "field_solver/roller_magnetostatics.h"
 
 #include <gtest/gtest.h>
 

@@ -1,9 +1,9 @@
 // Mesh cost against geometric accuracy: for each element size, the cells, the time to mesh and
 // write, the worst relative region-area error against the exact areas and the worst cell
 // quality. Prints tables; asserts nothing.
-#include "mesh_nip.h"
-#include "mesh_roller.h"
-#include "mesh_test_cases.h"
+#include "geometry/mesh_nip.h"
+#include "geometry/mesh_roller.h"
+#include "tests/geometry/mesh_test_cases.h"
 
 #include <chrono>
 #include <cmath>

@@ -1,5 +1,5 @@
 // deal.II's GridIn::read_msh on a magbrush mesh (see dealii_reader.h).
-#include "dealii_reader.h"
+#include "tests/geometry/dealii_reader.h"
 
 #include <deal.II/grid/grid_in.h>
 #include <deal.II/grid/tria.h>

@@ -1,4 +1,4 @@
-#include "mesh_test_cases.h"
+#include "tests/geometry/mesh_test_cases.h"
 
 #include <cmath>
 #include <filesystem>

@@ -3,7 +3,7 @@
 // without a photoconductor layer.
 #pragma once
 
-#include "case_model.h"
+#include "coupling/case_model.h"
 
 #include <string>
 

@@ -1,11 +1,11 @@
 // The meshes as the field solver sees them: deal.II 9.4's GridIn::read_msh reads both, every
 // cell a quadrilateral of positive measure, material ids = region tags with the cell counts
 // and areas Gmsh wrote, boundary ids = boundary tags on every boundary face.
-#include "dealii_reader.h"
-#include "mesh_nip.h"
-#include "mesh_roller.h"
-#include "mesh_tags.h"
-#include "mesh_test_cases.h"
+#include "tests/geometry/dealii_reader.h"
+#include "geometry/mesh_nip.h"
+#include "geometry/mesh_roller.h"
+#include "geometry/mesh_tags.h"
+#include "tests/geometry/mesh_test_cases.h"
 
 #include <gtest/gtest.h>
 

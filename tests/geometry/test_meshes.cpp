@@ -1,12 +1,12 @@
 // The roller and nip meshes: physical groups, exact areas, quadrilaterals only with positive
 // Jacobians, the photoconductor layer resolved across, sizes graded as asked, the circles and
 // shells as documented, the wall primitives in the same place, and clear errors.
-#include "mesh_common.h"
-#include "mesh_nip.h"
-#include "mesh_roller.h"
-#include "mesh_tags.h"
-#include "mesh_test_cases.h"
-#include "wall_primitives.h"
+#include "geometry/mesh_common.h"
+#include "geometry/mesh_nip.h"
+#include "geometry/mesh_roller.h"
+#include "geometry/mesh_tags.h"
+#include "tests/geometry/mesh_test_cases.h"
+#include "geometry/wall_primitives.h"
 
 #include <gmsh.h>
 #include <gtest/gtest.h>

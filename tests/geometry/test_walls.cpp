@@ -1,6 +1,6 @@
 // DEM wall primitives from the case: rotation senses and the nip slip speed (Kawamoto's
 // prototype), blade prisms, plane-wall paths.
-#include "wall_primitives.h"
+#include "geometry/wall_primitives.h"
 
 #include <gtest/gtest.h>
 

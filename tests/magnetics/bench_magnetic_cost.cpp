@@ -8,7 +8,7 @@
 // polarised slab), so the reference itself is checked against a second, smaller radius.
 //
 //   bench_magnetic_cost [chains] [reference_cutoff_diameters]
-#include "brush_configuration.h"
+#include "tests/magnetics/brush_configuration.h"
 #include "magnetics/dipole_physics.h"
 #include "magnetics/induced_dipoles.h"
 

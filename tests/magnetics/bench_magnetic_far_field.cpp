@@ -11,7 +11,7 @@
 // the plane (the brush's push on the stage/plate). Prints tables; asserts nothing.
 //
 //   bench_magnetic_far_field [chains_small] [chains_large] [cost]   (cost: only table 4)
-#include "brush_configuration.h"
+#include "tests/magnetics/brush_configuration.h"
 #include "magnetics/dipole_physics.h"
 #include "magnetics/induced_dipoles.h"
 

@@ -4,11 +4,11 @@
 // check. Prints the state difference after the run and the time per step.
 //
 //   bench_magnetic_refresh [particles] [steps]
-#include "dem_system.h"
+#include "dem/dem_system.h"
 #include "dem/force_terms/magnetic_force_term.h"
 
-#include "applied_magnetic_field.h"
-#include "case_parser.h"
+#include "coupling/applied_magnetic_field.h"
+#include "coupling/case_parser.h"
 
 #include <chrono>
 #include <cmath>

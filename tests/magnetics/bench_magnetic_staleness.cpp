@@ -34,10 +34,10 @@
 // dem.verlet_skin).
 #include "dem/force_terms/magnetic_force_term.h"
 
-#include "applied_magnetic_field.h"
-#include "case_parser.h"
-#include "dem_run.h"
-#include "field_files.h"
+#include "coupling/applied_magnetic_field.h"
+#include "coupling/case_parser.h"
+#include "dem/dem_run.h"
+#include "coupling/field_files.h"
 
 #include <omp.h>
 #include <unistd.h>

@@ -15,12 +15,12 @@
 // a refresh): along the stage normal, or radial at the middle of the nip arc.
 //
 //   bench_magnetic_step_share [nip_carriers] [compression_carriers] [steps] [brush|loose]
-#include "dem_system.h"
+#include "dem/dem_system.h"
 #include "dem/force_terms/magnetic_force_term.h"
-#include "brush_configuration.h"
+#include "tests/magnetics/brush_configuration.h"
 
-#include "applied_magnetic_field.h"
-#include "case_parser.h"
+#include "coupling/applied_magnetic_field.h"
+#include "coupling/case_parser.h"
 
 #include <omp.h>
 

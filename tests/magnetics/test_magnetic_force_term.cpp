@@ -6,9 +6,9 @@
 #include "dem/force_terms/magnetic_force_term.h"
 #include "magnetics/two_sphere_exact.h"
 
-#include "applied_magnetic_field.h"
-#include "case_parser.h"
-#include "dem_system.h"
+#include "coupling/applied_magnetic_field.h"
+#include "coupling/case_parser.h"
+#include "dem/dem_system.h"
 
 #include <gtest/gtest.h>
 

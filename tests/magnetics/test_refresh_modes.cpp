@@ -15,7 +15,7 @@
 //    same bits;
 //  * no applied field: nothing solved, no force; a ramped field rescales the held state
 //    exactly (p ∝ B, F ∝ B²).
-#include "brush_configuration.h"
+#include "tests/magnetics/brush_configuration.h"
 #include "magnetics/induced_dipoles.h"
 
 #include <gtest/gtest.h>

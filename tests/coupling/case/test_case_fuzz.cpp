@@ -1,7 +1,7 @@
 // Robustness: thousands of randomly damaged versions of a valid case (bytes deleted,
 // inserted, swapped; lines duplicated or dropped; random overrides) must each either load or
 // throw CaseError — never crash, hang, or leak another exception type.
-#include "case_parser.h"
+#include "coupling/case_parser.h"
 
 #include <gtest/gtest.h>
 

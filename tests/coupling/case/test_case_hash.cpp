@@ -1,6 +1,6 @@
 // Field hashes change when, and only when, an input of that field changes.
-#include "case_hash.h"
-#include "case_parser.h"
+#include "coupling/case_hash.h"
+#include "coupling/case_parser.h"
 
 #include <gtest/gtest.h>
 

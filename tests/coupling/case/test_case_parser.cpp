@@ -1,11 +1,11 @@
 // The case parser: the paper scenes load with the values the papers give, defaults match
 // the contract struct, overrides behave like file values, errors carry file:line:column,
 // the schema and the printed case agree, and printing then re-reading gives the same case.
-#include "case_format.h"
-#include "case_parser.h"
-#include "case_schema.h"
-#include "case_validation.h"
-#include "multipole_ring.h"
+#include "coupling/case_format.h"
+#include "coupling/case_parser.h"
+#include "coupling/case_schema.h"
+#include "coupling/case_validation.h"
+#include "coupling/multipole_ring.h"
 
 #include <gtest/gtest.h>
 

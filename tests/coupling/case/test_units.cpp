@@ -1,6 +1,6 @@
 // Units: every unit symbol, SI prefixes, µ/μ/u, exponents, bare numbers, dimension
 // mismatches, garbage, and format_quantity <-> parse_quantity round trips.
-#include "units.h"
+#include "coupling/units.h"
 
 #include <gtest/gtest.h>
 

@@ -4,10 +4,10 @@
 // and the time of one B+∇B lookup (Google Benchmark, random points in the annulus).
 // Errors are relative to the largest exact value over the annulus (|B|max, |∇|B|²|max).
 // Prints its table and exits 0; nothing here is asserted.
-#include "applied_magnetic_field.h"
-#include "cartesian_field_interpolator.h"
-#include "exact_multipole.h"
-#include "polar_field_interpolator.h"
+#include "coupling/applied_magnetic_field.h"
+#include "coupling/cartesian_field_interpolator.h"
+#include "tests/coupling/field_grid/exact_multipole.h"
+#include "coupling/polar_field_interpolator.h"
 
 #include <benchmark/benchmark.h>
 

@@ -1,8 +1,8 @@
 // The DEM's applied field: the uniform shortcut (with its ramp) is exact and has no gradient;
 // the roller kind is the grid interpolator, scaled by the same ramp.
-#include "applied_magnetic_field.h"
-#include "exact_multipole.h"
-#include "field_grid.h"
+#include "coupling/applied_magnetic_field.h"
+#include "tests/coupling/field_grid/exact_multipole.h"
+#include "coupling/field_grid.h"
 
 #include <filesystem>
 #include <unistd.h>

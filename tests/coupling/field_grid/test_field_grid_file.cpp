@@ -1,7 +1,7 @@
 // The HDF5 field-grid format: bit-exact round trip, the reader's checks (each with the
 // message a user will see), provenance comparison and the atomic write.
-#include "exact_multipole.h"
-#include "field_grid.h"
+#include "tests/coupling/field_grid/exact_multipole.h"
+#include "coupling/field_grid.h"
 
 #include <gtest/gtest.h>
 #include <hdf5.h>

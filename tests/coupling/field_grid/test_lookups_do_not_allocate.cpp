@@ -1,9 +1,9 @@
 // The per-particle lookups allocate nothing (the DEM calls them millions of times per step
 // from many threads): counted by replacing the global operator new in this test program.
-#include "applied_magnetic_field.h"
-#include "cartesian_field_interpolator.h"
-#include "exact_multipole.h"
-#include "polar_field_interpolator.h"
+#include "coupling/applied_magnetic_field.h"
+#include "coupling/cartesian_field_interpolator.h"
+#include "tests/coupling/field_grid/exact_multipole.h"
+#include "coupling/polar_field_interpolator.h"
 
 #include <gtest/gtest.h>
 

@@ -1,8 +1,8 @@
 // The magnetic interpolator against the exact multipole-ring field: accuracy and observed
 // convergence orders, exact divergence, curl to interpolation accuracy, the periodic seam,
 // the multipole tail beyond the grid and the behaviour inside the sleeve.
-#include "exact_multipole.h"
-#include "polar_field_interpolator.h"
+#include "tests/coupling/field_grid/exact_multipole.h"
+#include "coupling/polar_field_interpolator.h"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
 // The cubic-spline node data shared by both interpolators, and the electric interpolator
 // against an exact harmonic potential.
-#include "cartesian_field_interpolator.h"
-#include "field_grid.h"
+#include "coupling/cartesian_field_interpolator.h"
+#include "coupling/field_grid.h"
 
 #include <gtest/gtest.h>
 

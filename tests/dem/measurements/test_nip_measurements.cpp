@@ -2,14 +2,14 @@
 // drum with known forces and velocities (exact bin values), hand-placed bead pairs with known
 // branch directions (exact inclinations), beads moved across the nip window (exact counts),
 // and one engine step with beads pressed on a turning drum (Hertz force, slip = −drum speed).
-#include "chain_inclination.h"
-#include "nip_frame.h"
-#include "nip_profile.h"
-#include "nip_time_series.h"
+#include "dem/measurements/chain_inclination.h"
+#include "dem/measurements/nip_frame.h"
+#include "dem/measurements/nip_profile.h"
+#include "dem/measurements/nip_time_series.h"
 
-#include "dem_system.h"
+#include "dem/dem_system.h"
 
-#include "case_parser.h"
+#include "coupling/case_parser.h"
 
 #include <gtest/gtest.h>
 

@@ -3,13 +3,13 @@
 // that cannot follow it (pinned by their inertia) feels μ_wall × the normal force on every
 // bead; densities, spacing and pressure follow from the count and the periodic area; the
 // applied |B| follows the piecewise-linear schedule.
-#include "plate_compression.h"
+#include "dem/measurements/plate_compression.h"
 
-#include "measurement_registry.h"
+#include "dem/measurements/measurement_registry.h"
 
-#include "applied_magnetic_field.h"
-#include "case_parser.h"
-#include "dem_system.h"
+#include "coupling/applied_magnetic_field.h"
+#include "coupling/case_parser.h"
+#include "dem/dem_system.h"
 
 #include <gtest/gtest.h>
 

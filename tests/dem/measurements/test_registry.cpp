@@ -1,8 +1,8 @@
 // The measurement registry: a factory registered at start-up is asked for every case and its
 // measurement is added to the run only when the scene calls for it.
-#include "measurement_registry.h"
+#include "dem/measurements/measurement_registry.h"
 
-#include "dem_run.h"
+#include "dem/dem_run.h"
 
 #include <gtest/gtest.h>
 

@@ -15,9 +15,9 @@
 //       exponent) and the pooled ratios to Kawamoto's scaling.
 //
 // Prints tables, asserts nothing, exits 0 (a failed run is reported in the table).
-#include "compression_run.h"
+#include "tests/scenes/compression/compression_run.h"
 
-#include "case_parser.h"
+#include "coupling/case_parser.h"
 
 #include <cmath>
 #include <cstdio>

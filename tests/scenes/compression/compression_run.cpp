@@ -1,12 +1,12 @@
 // In-process runs of Kawamoto's compression scene (see compression_run.h).
-#include "compression_run.h"
+#include "tests/scenes/compression/compression_run.h"
 
-#include "dem_run.h"
+#include "dem/dem_run.h"
 #include "dem/force_terms/magnetic_force_term.h"
-#include "measurement_registry.h"
+#include "dem/measurements/measurement_registry.h"
 
-#include "applied_magnetic_field.h"
-#include "case_parser.h"
+#include "coupling/applied_magnetic_field.h"
+#include "coupling/case_parser.h"
 
 #include <omp.h>
 

@@ -12,9 +12,9 @@
 //                 last 0.25 mm (the ratio saturates after ~0.35 mm of sliding)
 #pragma once
 
-#include "plate_compression.h"
+#include "dem/measurements/plate_compression.h"
 
-#include "case_model.h"
+#include "coupling/case_model.h"
 
 #include <string>
 #include <vector>

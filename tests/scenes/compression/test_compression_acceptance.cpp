@@ -21,7 +21,7 @@
 //    the mean of the two sizes).
 //
 // Cost: six DEM runs on one thread, ~2 min wall on the shared 2-core machine.
-#include "compression_run.h"
+#include "tests/scenes/compression/compression_run.h"
 
 #include <gtest/gtest.h>
 

@@ -12,7 +12,7 @@
 //  * the report is written (index.html with the plots).
 //
 // Cost: about 1 min on 2 cores in Release (the DEM: 1.8 ms of simulated time, 45,000 steps).
-#include "csv_columns.h"
+#include "tests/scenes/nip/csv_columns.h"
 
 #include <gtest/gtest.h>
 

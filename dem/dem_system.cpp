@@ -528,12 +528,7 @@ void DemSystem::write_checkpoint(const std::string &path)
   out.put_array(particles_.species);
   out.put_array(particles_.id);
   out.put_array(contact_count_);
-  out.put_array(list_.row_start);
-  out.put_array(list_.partner);
-  out.put_array(list_.touching);
-  out.put_array(list_.hist_x);
-  out.put_array(list_.hist_y);
-  out.put_array(list_.hist_z);
+  list_.write_history(out);
   wall_slots_.write(out);
   out.commit();
   // Both this run and a run restarted from the file rebuild the list at the next step, so
@@ -561,12 +556,7 @@ void DemSystem::read_checkpoint(const std::string &path)
   const ForceBuffers saved_forces = forces_;
   const std::vector<std::int32_t> saved_counts = contact_count_;
   setup_derived();
-  in.get_array(list_.row_start);
-  in.get_array(list_.partner);
-  in.get_array(list_.touching);
-  in.get_array(list_.hist_x);
-  in.get_array(list_.hist_y);
-  in.get_array(list_.hist_z);
+  list_.read_history(in);
   wall_slots_.read(in);
   forces_ = saved_forces;
   contact_count_ = saved_counts;

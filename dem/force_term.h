@@ -37,4 +37,14 @@ public:
   virtual void particles_reordered(const std::vector<std::int32_t> & /*order*/) {}
 };
 
+// A term that is a plain loop over the particles (gravity, drag): it runs inside the engine's
+// team; add_forces() opens a parallel region of its own for callers outside one
+// (DemSystem::initialize(), tests). Derived classes implement add_forces_in_team() only.
+class PerParticleForceTerm : public ForceTerm
+{
+public:
+  void add_forces(const ParticleState &state, ForceBuffers &forces, double t) final;
+  bool runs_in_team() const final { return true; }
+};
+
 } // namespace magbrush::dem

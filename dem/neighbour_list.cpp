@@ -310,4 +310,20 @@ std::size_t NeighbourList::memory_bytes() const
   return b;
 }
 
+void NeighbourList::write_history(CheckpointWriter &out) const
+{
+  for (const auto *a : {&row_start, &partner, &touching})
+    out.put_array(*a);
+  for (const auto *a : {&hist_x, &hist_y, &hist_z})
+    out.put_array(*a);
+}
+
+void NeighbourList::read_history(CheckpointReader &in)
+{
+  for (auto *a : {&row_start, &partner, &touching})
+    in.get_array(*a);
+  for (auto *a : {&hist_x, &hist_y, &hist_z})
+    in.get_array(*a);
+}
+
 } // namespace magbrush::dem

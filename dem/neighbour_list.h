@@ -12,6 +12,7 @@
 // * Periodic directions use the minimum image; each pair stores which image it uses.
 #pragma once
 
+#include "dem/checkpoint_file.h"
 #include "dem/particle_state.h"
 
 #include <array>
@@ -68,6 +69,11 @@ public:
   // Statistics of the last build.
   double cell_size() const { return cell_size_; }
   std::size_t memory_bytes() const;
+
+  // The contact history in a checkpoint: the pairs (rows, partners), who touches, and ξ. The
+  // rest is rebuilt at the first step after a restart.
+  void write_history(CheckpointWriter &out) const;
+  void read_history(CheckpointReader &in);
 
 private:
   std::array<Vector3, 27> shifts_{};

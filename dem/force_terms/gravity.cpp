@@ -1,16 +1,9 @@
-// Gravity: a per-particle loop that runs inside the engine's team (add_forces_in_team);
-// add_forces() opens a region of its own for callers outside one (initialize(), tests).
+// Gravity: a per-particle loop, run inside the engine's team (dem/force_term.h, PerParticleForceTerm).
 #include "dem/force_terms/gravity.h"
 
 #include "dem/force_terms/force_term_registry.h"
 
 namespace magbrush::dem {
-
-void Gravity::add_forces(const ParticleState &s, ForceBuffers &f, double t)
-{
-#pragma omp parallel if (s.size() > 512)
-  add_forces_in_team(s, f, t);
-}
 
 void Gravity::add_forces_in_team(const ParticleState &s, ForceBuffers &f, double)
 {

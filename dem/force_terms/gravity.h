@@ -7,13 +7,11 @@
 
 namespace magbrush::dem {
 
-class Gravity : public ForceTerm
+class Gravity : public PerParticleForceTerm
 {
 public:
   explicit Gravity(const std::array<double, 3> &g) : g_(g) {}
   const char *name() const override { return "gravity"; }
-  void add_forces(const ParticleState &s, ForceBuffers &f, double t) override;
-  bool runs_in_team() const override { return true; }
   void add_forces_in_team(const ParticleState &s, ForceBuffers &f, double t) override;
 
 private:

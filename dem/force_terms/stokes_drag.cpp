@@ -1,5 +1,4 @@
-// Stokes drag: a per-particle loop that runs inside the engine's team (add_forces_in_team);
-// add_forces() opens a region of its own for callers outside one (initialize(), tests).
+// Stokes drag: a per-particle loop, run inside the engine's team (dem/force_term.h, PerParticleForceTerm).
 #include "dem/force_terms/stokes_drag.h"
 
 #include "dem/force_terms/force_term_registry.h"
@@ -7,12 +6,6 @@
 #include <cmath>
 
 namespace magbrush::dem {
-
-void StokesDrag::add_forces(const ParticleState &s, ForceBuffers &f, double t)
-{
-#pragma omp parallel if (s.size() > 512)
-  add_forces_in_team(s, f, t);
-}
 
 void StokesDrag::add_forces_in_team(const ParticleState &s, ForceBuffers &f, double)
 {

@@ -5,13 +5,11 @@
 
 namespace magbrush::dem {
 
-class StokesDrag : public ForceTerm
+class StokesDrag : public PerParticleForceTerm
 {
 public:
   explicit StokesDrag(double viscosity) : eta_(viscosity) {}
   const char *name() const override { return "Stokes drag"; }
-  void add_forces(const ParticleState &s, ForceBuffers &f, double t) override;
-  bool runs_in_team() const override { return true; }
   void add_forces_in_team(const ParticleState &s, ForceBuffers &f, double t) override;
 
 private:

@@ -13,6 +13,7 @@
 #include "tests/calibration/test_support.h"
 
 #include <gtest/gtest.h>
+#include "tests/test_temp_dir.h"
 
 #include <array>
 #include <cmath>
@@ -54,14 +55,8 @@ CommandResult run_magbrush(const std::string &arguments, const std::string &envi
 
 bool contains(const std::string &s, const std::string &part) { return s.find(part) != std::string::npos; }
 
-// A scratch directory per test, under the build tree.
-fs::path scratch(const std::string &name)
-{
-  const fs::path dir = fs::path(MAGBRUSH_BINARY_DIR) / "tests" / "flux_scratch" / name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+// A scratch directory per test, private to this process.
+fs::path scratch(const std::string &name) { return magbrush::testing::test_temp_dir("flux_" + name); }
 
 // The case of the example roller with a design layout to start the fit from (the header's
 // angles deviate from these by zero on average, so the fitted encoder offset is zero).

@@ -10,6 +10,7 @@
 #include "calibration/flux_scan.h"
 #include "calibration/pole_fit.h"
 #include "tests/calibration/unseen_roller.h"
+#include "tests/test_temp_dir.h"
 
 #include <gtest/gtest.h>
 
@@ -62,9 +63,7 @@ FluxScan scan_from_fe_profile(const fs::path &profile)
 
 TEST(FiniteElementScan, PerPoleShapesAreChosenAndRecovered)
 {
-  const fs::path dir = fs::path(MAGBRUSH_BINARY_DIR) / "tests" / "flux_scratch" / "fe_scan";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = magbrush::testing::test_temp_dir("fe_scan");
   const fs::path case_file = write_true_case(dir);
   const std::string command = std::string(MAGBRUSH_BINARY_DIR) + "/bin/magbrush-field " +
                               case_file.string() + " --only magnetic --no-vtu > " +

@@ -152,10 +152,11 @@ TEST(PoleFit, RecoversSyntheticScansWithNoise)
   std::printf("worst over 5 seeds: angles %.4f deg, strengths %.3f %%, α %.3f %%, offset %.4f deg, "
               "largest |error|/σ %.2f\n",
               w.angle / deg, 100 * w.strength, 100 * w.shape, w.offset / deg, w.pull);
-  EXPECT_LT(w.angle, 0.1 * deg);
-  EXPECT_LT(w.strength, 0.01);
-  EXPECT_LT(w.shape, 0.01);
-  EXPECT_LT(w.offset, 0.05 * deg);
+  // The README's figures (measured worst of the five seeds: 0.048°, 0.31 %, 0.12 %, 0.005°).
+  EXPECT_LT(w.angle, 0.06 * deg);
+  EXPECT_LT(w.strength, 0.004);
+  EXPECT_LT(w.shape, 0.002);
+  EXPECT_LT(w.offset, 0.01 * deg);
   EXPECT_LT(w.pull, 5.0); // the reported uncertainties are honest
 }
 

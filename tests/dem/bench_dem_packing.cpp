@@ -18,6 +18,7 @@
 #include "dem/dem_system.h"
 #include "dem/openmp_waiting.h"
 #include "dem/snapshot_writer.h"
+#include "tests/test_temp_dir.h"
 
 #include <omp.h>
 
@@ -162,7 +163,7 @@ Result run(int per_side, int threads, int steps)
   auto &p = sys.particles();
   const PhaseTimes before = sys.phase_times();
   const long rebuilds0 = sys.neighbour_rebuilds();
-  const auto dir = std::filesystem::temp_directory_path() / "magbrush_bench_dem";
+  const auto dir = magbrush::testing::test_temp_dir("bench_dem") / "snapshots";
   SnapshotWriter writer(dir.string());
   double output = 0.0;
   std::vector<double> windows;

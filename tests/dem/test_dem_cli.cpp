@@ -2,6 +2,7 @@
 // a restart from the checkpoint that reproduces the uninterrupted run's final snapshot bit for
 // bit, and the messages of a refused time step and an impossible insertion.
 #include <gtest/gtest.h>
+#include "tests/test_temp_dir.h"
 #include <hdf5.h>
 
 #include <sys/wait.h>
@@ -94,12 +95,11 @@ std::vector<double> read_dataset(const std::string &file, const char *name)
 class DemCli : public ::testing::Test
 {
 protected:
-  fs::path dir = fs::temp_directory_path() / "magbrush_dem_cli_test";
+  fs::path dir;
   std::string case_file;
   void SetUp() override
   {
-    fs::remove_all(dir);
-    fs::create_directories(dir);
+    dir = magbrush::testing::test_temp_dir("dem_cli");
     case_file = (dir / "case.yaml").string();
     std::ofstream(case_file) << case_text;
   }

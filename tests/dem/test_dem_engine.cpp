@@ -9,6 +9,7 @@
 #include "dem/insertion.h"
 #include "dem/dem_run.h"
 #include "dem/snapshot_writer.h"
+#include "tests/test_temp_dir.h"
 
 #include <gtest/gtest.h>
 #include <hdf5.h>
@@ -117,7 +118,7 @@ TEST(DemEngine, RestartContinuesBitIdentically)
 {
   omp_set_num_threads(1); // thread independence is the test above; keep this one quick
   const Case c = packing_case();
-  const std::string path = (std::filesystem::temp_directory_path() / "magbrush_dem_restart_test.bin").string();
+  const std::string path = (magbrush::testing::test_temp_dir("dem_restart") / "restart.bin").string();
   auto a = make_packing(c);
   for (int k = 0; k < 600; ++k)
     a->step();
@@ -140,7 +141,7 @@ TEST(DemEngine, RestartContinuesBitIdentically)
 
 TEST(DemEngine, CorruptCheckpointIsRefused)
 {
-  const std::string path = (std::filesystem::temp_directory_path() / "magbrush_dem_bad.bin").string();
+  const std::string path = (magbrush::testing::test_temp_dir("dem_bad_checkpoint") / "bad.bin").string();
   std::ofstream(path) << "not a checkpoint";
   DemSystem s(packing_case());
   try
@@ -433,8 +434,7 @@ TEST(DemEngine, SnapshotIsReadableAndInIdOrder)
   auto sys = make_packing(c);
   for (int k = 0; k < 50; ++k)
     sys->step();
-  const auto dir = std::filesystem::temp_directory_path() / "magbrush_dem_snapshot_test";
-  std::filesystem::remove_all(dir);
+  const auto dir = magbrush::testing::test_temp_dir("dem_snapshot") / "out";
   SnapshotWriter w(dir.string());
   w.write(*sys);
   ASSERT_EQ(w.snapshots().size(), 1u);
@@ -569,8 +569,7 @@ TEST(DemEngine, MeasurementsAreSampledAtTheirIntervalAndWritten)
   c.populations[0].insert_box = std::array<Vec3, 2>{Vec3{0, 0, 0}, Vec3{3e-3, 3e-3, 3e-3}};
   c.dem.time_step = 1e-6;
   c.dem.duration = 100e-6;
-  const std::string dir = (std::filesystem::temp_directory_path() / "magbrush_measurement_test").string();
-  std::filesystem::remove_all(dir);
+  const std::string dir = (magbrush::testing::test_temp_dir("dem_measurement") / "out").string();
   RunOptions o;
   o.output_dir = dir;
   o.threads = 1;

@@ -57,8 +57,9 @@ TEST(DemPhysics, UndampedPeriodicGasConservesEnergy)
               sys.time_step(), sys.time(), sys.neighbour_rebuilds(), collisions_seen, worst, std::abs(e1 - e0) / e0);
   EXPECT_GT(collisions_seen, 100);        // it really is a colliding gas
   EXPECT_GT(sys.neighbour_rebuilds(), 10); // and the list really was rebuilt
-  EXPECT_LT(std::abs(e1 - e0) / e0, 1e-4);
-  EXPECT_LT(worst, 1e-3);
+  // The README quotes the worst drift (measured 2.47e-5, final 1.08e-5).
+  EXPECT_LT(std::abs(e1 - e0) / e0, 3e-5);
+  EXPECT_LT(worst, 3e-5);
 }
 
 TEST(DemPhysics, RollingFrictionDeceleratesRollingSphere)

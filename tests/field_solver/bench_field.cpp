@@ -7,6 +7,7 @@
 #include "coupling/multipole_ring.h"
 #include "field_solver/potential_problem.h"
 #include "field_solver/roller_magnetostatics.h"
+#include "tests/test_temp_dir.h"
 
 #include <deal.II/base/mpi.h>
 #include <deal.II/distributed/shared_tria.h>
@@ -170,8 +171,7 @@ void pole_change_timing()
   c.sleeve = Sleeve{};
   c.sleeve->radius = 10e-3;
   c.sleeve->thickness = 0.5e-3;
-  c.field.output_dir = (std::filesystem::temp_directory_path() / "magbrush_field_bench").string();
-  std::filesystem::create_directories(c.field.output_dir);
+  c.field.output_dir = magbrush::testing::test_temp_dir("field_bench").string();
   FieldRunOptions options;
   options.vtu = false;
   options.electric = false;

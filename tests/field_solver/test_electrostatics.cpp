@@ -138,8 +138,9 @@ TEST(FieldElectrostatics, CosineLatentImage)
   }
   print_study("cosine latent image, surface potential, max |Δφ_s| / φ_s0", phi_errors);
   print_study("cosine latent image, field, max |ΔE| / max |E|", E_errors);
-  EXPECT_LT(phi_errors.back(), 1.5e-4);
-  EXPECT_LT(E_errors.back(), 1.5e-3);
+  // measured 5.3e-5 and 6.9e-4 at level 3
+  EXPECT_LT(phi_errors.back(), 6e-5);
+  EXPECT_LT(E_errors.back(), 8e-4);
   EXPECT_GT(observed_orders(phi_errors).back(), 2.5);
   EXPECT_GT(observed_orders(E_errors).back(), 1.7);
 }
@@ -215,8 +216,10 @@ TEST(FieldElectrostatics, TwoCylindersBipolar)
   }
   print_study("two cylinders, nip field, max |ΔE| / E_gap", E_errors);
   print_study("two cylinders, capacitance (energy), |ΔC'|/C'", C_errors);
-  EXPECT_LT(E_errors.back(), 1e-3);
-  EXPECT_LT(C_errors.back(), 1e-5);
+  // The README's "E in the gap to 2e-4 and better": 2.2e-4 at level 0, 3.7e-6 at level 3.
+  EXPECT_LT(E_errors.front(), 2.5e-4);
+  EXPECT_LT(E_errors.back(), 5e-6);
+  EXPECT_LT(C_errors.back(), 3e-6);
   EXPECT_GT(observed_orders(E_errors).back(), 1.7);
   EXPECT_GT(observed_orders(C_errors).back(), 3.0);
 }
@@ -301,7 +304,9 @@ TEST(FieldElectrostatics, ProductionNipAgainstBipolar)
     }
   }
   print_study("production nip mesh, surface potential, max |dE| / E_gap", E_errors);
-  EXPECT_LT(E_errors.back(), 1e-3);
+  // measured 2.0e-4 at level 0, 1.2e-5 at level 2
+  EXPECT_LT(E_errors.front(), 2.2e-4);
+  EXPECT_LT(E_errors.back(), 1.4e-5);
   EXPECT_GT(observed_orders(E_errors).back(), 1.7);
 }
 

@@ -4,6 +4,7 @@
 #include "coupling/field_grid.h"
 
 #include <gtest/gtest.h>
+#include "tests/test_temp_dir.h"
 
 #include <cstdio>
 #include <cstdlib>
@@ -16,7 +17,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::string out_dir = std::string(MAGBRUSH_BINARY_DIR) + "/tests/field_app_output";
+const std::string out_dir = (magbrush::testing::test_temp_dir("field_app") / "out").string();
 
 std::string run_field(const std::string &extra, int &rc)
 {

@@ -16,6 +16,7 @@
 
 #include "coupling/multipole_ring.h"
 #include "field_solver/roller_magnetostatics.h"
+#include "tests/test_temp_dir.h"
 
 #include <gtest/gtest.h>
 
@@ -85,9 +86,7 @@ double seconds_since(std::chrono::steady_clock::time_point t0)
 const RollerMeshFile &mesh_file()
 {
   static const RollerMeshFile file = [] {
-    const auto dir = std::filesystem::temp_directory_path() /
-                     ("magbrush_field_gmsh_" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir);
+    const auto dir = magbrush::testing::test_temp_dir("field_gmsh");
     return write_roller_mesh_file(roller_case(100.0), (dir / "roller.msh").string(), degree,
                                   MPI_COMM_WORLD);
   }();

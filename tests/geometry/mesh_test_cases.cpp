@@ -1,5 +1,7 @@
 #include "tests/geometry/mesh_test_cases.h"
 
+#include "tests/test_temp_dir.h"
+
 #include <cmath>
 #include <filesystem>
 #include <unistd.h>
@@ -63,11 +65,7 @@ Case coarse_nip_case(double pc_thickness)
 std::string scratch_dir(const std::string &name)
 {
   // One directory per process: ctest runs the test cases of one executable in parallel.
-  const std::filesystem::path dir = std::filesystem::path(MAGBRUSH_BINARY_DIR) / "tests" / "scratch" /
-                                    (name + "-" + std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir.string();
+  return magbrush::testing::test_temp_dir("mesh_" + name).string();
 }
 
 } // namespace magbrush::testing

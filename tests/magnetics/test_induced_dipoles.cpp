@@ -128,7 +128,7 @@ TEST(InducedDipoles, CorrectedMatchesExactSeries)
       const double scale = std::hypot(F[0], F[2]);
       const double err = std::hypot(beads.fx[1] - F[0], beads.fz[1] - F[2]) / scale;
       worst = std::max(worst, err);
-      EXPECT_LT(err, 1e-4) << "D = " << D << " psi = " << psi;
+      EXPECT_LT(err, 1e-6) << "D = " << D << " psi = " << psi; // the README's figure; measured 9.1e-7
     }
   }
   std::printf("corrected vs exact series, D in {2, 2.2, 3, 4}: worst relative error %.2e\n", worst);

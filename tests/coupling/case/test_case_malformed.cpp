@@ -5,6 +5,7 @@
 // that cannot live in the repository (empty, binary, directory, missing, huge, deep) are
 // generated here.
 #include <gtest/gtest.h>
+#include "tests/test_temp_dir.h"
 
 #include <sys/wait.h>
 
@@ -39,7 +40,7 @@ std::string quote(const std::string &s)
 
 CheckRun run_check(const std::vector<std::string> &args)
 {
-  const fs::path out = fs::temp_directory_path() / ("magbrush_check_" + std::to_string(getpid()) + ".txt");
+  const fs::path out = magbrush::testing::test_temp_dir("check") / "output.txt";
   std::string command = "timeout -s KILL 30 " + quote(binary) + " check";
   for (const auto &a : args)
     command += " " + quote(a);
@@ -76,9 +77,7 @@ void expect_invalid(const CheckRun &r, const std::vector<std::string> &fragments
 
 fs::path scratch()
 {
-  const fs::path dir = fs::temp_directory_path() / ("magbrush_case_test_" + std::to_string(getpid()));
-  fs::create_directories(dir);
-  return dir;
+  return magbrush::testing::test_temp_dir("case_test");
 }
 
 } // namespace

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <gtest/gtest.h>
+#include "tests/test_temp_dir.h"
 
 using namespace magbrush;
 
@@ -106,8 +107,7 @@ TEST(AppliedMagneticField, RollerKindIsTheGridInterpolatorTimesTheRamp)
 TEST(AppliedMagneticField, ForCaseReadsTheGridAndChecksProvenance)
 {
   namespace fs = std::filesystem;
-  const fs::path dir = fs::temp_directory_path() / ("magbrush_applied_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
+  const fs::path dir = magbrush::testing::test_temp_dir("applied");
   Case c;
   c.name = "t";
   c.sleeve = Sleeve{};

@@ -4,6 +4,7 @@
 #include "coupling/field_grid.h"
 
 #include <gtest/gtest.h>
+#include "tests/test_temp_dir.h"
 #include <hdf5.h>
 
 #include <cmath>
@@ -17,35 +18,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A scratch directory per test (ctest runs the tests of this file as parallel processes),
-// removed when the test program ends.
-std::vector<fs::path> &scratch_dirs()
-{
-  static std::vector<fs::path> dirs;
-  return dirs;
-}
-
-struct RemoveScratchDirs : ::testing::Environment
-{
-  void TearDown() override
-  {
-    std::error_code ignored;
-    for (const auto &d : scratch_dirs())
-      fs::remove_all(d, ignored);
-  }
-};
-[[maybe_unused]] ::testing::Environment *const remove_scratch_dirs =
-    ::testing::AddGlobalTestEnvironment(new RemoveScratchDirs);
-
+// A scratch directory per test, removed when the test program ends.
 fs::path scratch_dir()
 {
   const auto *info = ::testing::UnitTest::GetInstance()->current_test_info();
-  fs::path dir = fs::temp_directory_path() /
-                 ("magbrush_fieldgrid_" + std::to_string(::getpid()) + "_" + info->name());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  scratch_dirs().push_back(dir);
-  return dir;
+  return magbrush::testing::test_temp_dir(std::string("fieldgrid_") + info->name());
 }
 
 PolarGrid some_polar_grid()

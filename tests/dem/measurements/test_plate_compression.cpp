@@ -12,6 +12,7 @@
 #include "dem/dem_system.h"
 
 #include <gtest/gtest.h>
+#include "tests/test_temp_dir.h"
 
 #include <cmath>
 #include <filesystem>
@@ -169,8 +170,7 @@ TEST(PlateCompression, PressedBeadsGiveHertzForcesDensityAndSpacing)
   EXPECT_NEAR(s.wall_loads()[1].force[2], total, 1e-9 * total);
 
   // Rows: 5 samples per window, each the mean of its samples.
-  fs::path dir = fs::temp_directory_path() / ("magbrush_plate_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
+  fs::path dir = magbrush::testing::test_temp_dir("plate");
   std::vector<double> fn_samples;
   for (int k = 0; k < 10; ++k)
   {

@@ -5,6 +5,7 @@
 #include "dem/dem_run.h"
 
 #include <gtest/gtest.h>
+#include "tests/test_temp_dir.h"
 
 #include <filesystem>
 #include <sstream>
@@ -55,7 +56,7 @@ TEST(MeasurementRegistry, AddsOnlyTheMeasurementsAScenesCallsFor)
     listed = listed || f.name == "null probe";
   EXPECT_TRUE(listed);
   RunOptions o;
-  o.output_dir = (std::filesystem::temp_directory_path() / "magbrush_registry_test").string();
+  o.output_dir = (magbrush::testing::test_temp_dir("registry") / "out").string();
   std::ostringstream log;
   for (const std::string name : {"wants_probe", "other"})
   {

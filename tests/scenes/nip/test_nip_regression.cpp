@@ -1,20 +1,29 @@
 // The development nip end to end on a reduced scene (tests/scenes/nip/kawamoto_nip_reduced.yaml: a
 // 0.3 mm slab of 1,300 beads, the paper's magnetic cutoff), through `magbrush run` exactly as a
-// user runs it (field, DEM with the nip measurements, report), asserting Kawamoto's findings:
+// user runs it (field, DEM with the nip measurements, report).
 //
-//  * the slip of the beads touching the drum at the gap centre equals the relative surface
-//    speed of sleeve and drum (0.135 m/s) within 5 %;
-//  * tangential / normal pressure on the drum = 0.35 ± 0.05 (the bead–drum friction);
-//  * the normal pressure is of the order of the magnetic pressure B²/2μ0 at the gap centre
-//    (its peak between 0.1× and 10×);
-//  * no bead is lost or created in the periodic slab, and the bead budget of the nip window
-//    balances (inside(t) = inside(0) + entered − left);
+// A regression GUARD, not a validation: the run is 1.8 ms after a sudden start, not shown to be
+// steady, and one chaotic trajectory; the bounds below sit around the values it gives (slip
+// 1.04 × the relative surface speed, tangential/normal 0.34, peak pressure 0.13 × B²/2μ0) and
+// are there to catch a change of behaviour, not to confirm the paper. What it asserts:
+//
+//  * the slip of the beads touching the drum at the gap centre is the relative surface speed
+//    of sleeve and drum (0.135 m/s) within 5 % (Kawamoto's finding; guard band);
+//  * tangential / normal force on the drum: never above the bead–drum friction μ = 0.35
+//    (Coulomb, each contact), and at least 0.30 (guard: most drum contacts slide);
+//  * the peak normal pressure is 0.06–0.26 × the magnetic pressure B²/2μ0 at the gap centre
+//    (guard, a factor 2 around the observed 0.13: the reduced layer is thinner than the paper's,
+//    and the paper's "of the order of B²/2μ0" is not reached here);
+//  * no bead is lost or created in the periodic slab (the nip window's budget is not asserted:
+//    the whole reduced slab lies inside the window, so no bead crosses its edges; the crossing
+//    counts are tested on hand-made trajectories in tests/dem/measurements);
 //  * the report is written (index.html with the plots).
 //
 // Cost: about 1 min on 2 cores in Release (the DEM: 1.8 ms of simulated time, 45,000 steps).
 #include "tests/scenes/nip/csv_columns.h"
 
 #include <gtest/gtest.h>
+#include "tests/test_temp_dir.h"
 
 #include <cmath>
 #include <cstdio>
@@ -63,9 +72,7 @@ struct ReducedNipRun
 ReducedNipRun run_reduced_nip()
 {
   ReducedNipRun r;
-  r.dir = fs::temp_directory_path() / ("magbrush_nip_regression_" + std::to_string(getpid()));
-  fs::remove_all(r.dir);
-  fs::create_directories(r.dir);
+  r.dir = magbrush::testing::test_temp_dir("nip_regression");
   const std::string cmd = "cd '" + r.dir.string() + "' && OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 '" +
                           binary_dir + "/bin/magbrush' run '" + source_dir +
                           "/tests/scenes/nip/kawamoto_nip_reduced.yaml' --skip mesh --set output.directory=results "
@@ -124,7 +131,8 @@ void tangential_over_normal_is_the_drum_friction(const ReducedNipRun &run)
 {
   const auto s = read_summary(run.dem() / "nip_summary.csv");
   std::printf("tangential / normal %.4f (bead-drum friction 0.35)\n", s.at("tangential_over_normal"));
-  EXPECT_NEAR(s.at("tangential_over_normal"), 0.35, 0.05);
+  EXPECT_LE(s.at("tangential_over_normal"), 0.35 + 1e-9); // Coulomb: no contact exceeds μ F_n
+  EXPECT_GE(s.at("tangential_over_normal"), 0.30);        // guard
 }
 
 void pressure_is_of_the_order_of_the_magnetic_pressure(const ReducedNipRun &run)
@@ -136,8 +144,9 @@ void pressure_is_of_the_order_of_the_magnetic_pressure(const ReducedNipRun &run)
               "Pa; peak / (B^2/2mu0) = %.3f\n",
               peak, s.at("normal_pressure_at_gap_centre"), b * 1e3, pm, peak / pm);
   EXPECT_GT(b, 0.08); // the development pole: ~100 mT on the sleeve, a little less mid-gap
-  EXPECT_GT(peak, 0.1 * pm);
-  EXPECT_LT(peak, 10.0 * pm);
+  // Guard band: a factor 2 either way around the observed ratio 0.127.
+  EXPECT_GT(peak, 0.06 * pm);
+  EXPECT_LT(peak, 0.26 * pm);
 }
 
 void no_bead_is_lost_or_created(const ReducedNipRun &run)
@@ -150,13 +159,12 @@ void no_bead_is_lost_or_created(const ReducedNipRun &run)
   {
     ASSERT_EQ(std::atol(t.at("beads")[k].c_str()), beads0) << "row " << k;
     ASSERT_EQ(std::atol(t.at("lost")[k].c_str()), 0) << "row " << k;
-    ASSERT_EQ(std::atol(t.at("in_window")[k].c_str()),
-              inside0 + std::atol(t.at("entered")[k].c_str()) - std::atol(t.at("left")[k].c_str()))
-        << "row " << k;
   }
+  std::printf("nip window: %ld beads inside at the start, %s entered, %s left\n", inside0,
+              t.at("entered").back().c_str(), t.at("left").back().c_str());
 }
 
-TEST(ReducedNip, KawamotosFindingsEndToEnd)
+TEST(ReducedNipGuard, KawamotosFindingsEndToEnd)
 {
   const ReducedNipRun run = run_reduced_nip();
   ASSERT_EQ(run.status, 0) << "magbrush run failed; its log: " << (run.dir / "run.log").string();

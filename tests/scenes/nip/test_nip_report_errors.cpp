@@ -1,6 +1,7 @@
 // `magbrush report` and `magbrush sweep` refuse bad input with messages that say what was
 // expected, what was found and what to do.
 #include <gtest/gtest.h>
+#include "tests/test_temp_dir.h"
 
 #include <array>
 #include <cstdio>
@@ -36,8 +37,7 @@ const std::string nip_case = std::string(MAGBRUSH_SOURCE_DIR) + "/cases/kawamoto
 
 TEST(NipReport, MissingDemOutputsAreAClearError)
 {
-  const auto dir = std::filesystem::temp_directory_path() / "magbrush_report_missing_outputs";
-  std::filesystem::remove_all(dir);
+  const auto dir = magbrush::testing::test_temp_dir("report_missing_outputs") / "out";
   const Result r = run("report '" + nip_case + "' --set output.directory=" + dir.string());
   EXPECT_EQ(r.status, 1) << r.output;
   EXPECT_NE(r.output.find("no DEM results for case 'kawamoto_nip'"), std::string::npos) << r.output;
@@ -62,7 +62,8 @@ TEST(NipSweep, UsageErrors)
   EXPECT_EQ(bad.status, 2);
   EXPECT_NE(bad.output.find("--vary expects key=v1,v2"), std::string::npos) << bad.output;
   // A bad value is reported by the case validation, naming the key.
-  const Result value = run("sweep '" + nip_case + "' --vary drum.gap=-1mm --set output.directory=/tmp/magbrush_sweep_bad");
+  const Result value = run("sweep '" + nip_case + "' --vary drum.gap=-1mm --set output.directory=" +
+                            (magbrush::testing::test_temp_dir("sweep_bad") / "out").string());
   EXPECT_NE(value.status, 0);
   EXPECT_NE(value.output.find("drum.gap"), std::string::npos) << value.output;
 }

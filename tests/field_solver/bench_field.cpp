@@ -7,6 +7,7 @@
 #include "coupling/multipole_ring.h"
 #include "field_solver/potential_problem.h"
 #include "field_solver/roller_magnetostatics.h"
+#include "tests/field_solver/five_pole_roller.h"
 #include "tests/test_temp_dir.h"
 
 #include <deal.II/base/mpi.h>
@@ -20,6 +21,7 @@
 
 using namespace magbrush;
 using namespace magbrush::field;
+using magbrush::field::testing::five_pole_roller;
 
 namespace {
 
@@ -30,21 +32,6 @@ double now()
 {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
     .count();
-}
-
-Roller five_pole_roller()
-{
-  Roller roller;
-  roller.shaft_radius = 3e-3;
-  roller.shaft_mu_r = 1000.0;
-  roller.magnet_radius = 9.3e-3;
-  const double deg = pi / 180.0;
-  roller.poles = {{"S1", 0 * deg, -330e3, 10.0},
-                  {"N1", 72 * deg, 172e3, 10.0},
-                  {"S2", 144 * deg, -200e3, 10.0},
-                  {"S3", 216 * deg, -170e3, 10.0},
-                  {"N2", 288 * deg, 142e3, 10.0}};
-  return roller;
 }
 
 void roller_table()

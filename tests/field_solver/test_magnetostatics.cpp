@@ -3,6 +3,7 @@
 // finest level AND the observed order under uniform refinement (B is a derivative of A, so
 // O(h^p) = O(h²) is expected).
 #include "tests/field_solver/convergence.h"
+#include "tests/field_solver/five_pole_roller.h"
 #include "tests/field_solver/mpi_environment.h"
 
 #include "field_solver/field_app.h"
@@ -179,17 +180,7 @@ INSTANTIATE_TEST_SUITE_P(Harmonics, FieldMultipoleRing, ::testing::Values(3, 5))
 // circle relative to the peak |B|.
 TEST(FieldMagnetostatics, FivePoleRollerOnTheSleeve)
 {
-  Roller roller;
-  roller.shaft_radius = 3e-3;
-  roller.shaft_mu_r = 1000.0;
-  roller.magnet_radius = 9.3e-3;
-  roller.magnet_mu_r = 1.0;
-  const double deg = pi / 180.0;
-  roller.poles = {{"S1", 0 * deg, -330e3, 10.0},
-                  {"N1", 72 * deg, 172e3, 10.0},
-                  {"S2", 144 * deg, -200e3, 10.0},
-                  {"S3", 216 * deg, -170e3, 10.0},
-                  {"N2", 288 * deg, 142e3, 10.0}};
+  const Roller roller = five_pole_roller();
   Sleeve sleeve;
   sleeve.radius = 10e-3;
   const MultipoleRing ring(roller);
@@ -214,16 +205,7 @@ TEST(FieldMagnetostatics, FivePoleRollerAtTheCaseDefaults)
 {
   Case c;
   c.name = "defaults_roller";
-  Roller roller;
-  roller.shaft_radius = 3e-3;
-  roller.shaft_mu_r = 1000.0;
-  roller.magnet_radius = 9.3e-3;
-  const double deg = pi / 180.0;
-  roller.poles = {{"S1", 0 * deg, -330e3, 10.0},
-                  {"N1", 72 * deg, 172e3, 10.0},
-                  {"S2", 144 * deg, -200e3, 10.0},
-                  {"S3", 216 * deg, -170e3, 10.0},
-                  {"N2", 288 * deg, 142e3, 10.0}};
+  const Roller roller = five_pole_roller();
   c.roller = roller;
   c.sleeve = Sleeve{};
   c.sleeve->radius = 10e-3;

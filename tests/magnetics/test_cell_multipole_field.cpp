@@ -3,6 +3,7 @@
 // one periodic axis (the nip slab) and two (the compression box), with the error falling
 // as the expansion order grows.
 #include "magnetics/cell_multipole_field.h"
+#include "tests/magnetics/far_field_error.h"
 #include "magnetics/dipole_physics.h"
 
 #include <gtest/gtest.h>
@@ -13,6 +14,8 @@
 #include <vector>
 
 using namespace magbrush::magnetics;
+
+using magbrush::magnetics::testing::far_field_rms_error;
 
 namespace {
 
@@ -112,20 +115,6 @@ void fast(const Cloud &c, const std::array<double, 3> &box, int order, double h,
     *near = field.near_pairs().size();
 }
 
-// Error of the far field: RMS over beads of |X_far − (X_ref − X_near)| / RMS |X_ref − X_near|,
-// i.e. relative to the far part itself (the near part is exact by construction).
-double rms_error(const std::vector<double> &far, const std::vector<double> &near,
-                 const std::vector<double> &ref)
-{
-  double e = 0.0, r = 0.0;
-  for (std::size_t k = 0; k < far.size(); ++k)
-  {
-    const double want = ref[k] - near[k];
-    e += (far[k] - want) * (far[k] - want);
-    r += want * want;
-  }
-  return std::sqrt(e / r);
-}
 
 // RMS |X_ref − X_near| / RMS |X_ref|: the share of the far field in the total.
 double far_share(const std::vector<double> &near, const std::vector<double> &ref)
@@ -150,7 +139,7 @@ TEST(CellMultipoleField, OpenBoxMatchesDirectSum)
   for (int order = 0; order <= 4; ++order)
   {
     fast(c, {0, 0, 0}, order, 65e-6, 2, B, G, Bn, Gn);
-    const double eB = rms_error(B, Bn, Bref), eG = rms_error(G, Gn, Gref);
+    const double eB = far_field_rms_error(B, Bn, Bref), eG = far_field_rms_error(G, Gn, Gref);
     std::printf("open, order %d: far-field error: field %.2e  gradient %.2e  (far share %.2f, %.2f)\n", order, eB, eG, far_share(Bn, Bref), far_share(Gn, Gref));
     EXPECT_LT(eB, previous);
     previous = eB;
@@ -172,7 +161,7 @@ TEST(CellMultipoleField, PeriodicAlongOneAxisMatchesImageSum)
   for (int order = 1; order <= 3; ++order)
   {
     fast(c, box, order, 65e-6, 2, B, G, Bn, Gn);
-    const double eB = rms_error(B, Bn, Bref), eG = rms_error(G, Gn, Gref);
+    const double eB = far_field_rms_error(B, Bn, Bref), eG = far_field_rms_error(G, Gn, Gref);
     std::printf("z-periodic, order %d: far-field error: field %.2e  gradient %.2e  (far share %.2f, %.2f)\n", order, eB, eG, far_share(Bn, Bref), far_share(Gn, Gref));
     if (order == 3)
     {
@@ -192,7 +181,7 @@ TEST(CellMultipoleField, SinglePrecisionTranslationsAreHarmless)
   fast(c, box, 2, 90e-6, 2, B1, G1, Bn, Gn, nullptr, true);
   fast(c, box, 2, 90e-6, 2, B2, G2, Bn, Gn, nullptr, false);
   const std::vector<double> zeroB(B1.size(), 0.0), zeroG(G1.size(), 0.0);
-  const double eB = rms_error(B1, zeroB, B2), eG = rms_error(G1, zeroG, G2);
+  const double eB = far_field_rms_error(B1, zeroB, B2), eG = far_field_rms_error(G1, zeroG, G2);
   std::printf("single vs double precision M2L: field %.2e  gradient %.2e (relative to the far field)\n", eB, eG);
   EXPECT_LT(eB, 1e-5);
   EXPECT_LT(eG, 1e-5);
@@ -207,7 +196,7 @@ TEST(CellMultipoleField, WideStripPeriodicAlongOneAxis)
   std::vector<double> Bref, Gref, B, G, Bn, Gn;
   direct(c, box, [](auto &&f) { for (long m = -200; m <= 200; ++m) f(0, 0, m); }, Bref, Gref);
   fast(c, box, 3, 65e-6, 2, B, G, Bn, Gn);
-  const double eB = rms_error(B, Bn, Bref), eG = rms_error(G, Gn, Gref);
+  const double eB = far_field_rms_error(B, Bn, Bref), eG = far_field_rms_error(G, Gn, Gref);
   std::printf("wide z-periodic strip, order 3: far-field error: field %.2e  gradient %.2e\n", eB, eG);
   EXPECT_LT(eB, 4e-2);
   EXPECT_LT(eG, 2.5e-1);
@@ -246,13 +235,13 @@ TEST(CellMultipoleField, PeriodicAlongTwoAxesMatchesLatticeSum)
   std::vector<double> Bref, Gref, B2, G2, B, G, Bn, Gn;
   reference(100, Bref, Gref);
   reference(50, B2, G2);
-  const double ref_error = rms_error(B2, std::vector<double>(B2.size(), 0.0), Bref);
+  const double ref_error = far_field_rms_error(B2, std::vector<double>(B2.size(), 0.0), Bref);
   std::printf("x/z-periodic reference: disc 50 vs 100 periods %.2e\n", ref_error);
   EXPECT_LT(ref_error, 1e-4);
   for (int order = 1; order <= 3; ++order)
   {
     fast(c, box, order, 65e-6, 2, B, G, Bn, Gn);
-    const double eB = rms_error(B, Bn, Bref), eG = rms_error(G, Gn, Gref);
+    const double eB = far_field_rms_error(B, Bn, Bref), eG = far_field_rms_error(G, Gn, Gref);
     std::printf("x/z-periodic, order %d: far-field error: field %.2e  gradient %.2e  (far share %.2f, %.2f)\n", order, eB, eG, far_share(Bn, Bref), far_share(Gn, Gref));
     if (order == 3)
     {

@@ -17,6 +17,7 @@
 // dipoles of moment ~ q × spacing: field 2.3e-2 at order 4, 4.8e-3 at order 6.
 #include "magnetics/cartesian_taylor.h"
 #include "magnetics/cell_multipole_field.h"
+#include "tests/magnetics/far_field_error.h"
 
 #include <gtest/gtest.h>
 
@@ -28,6 +29,8 @@
 #include <vector>
 
 using namespace magbrush::magnetics;
+
+using magbrush::magnetics::testing::far_field_rms_error;
 
 namespace {
 
@@ -132,19 +135,6 @@ void fast(const Charges &c, int order, double h, Fields &far, Fields &near, bool
   }
 }
 
-// RMS |X_far − (X_ref − X_near)| / RMS |X_ref − X_near| (relative to the far part itself).
-double rms_error(const std::vector<double> &far, const std::vector<double> &near,
-                 const std::vector<double> &ref)
-{
-  double e = 0.0, r = 0.0;
-  for (std::size_t k = 0; k < far.size(); ++k)
-  {
-    const double want = ref[k] - near[k];
-    e += (far[k] - want) * (far[k] - want);
-    r += want * want;
-  }
-  return std::sqrt(e / r);
-}
 
 } // namespace
 
@@ -229,8 +219,8 @@ TEST(CellMultipoleField, OpenBoxChargesMatchDirectCoulombSum)
   for (int order : {2, 4, 6})
   {
     fast(c, order, 65e-6, far, near, false);
-    const double ephi = rms_error(far.phi, near.phi, ref.phi), eE = rms_error(far.E, near.E, ref.E),
-                 eG = rms_error(far.G, near.G, ref.G);
+    const double ephi = far_field_rms_error(far.phi, near.phi, ref.phi), eE = far_field_rms_error(far.E, near.E, ref.E),
+                 eG = far_field_rms_error(far.G, near.G, ref.G);
     std::printf("charges, open, order %d: far-field error: potential %.2e  field %.2e  gradient %.2e\n",
                 order, ephi, eE, eG);
     EXPECT_LT(eE, 0.5 * previous); // at least halves per two orders
@@ -245,7 +235,7 @@ TEST(CellMultipoleField, OpenBoxChargesMatchDirectCoulombSum)
   for (std::size_t k = 0; k < far.E.size(); ++k)
     total.E[k] = far.E[k] + near.E[k];
   const std::vector<double> zero(total.E.size(), 0.0);
-  const double e_total = rms_error(total.E, zero, ref.E);
+  const double e_total = far_field_rms_error(total.E, zero, ref.E);
   std::printf("charges, open, order 6: total field error %.2e (relative to the whole field)\n", e_total);
   EXPECT_LT(e_total, 6e-4);
 }
@@ -261,7 +251,7 @@ TEST(CellMultipoleField, OpenBoxChargesAndDipolesMatchDirectSum)
   for (int order : {4, 6})
   {
     fast(c, order, 65e-6, far, near, true);
-    const double ephi = rms_error(far.phi, near.phi, ref.phi), eE = rms_error(far.E, near.E, ref.E);
+    const double ephi = far_field_rms_error(far.phi, near.phi, ref.phi), eE = far_field_rms_error(far.E, near.E, ref.E);
     std::printf("charges + dipoles, open, order %d: far-field error: potential %.2e  field %.2e\n",
                 order, ephi, eE);
     EXPECT_LT(ephi, order == 4 ? 7e-3 : 1.5e-3);

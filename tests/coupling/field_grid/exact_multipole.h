@@ -151,7 +151,7 @@ inline std::vector<RingTerm> gaussian_poles_as_rings(const std::vector<std::arra
 }
 
 // The roller of the benchmark and of the accuracy tests: the 5-pole roller of
-// /work/shared/data/sleeve_profile_example.csv scaled to a 12.5 mm sleeve (magnet ring
+// cases/data/sleeve_profile_example.csv scaled to a 12.5 mm sleeve (magnet ring
 // 3.75..11.625 mm in air, α = 10 /rad², poles S1 0° −330, N1 72° 172, S2 144° −200,
 // S3 216° −170, N2 288° 142 kA/m). A larger α makes sharper poles (more harmonics).
 inline MultipoleField roller_like_field(double alpha = 10.0)

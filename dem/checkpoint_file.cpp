@@ -7,7 +7,7 @@
 namespace magbrush::dem {
 
 namespace {
-constexpr char checkpoint_magic[9] = "MBDEMCK2";
+constexpr char checkpoint_magic[9] = "MBDEMCK3";
 }
 
 CheckpointWriter::CheckpointWriter(const std::string &path) : file_(path)

@@ -1,7 +1,8 @@
-// The DEM checkpoint's file format: a flat binary file, the 8-byte magic "MBDEMCK2" (2: 32-bit
-// pair flags), then scalars and length-prefixed arrays in the order the writer puts them
-// (the clock, the particles, the forces, the neighbour list with its contact history, the
-// wall-contact slots: DemSystem::write_checkpoint). Native byte order: a checkpoint is for
+// The DEM checkpoint's file format: a flat binary file, the 8-byte magic "MBDEMCK3" (2: 32-bit
+// pair flags; 3: force-term state), then scalars and length-prefixed arrays in the order the
+// writer puts them (the clock, the particles, the forces, the neighbour list with its contact
+// history, the wall-contact slots, then each force term's name and state:
+// DemSystem::write_checkpoint). Native byte order: a checkpoint is for
 // restarting on the machine (or the same architecture) that wrote it.
 //
 // The writer writes to a temporary file in the same folder and renames it over the target

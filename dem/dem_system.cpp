@@ -530,6 +530,15 @@ void DemSystem::write_checkpoint(const std::string &path)
   out.put_array(contact_count_);
   list_.write_history(out);
   wall_slots_.write(out);
+  // Each force term's own state, framed by its name so that a restart under a different set
+  // of terms is refused rather than misread.
+  out.put<std::uint64_t>(terms_.size());
+  for (const auto &term : terms_)
+  {
+    const std::string name = term->name();
+    out.put_array(std::vector<char>(name.begin(), name.end()));
+    term->write_state(out);
+  }
   out.commit();
   // Both this run and a run restarted from the file rebuild the list at the next step, so
   // that they continue through identical lists.
@@ -558,6 +567,19 @@ void DemSystem::read_checkpoint(const std::string &path)
   setup_derived();
   list_.read_history(in);
   wall_slots_.read(in);
+  const auto n_terms = in.get<std::uint64_t>();
+  if (n_terms != terms_.size())
+    in.fail("holds the state of " + std::to_string(n_terms) + " force terms, this run has " +
+            std::to_string(terms_.size()) + ": restart with the case that wrote it");
+  for (const auto &term : terms_)
+  {
+    std::vector<char> name;
+    in.get_array(name);
+    if (std::string(name.begin(), name.end()) != term->name())
+      in.fail("holds the state of force term '" + std::string(name.begin(), name.end()) +
+              "' where this run has '" + term->name() + "': restart with the case that wrote it");
+    term->read_state(in);
+  }
   forces_ = saved_forces;
   contact_count_ = saved_counts;
   step_ = step;

@@ -17,6 +17,9 @@
 
 namespace magbrush::dem {
 
+class CheckpointWriter;
+class CheckpointReader;
+
 class ForceTerm
 {
 public:
@@ -35,6 +38,13 @@ public:
   // Particle arrays were re-sorted (new[k] = old[order[k]]): terms that cache per-particle
   // data (e.g. dipole moments) reorder it here.
   virtual void particles_reordered(const std::vector<std::int32_t> & /*order*/) {}
+  // Checkpoint: a term whose forces depend on more than the particle state of this step
+  // (held forces between refreshes, a far field kept from the last solve, a random stream)
+  // writes that state here and reads it back, so that a restarted run continues bit for bit.
+  // The engine frames each term's block with its name (DemSystem::write_checkpoint); a term
+  // without such state writes nothing.
+  virtual void write_state(CheckpointWriter & /*out*/) const {}
+  virtual void read_state(CheckpointReader & /*in*/) {}
 };
 
 // A term that is a plain loop over the particles (gravity, drag): it runs inside the engine's

@@ -27,7 +27,9 @@ namespace magbrush::dem {
 class DemSystem;
 
 // The order in which the terms add their forces to a particle, the order of the papers' force
-// list (Kawamoto A1: gravity and drag, then the magnetic force of A8–A11). It is fixed here,
+// list (Kawamoto A1: gravity and drag, then the magnetic force of A8–A11; Kweon eq. 1–6 adds
+// the electric force qE of the nip field, Coulomb between the charges and the charges' images
+// in the drum and the sleeve). It is fixed here,
 // not left to the order of static initialisation, because floating-point sums depend on it: a
 // run must give the same bits whatever the link order. Terms that run inside the engine's
 // OpenMP team (ForceTerm::runs_in_team) must come before the others. A new term takes a slot
@@ -36,6 +38,9 @@ namespace force_term_order {
 constexpr int gravity = 10;
 constexpr int stokes_drag = 20;
 constexpr int magnetic_dipoles = 30;
+constexpr int electric_field = 40;   // qE in the stored nip field
+constexpr int coulomb = 50;          // charge–charge, with the periodic images of the slab
+constexpr int conductor_images = 60; // a charge's images in the drum (through its layer) and sleeve
 } // namespace force_term_order
 
 struct ForceTermFactory

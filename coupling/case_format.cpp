@@ -174,6 +174,9 @@ std::vector<ResolvedEntry> resolved_entries(const Case &c)
     e.q(at + ".mass", "populations[].mass", p.mass);
     e.q(at + ".concentration", "populations[].concentration", p.concentration);
     e.q(at + ".charge_to_mass", "populations[].charge_to_mass", p.charge_to_mass);
+    e.q(at + ".charge_to_mass_std", "populations[].charge_to_mass_std", p.charge_to_mass_std);
+    e.q(at + ".wrong_sign_fraction", "populations[].wrong_sign_fraction", p.wrong_sign_fraction);
+    e.b(at + ".counter_charge", "populations[].counter_charge", p.counter_charge);
     if (p.insert_box)
     {
       const auto &bx = *p.insert_box;
@@ -379,6 +382,19 @@ std::string format_derived(const Case &c)
     if (p.kind == ParticleKind::carrier)
       carrier_mass += mass;
   }
+  // The populations' masses, then their charges: a wrong-sign fraction f reverses the charge
+  // of that share, so the expected total is (1 − 2f) (q/m) m; counter-charged carriers carry
+  // minus the sum of all the others.
+  for (size_t i = 0; i < c.populations.size(); ++i)
+  {
+    const auto &p = c.populations[i];
+    if (p.concentration > 0.0)
+      count_mass[i].second = p.concentration * carrier_mass;
+  }
+  double charged_total = 0.0;
+  for (size_t i = 0; i < c.populations.size(); ++i)
+    charged_total += (1.0 - 2.0 * c.populations[i].wrong_sign_fraction) * c.populations[i].charge_to_mass *
+                     count_mass[i].second;
   for (size_t i = 0; i < c.populations.size(); ++i)
   {
     const auto &p = c.populations[i];
@@ -395,10 +411,12 @@ std::string format_derived(const Case &c)
     }
     out << "population " << p.name << ": " << fmt("%.0f", n) << " particles, "
         << format_quantity(mass, Dimension::mass);
+    const double charge = (1.0 - 2.0 * p.wrong_sign_fraction) * p.charge_to_mass * mass;
     if (p.charge_to_mass != 0.0)
-      out << ", total charge " << format_quantity(p.charge_to_mass * mass, Dimension::charge)
-          << ", mean particle charge "
-          << format_quantity(n > 0 ? p.charge_to_mass * mass / n : 0.0, Dimension::charge);
+      out << ", total charge " << format_quantity(charge, Dimension::charge) << ", mean particle charge "
+          << format_quantity(n > 0 ? charge / n : 0.0, Dimension::charge);
+    if (p.counter_charge)
+      out << ", counter-charge of all counter-charged carriers " << format_quantity(-charged_total, Dimension::charge);
     out << "\n";
   }
   if (c.dem.time_step > 0.0 && c.dem.duration > 0.0)

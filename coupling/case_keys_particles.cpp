@@ -40,8 +40,19 @@ std::vector<KeySpec> particle_keys()
       quantity("populations[].mass", D::mass, "Total mass of the population.").def("0 kg").non_negative(),
       number("populations[].concentration", "Toner only: toner mass / carrier mass (e.g. 7 %).")
           .def("0").non_negative().max(1.0, false),
-      quantity("populations[].charge_to_mass", D::charge_to_mass, "Charge-to-mass ratio q/m (toner: required).")
+      quantity("populations[].charge_to_mass", D::charge_to_mass,
+               "Mean charge-to-mass ratio q/m; each particle carries q = (q/m) m (toner: required).")
           .def("0 uC/g"),
+      quantity("populations[].charge_to_mass_std", D::charge_to_mass,
+               "Standard deviation of q/m between particles (normal, truncated so that it never flips the sign).")
+          .def("0 uC/g").non_negative(),
+      number("populations[].wrong_sign_fraction",
+             "Fraction of the particles whose charge has the opposite sign to q/m (wrong-sign toner).")
+          .def("0").min(0.0).max(1.0),
+      boolean("populations[].counter_charge",
+              "Carrier only: the carriers carry the opposite of the total charge of all other particles, "
+              "shared by surface area, so that the developer is neutral.")
+          .def("false"),
       Key("populations[].insert_box", KeyType::box, "Insertion box [[xmin, ymin, zmin], [xmax, ymax, zmax]].")
           .dim(D::length),
       quantity("populations[].layer_thickness", D::length, "Insert as a layer of this thickness on the sleeve.")

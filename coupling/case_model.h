@@ -113,7 +113,10 @@ struct Population
   long count = 0;                // number of particles (0 = derive from mass or concentration)
   double mass = 0.0;             // total mass [kg] (0 = unused)
   double concentration = 0.0;    // toner only: toner mass / carrier mass (0 = unused)
-  double charge_to_mass = 0.0;   // q/m [C/kg]
+  double charge_to_mass = 0.0;   // mean q/m [C/kg]
+  double charge_to_mass_std = 0.0; // spread of q/m between particles [C/kg]
+  double wrong_sign_fraction = 0.0; // share of particles charged against the sign of q/m
+  bool counter_charge = false;   // carrier: carries minus the charge of all other particles
   // Where they are inserted: a box (min, max corners) in the scene frame, or, when
   // layer_thickness > 0, a layer of this thickness on the sleeve surface.
   std::optional<std::array<Vec3, 2>> insert_box;

@@ -901,6 +901,9 @@ private:
     p.mass = q(s, "mass");
     p.concentration = q(s, "concentration");
     p.charge_to_mass = q(s, "charge_to_mass");
+    p.charge_to_mass_std = q(s, "charge_to_mass_std");
+    p.wrong_sign_fraction = q(s, "wrong_sign_fraction");
+    p.counter_charge = flag(s, "counter_charge");
     if (has(s, "insert_box"))
     {
       const auto &n = leaf(s, "insert_box").numbers;

@@ -246,6 +246,16 @@ void check_populations(const Case &c, std::vector<CaseIssue> &out)
       out.push_back({path + ".concentration", "a toner concentration needs a carrier population to be relative to"});
     if (p.kind == ParticleKind::toner && p.charge_to_mass == 0.0)
       out.push_back({path + ".charge_to_mass", "toner needs a charge-to-mass ratio q/m (e.g. -30 uC/g)"});
+    if (p.counter_charge && p.kind != ParticleKind::carrier)
+      out.push_back({path + ".counter_charge", "the counter-charge is the carriers' (toner is charged from its q/m)"});
+    if (p.counter_charge && (p.charge_to_mass != 0.0 || p.charge_to_mass_std > 0.0 || p.wrong_sign_fraction > 0.0))
+      out.push_back({path + ".counter_charge", "a counter-charged carrier takes its charge from the toner: "
+                                               "give either counter_charge or charge_to_mass (with its spread), not both"});
+    if (p.charge_to_mass == 0.0 && (p.charge_to_mass_std > 0.0 || p.wrong_sign_fraction > 0.0))
+      out.push_back({path + ".charge_to_mass", "a q/m spread or wrong-sign fraction needs a mean q/m"});
+    if (p.charge_to_mass_std > 0.0 && p.charge_to_mass_std > std::abs(p.charge_to_mass))
+      out.push_back({path + ".charge_to_mass_std", "the q/m spread exceeds the mean q/m; the truncated distribution "
+                                                   "would no longer have that mean (expected std <= |mean|)"});
     if (p.insert_box)
       for (int k = 0; k < 3; ++k)
         if ((*p.insert_box)[0][k] >= (*p.insert_box)[1][k])

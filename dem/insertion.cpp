@@ -1,6 +1,8 @@
 // Population sampling and random sequential insertion (see insertion.h).
 #include "dem/insertion.h"
 
+#include "dem/particle_charges.h"
+
 #include <algorithm>
 #include <functional>
 #include <cmath>
@@ -134,6 +136,7 @@ void insert_populations(const Case &c, const DemWalls &walls, const PeriodicBox 
     }
   }
   PlacementGrid grid(std::max(d_max, 1e-12), box);
+  std::mt19937_64 charge_rng = charge_random_stream(c);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   for (std::size_t s = 0; s < c.populations.size(); ++s)
   {
@@ -141,6 +144,7 @@ void insert_populations(const Case &c, const DemWalls &walls, const PeriodicBox 
     const Material &mat = c.material(p.material);
     auto &d = diameters[s];
     std::sort(d.begin(), d.end(), std::greater<double>()); // largest first: jams last
+    const std::vector<double> charge = draw_charges(p, d, mat.density, charge_rng);
     // The region's sampler, given the radius.
     std::function<Vector3(double)> sample;
     double region_volume = 0.0;
@@ -195,7 +199,7 @@ void insert_populations(const Case &c, const DemWalls &walls, const PeriodicBox 
         if (!clear)
           continue;
         grid.add(q, particles.size());
-        particles.add(q, r, mat.density, static_cast<int>(s), p.charge_to_mass * sphere_mass(d[k], mat.density));
+        particles.add(q, r, mat.density, static_cast<int>(s), charge[k]);
         placed = true;
       }
       if (!placed)
@@ -206,6 +210,7 @@ void insert_populations(const Case &c, const DemWalls &walls, const PeriodicBox 
             " %; random insertion jams near 30-40 %: enlarge the insertion region (or layer) or insert fewer particles");
     }
   }
+  assign_counter_charges(c, particles);
 }
 
 } // namespace magbrush::dem

@@ -106,6 +106,7 @@ void SnapshotWriter::write(const DemSystem &system)
     h5.dataset("angular_velocity", vec3(s.wx, s.wy, s.wz), n, 3);
     h5.dataset("force", vec3(f.fx, f.fy, f.fz), n, 3);
     h5.dataset("radius", scalar(s.radius), n, 1);
+    h5.dataset("charge", scalar(s.charge), n, 1);
     h5.dataset("species", scalar(s.species), n, 1);
     h5.dataset("id", scalar(s.id), n, 1);
     h5.dataset("contact_count", scalar(system.contact_count()), n, 1);
@@ -180,6 +181,7 @@ void SnapshotWriter::write_index() const
     attr("angular_velocity", "Vector", 3, "Float", 8);
     attr("force", "Vector", 3, "Float", 8);
     attr("radius", "Scalar", 1, "Float", 8);
+    attr("charge", "Scalar", 1, "Float", 8);
     attr("species", "Scalar", 1, "Int", 4);
     attr("id", "Scalar", 1, "Int", 4);
     attr("contact_count", "Scalar", 1, "Int", 4);

@@ -283,26 +283,8 @@ void write_profile_csv(const std::string &path, const Case &c, double r,
   write_text_atomically(path, out.str());
 }
 
-// Candidate locations of tools/plot_flux.py: next to this source file's repository, or
-// relative to the executable (build/bin → ../../tools).
-std::string find_plot_script()
-{
-  std::vector<fs::path> candidates;
-  if (const char *env = std::getenv("MAGBRUSH_TOOLS"))
-    candidates.push_back(fs::path(env) / "plot_flux.py");
-  candidates.push_back(fs::path(__FILE__).parent_path().parent_path() / "tools" / "plot_flux.py");
-  const fs::path exe = executable_dir();
-  candidates.push_back(exe / ".." / ".." / "tools" / "plot_flux.py");
-  candidates.push_back(exe / ".." / "tools" / "plot_flux.py");
-  candidates.push_back(exe / ".." / "share" / "magbrush" / "tools" / "plot_flux.py");
-  for (const auto &c : candidates)
-  {
-    std::error_code ec;
-    if (fs::is_regular_file(c, ec))
-      return fs::weakly_canonical(c, ec).string();
-  }
-  return "";
-}
+// tools/plot_flux.py (app/subcommand.h find_tool_script).
+std::string find_plot_script() { return find_tool_script("plot_flux.py"); }
 
 void plot(const std::string &residuals, const std::string &fitted, const std::string &png,
           const std::string &title, const std::string &label)

@@ -69,25 +69,8 @@ Exit status: 0 done, 1 missing outputs or a failed plot script, 2 bad usage.
   return spec;
 }
 
-// tools/report.py of the source tree this binary was built from (__FILE__ is the absolute
-// source path CMake compiled), or $MAGBRUSH_TOOLS/report.py, or next to the executable.
-std::string find_report_script()
-{
-  std::vector<fs::path> candidates;
-  if (const char *env = std::getenv("MAGBRUSH_TOOLS"))
-    candidates.push_back(fs::path(env) / "report.py");
-  candidates.push_back(fs::path(__FILE__).parent_path().parent_path() / "tools" / "report.py");
-  const fs::path exe = executable_dir();
-  candidates.push_back(exe / ".." / ".." / "tools" / "report.py");
-  candidates.push_back(exe / ".." / "share" / "magbrush" / "tools" / "report.py");
-  for (const auto &c : candidates)
-  {
-    std::error_code ec;
-    if (fs::is_regular_file(c, ec))
-      return fs::weakly_canonical(c, ec).string();
-  }
-  return "";
-}
+// tools/report.py (app/subcommand.h find_tool_script).
+std::string find_report_script() { return find_tool_script("report.py"); }
 
 // A number for the command line of the plot script, with all the digits it needs.
 std::string number(double value)

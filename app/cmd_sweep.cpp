@@ -1,26 +1,35 @@
 // `magbrush sweep CASE --vary key=v1,v2,... [--vary ...]`: the pipeline once per point of a
-// parameter sweep, each point in its own output folder, then the nip profiles of all points
-// side by side (Kawamoto Fig. 22–27: carrier diameter, supplied layer, development gap).
+// parameter sweep, each point in its own output folder, then every point's key numbers in one
+// table and plot: Kawamoto's nip studies (Fig. 22–27: carrier diameter, supplied layer,
+// development gap), Kweon's TMA against the bias and DMA against the blade gap.
 //
 //   points = the Cartesian product of the --vary lists → for each: its overrides (a carrier
 //   diameter also rescales the bead count so that the supplied volume — the layer — stays the
 //   same) → `magbrush run` with output.directory and field.output_dir inside the point's
-//   folder → gather nip_summary.csv and nip_profile.csv of every point into
-//   sweep_summary.csv / sweep_profiles.csv → tools/plot_sweep.py draws the comparison.
+//   folder, timed → gather every point's dem/summary.csv (whatever its measurements report,
+//   with standard errors and the steady-state verdict) into sweep_summary.csv
+//   (common/study_table.h), with a measured series compared when given, and the nip profiles
+//   into sweep_profiles.csv → tools/plot_sweep.py draws each key against the varied value
+//   (error bars, the physical bound, the measured points) and the profiles side by side.
 #include "app/run_pipeline.h"
 #include "app/subcommand.h"
 
 #include "coupling/case_parser.h"
+#include "coupling/case_schema.h"
+#include "coupling/units.h"
 #include "common/atomic_file.h"
 #include "common/child_process.h"
+#include "common/study_table.h"
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <map>
+#include <optional>
 #include <regex>
 #include <sstream>
 #include <stdexcept>
@@ -45,10 +54,15 @@ const cli::CommandSpec &sweep_command_line()
 for every combination of the --vary values, each point in
 <output.directory>/sweep_<NAME>/<point>/ (its own fields/, dem/, report/), then compares the
 nip profiles of all points:
-  sweep_summary.csv    one row per point: the varied values, the bead count, and the key
-                       numbers (slip at the gap centre, peak and centre normal pressure,
-                       tangential/normal, touching density, density x d^2, force per length)
-  sweep_profiles.csv   every point's profile along the nip (long format)
+  sweep_summary.csv    one row per point: the varied values (as given and in SI), the bead
+                       count, every key number the point's measurements report (dem/summary.csv:
+                       e.g. slip at the gap centre, normal force per length, TMA, DMA) with its
+                       standard error, steady_state (1: every tested mean drifts < 2 %), the
+                       run time of the point, and with --measured the measured value, the
+                       relative error and a within-tolerance flag
+  sweep_profiles.csv   every point's profile along the nip (long format), for nip scenes
+  sweep_<key>.png      each key with a standard error against the (first) varied value, with
+                       its physical bound (<key>_bound) and the measured points
   sweep_slip.png, sweep_pressure.png, sweep_density.png   (Kawamoto Fig. 17-19, 22-27)
 Values carry units as in the case file (--vary populations.carrier.diameter=42um,50um,60um).
 Varying a population's diameter also scales its count by (d0/d)^3 and its diameter_std by
@@ -62,7 +76,10 @@ The options of the stages (named in brackets) go to the stages that declare them
                  cli::set_option(),
                  {"--name", {}, "NAME", "the sweep's folder is sweep_NAME (default: the varied keys' names)"},
                  {"--no-keep-layer", {}, "", "do not rescale the count, diameter_std and time step with a diameter"},
-                 {"--skip", {}, "STAGE[,STAGE]", "stages not run at each point (default: mesh)"}};
+                 {"--skip", {}, "STAGE[,STAGE]", "stages not run at each point (default: mesh)"},
+                 {"--measured", {}, "FILE", "a measured series to compare: CSV with the varied key and a summary key "
+                                            "as columns (e.g. electric.bias,tma_kg_per_m2; values in SI or with units)"},
+                 {"--tolerance", {}, "FRACTION", "relative error counted as agreement with --measured (default 0.1)"}};
     const auto of_stages = stage_options();
     s.options.insert(s.options.end(), of_stages.begin(), of_stages.end());
     s.epilog = R"(Examples (Fig. 22-27):
@@ -128,28 +145,6 @@ const Population *population_of(const Case &c, const std::string &key, std::stri
   return nullptr;
 }
 
-std::map<std::string, std::string> read_summary(const fs::path &path)
-{
-  std::map<std::string, std::string> values;
-  std::ifstream in(path);
-  std::string line;
-  bool header = true;
-  while (std::getline(in, line))
-  {
-    if (line.empty() || line[0] == '#')
-      continue;
-    if (header)
-    {
-      header = false;
-      continue;
-    }
-    const auto cells = split(line, ',');
-    if (cells.size() >= 2)
-      values[cells[0]] = cells[1];
-  }
-  return values;
-}
-
 // "key=v1,v2,..." of one --vary.
 Vary parse_vary(const std::string &v)
 {
@@ -157,6 +152,105 @@ Vary parse_vary(const std::string &v)
   if (eq == std::string::npos || eq == 0 || eq + 1 >= v.size())
     throw cli::UsageError("--vary expects key=v1,v2,... (e.g. --vary drum.gap=0.3mm,0.4mm), found '" + v + "'");
   return {v.substr(0, eq), split(v.substr(eq + 1), ',')};
+}
+
+// The case key's declaration for an override path: "populations.carrier.diameter" is declared
+// as "populations[].diameter", "materials.toner.hamaker" as "materials.*.hamaker".
+const KeySpec *spec_of_path(const std::string &path)
+{
+  if (const KeySpec *s = find_key_spec(path))
+    return s;
+  const auto first = path.find('.'), second = path.find('.', first + 1);
+  if (first == std::string::npos || second == std::string::npos)
+    return nullptr;
+  for (const char *wild : {"[]", ".*"})
+  {
+    const std::string head = path.substr(0, first);
+    const std::string pattern = std::string(wild) == "[]" ? head + "[]" + path.substr(second)
+                                                          : head + ".*" + path.substr(second);
+    if (const KeySpec *s = find_key_spec(pattern))
+      return s;
+  }
+  return nullptr;
+}
+
+// A varied value in SI (NaN when it is not a number): "-500V" → −500, "0.4mm" → 4e-4.
+double si_value(const std::string &key, const std::string &text)
+{
+  const KeySpec *spec = spec_of_path(key);
+  try
+  {
+    return parse_quantity(text, spec ? spec->dimension : Dimension::dimensionless);
+  }
+  catch (const std::exception &)
+  {
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+}
+
+std::string si_header(const std::string &key)
+{
+  const KeySpec *spec = spec_of_path(key);
+  const std::string unit = spec ? si_unit(spec->dimension) : "";
+  return key + " [" + (unit.empty() ? "1" : unit) + "]";
+}
+
+// A measured series: CSV with the varied key (values in SI or with units) and a summary key.
+// Read before the sweep runs, so that a malformed file costs no run.
+struct MeasuredSeries
+{
+  std::string key;
+  std::vector<std::pair<double, double>> values; // (varied value in SI, measured value)
+};
+
+MeasuredSeries read_measured(const std::string &path, const std::string &varied_key)
+{
+  std::ifstream in(path);
+  if (!in)
+    throw std::runtime_error("--measured: cannot read '" + path + "'");
+  std::string line;
+  std::vector<std::string> header;
+  std::vector<std::pair<double, double>> values;
+  while (std::getline(in, line))
+  {
+    if (line.empty() || line[0] == '#')
+      continue;
+    const auto cells = split(line, ',');
+    if (header.empty())
+    {
+      header = cells;
+      if (header.size() != 2 || header[0] != varied_key)
+        throw std::runtime_error("--measured '" + path + "': expected the header '" + varied_key +
+                                 ",<summary key>' (e.g. " + varied_key + ",tma_kg_per_m2), found '" + line + "'");
+      continue;
+    }
+    if (cells.size() != 2)
+      throw std::runtime_error("--measured '" + path + "': expected two values per line, found '" + line + "'");
+    const double x = si_value(varied_key, cells[0]), y = si_value("", cells[1]);
+    if (std::isnan(x) || std::isnan(y))
+      throw std::runtime_error("--measured '" + path + "': cannot read the numbers of '" + line + "'");
+    values.emplace_back(x, y);
+  }
+  if (header.size() != 2)
+    throw std::runtime_error("--measured '" + path + "' holds no header line");
+  return {header[1], values};
+}
+
+// The measured value at each point (NaN where the series has none).
+MeasuredComparison compare_with(const MeasuredSeries &series, const std::vector<double> &point_x, double tolerance)
+{
+  MeasuredComparison m;
+  m.key = series.key;
+  m.tolerance = tolerance;
+  for (double x : point_x)
+  {
+    double y = std::numeric_limits<double>::quiet_NaN();
+    for (const auto &[mx, my] : series.values)
+      if (std::abs(mx - x) <= 1e-9 * std::max(std::abs(x), 1e-300))
+        y = my;
+    m.measured.push_back(y);
+  }
+  return m;
 }
 
 int sweep(const cli::ParsedArguments &args)
@@ -170,6 +264,15 @@ int sweep(const cli::ParsedArguments &args)
     vary.push_back(parse_vary(v));
   if (vary.empty())
     throw cli::UsageError("nothing to vary: give --vary key=v1,v2,...");
+  std::optional<MeasuredSeries> measured;
+  const double tolerance = std::atof(args.value("--tolerance", "0.1").c_str());
+  if (args.has("--measured") && vary.size() > 1)
+    throw cli::UsageError("--measured compares along one varied key; this sweep varies " + std::to_string(vary.size()));
+  if (!(tolerance > 0.0))
+    throw cli::UsageError("--tolerance expects a positive fraction (0.1 = 10 %), found '" +
+                          args.value("--tolerance", "") + "'");
+  if (args.has("--measured"))
+    measured = read_measured(args.value("--measured"), vary[0].key);
   const Case base = load_case(case_path, overrides);
   if (name.empty())
     for (const auto &v : vary)
@@ -192,13 +295,9 @@ int sweep(const cli::ParsedArguments &args)
   }
   std::cout << "magbrush sweep: " << points.size() << " points into " << sweep_dir.string() << "/\n";
 
-  std::ostringstream summary, profiles;
-  summary << "# magbrush sweep of " << case_path << "\npoint";
-  for (const auto &v : vary)
-    summary << "," << v.key;
-  summary << ",count,diameter_um,slip_at_gap_centre_m_s,relative_surface_speed_m_s,peak_normal_pressure_Pa,"
-             "normal_pressure_at_gap_centre_Pa,tangential_over_normal,density_at_gap_centre_per_mm2,"
-             "density_x_d2_at_gap_centre,normal_force_per_length_N_m,touching_beads,status\n";
+  std::vector<StudyPoint> table;
+  std::vector<double> first_x; // the first varied key's SI value per point (for --measured)
+  std::ostringstream profiles;
   profiles << "# magbrush sweep profiles of " << case_path << " (columns after 'point' as in nip_profile.csv)\n";
   bool profile_header = false;
   int failures = 0;
@@ -250,26 +349,38 @@ int sweep(const cli::ParsedArguments &args)
     }
     const auto stage_words = options_for_the_stages(args);
     run_args.insert(run_args.end(), stage_words.begin(), stage_words.end());
+    const auto started = std::chrono::steady_clock::now();
     const int rc = run_pipeline(run_args);
+    const double run_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     if (rc != 0)
       ++failures;
-    // Gather the point's key numbers and profile.
-    const auto s = read_summary(point_dir / "dem" / "nip_summary.csv");
-    auto get = [&](const char *key) { return s.count(key) ? s.at(key) : std::string("nan"); };
-    const double d = point_case.populations.empty() ? 0.0 : point_case.populations[0].diameter_mean;
-    const double density = std::atof(get("density_at_gap_centre").c_str());
-    summary << label;
+    // Gather the point's key numbers (whatever its measurements report) and profile.
+    StudyPoint row;
+    row.label = label;
     for (std::size_t k = 0; k < vary.size(); ++k)
-      summary << "," << vary[k].values[points[n][k]];
-    char row[512];
-    std::snprintf(row, sizeof row, ",%ld,%.4g,%s,%s,%s,%s,%s,%s,%.6g,%s,%s,%s\n",
-                  point_case.populations.empty() ? 0L : point_case.populations[0].count, d * 1e6,
-                  get("slip_at_gap_centre").c_str(), get("relative_surface_speed").c_str(),
-                  get("peak_normal_pressure").c_str(), get("normal_pressure_at_gap_centre").c_str(),
-                  get("tangential_over_normal").c_str(), get("density_at_gap_centre").c_str(),
-                  density * (d * 1e3) * (d * 1e3), get("normal_force_per_length").c_str(),
-                  get("touching_beads").c_str(), rc == 0 ? "ok" : "failed");
-    summary << row;
+      row.leading.push_back(vary[k].values[points[n][k]]);
+    char cell[64];
+    for (std::size_t k = 0; k < vary.size(); ++k)
+    {
+      const double x = si_value(vary[k].key, vary[k].values[points[n][k]]);
+      std::snprintf(cell, sizeof cell, "%.9g", x);
+      row.leading.push_back(cell);
+      if (k == 0)
+        first_x.push_back(x);
+    }
+    const double d = point_case.populations.empty() ? 0.0 : point_case.populations[0].diameter_mean;
+    row.leading.push_back(std::to_string(point_case.populations.empty() ? 0L : point_case.populations[0].count));
+    std::snprintf(cell, sizeof cell, "%.4g", d * 1e6);
+    row.leading.push_back(cell);
+    row.summary = read_summary_csv((point_dir / "dem" / "summary.csv").string());
+    // Kawamoto's contact density scales as 1/d²: density × d² is the size-free number (Fig. 24).
+    for (const auto &r : std::vector<SummaryRow>(row.summary))
+      if (r.key == "density_at_gap_centre_per_mm2")
+        row.summary.push_back({"density_x_d2_at_gap_centre", r.value * (d * 1e3) * (d * 1e3),
+                               std::numeric_limits<double>::quiet_NaN()});
+    std::snprintf(cell, sizeof cell, "%.1f", run_time);
+    row.trailing = {cell, rc == 0 ? "ok" : "failed"};
+    table.push_back(row);
     std::ifstream prof(point_dir / "dem" / "nip_profile.csv");
     std::string line;
     bool header = true;
@@ -288,29 +399,40 @@ int sweep(const cli::ParsedArguments &args)
       profiles << label << "," << line << "\n";
     }
   }
-  write_text_atomically((sweep_dir / "sweep_summary.csv").string(), summary.str());
+  std::vector<std::string> leading_header;
+  for (const auto &v : vary)
+    leading_header.push_back(v.key);
+  for (const auto &v : vary)
+    leading_header.push_back(si_header(v.key));
+  leading_header.push_back("count");
+  leading_header.push_back("diameter_um");
+  std::optional<MeasuredComparison> comparison;
+  if (measured)
+    comparison = compare_with(*measured, first_x, tolerance);
+  const std::string summary = study_table_csv("magbrush sweep of " + case_path, leading_header,
+                                              {"run_time_s", "status"}, table, comparison);
+  write_text_atomically((sweep_dir / "sweep_summary.csv").string(), summary);
   write_text_atomically((sweep_dir / "sweep_profiles.csv").string(), profiles.str());
-  std::cout << "\nmagbrush sweep: " << (sweep_dir / "sweep_summary.csv").string() << "\n" << summary.str();
+  std::cout << "\nmagbrush sweep: " << (sweep_dir / "sweep_summary.csv").string() << "\n" << summary;
 
-  // The comparison plots (tools/plot_sweep.py, next to the sources of this build).
-  const fs::path script = fs::path(__FILE__).parent_path().parent_path() / "tools" / "plot_sweep.py";
-  const char *env_tools = std::getenv("MAGBRUSH_TOOLS");
-  const fs::path chosen = env_tools ? fs::path(env_tools) / "plot_sweep.py" : script;
+  // The comparison plots (tools/plot_sweep.py).
+  const std::string chosen = find_tool_script("plot_sweep.py");
   const char *env_python = std::getenv("MAGBRUSH_PYTHON");
   const std::string python = env_python ? env_python : (fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3");
-  const std::vector<std::string> command = {python, chosen.string(), "--dir", sweep_dir.string()};
-  std::string failure;
+  const std::vector<std::string> command = {python, chosen, "--dir", sweep_dir.string()};
+  std::string failure = chosen.empty() ? "tools/plot_sweep.py not found; set MAGBRUSH_TOOLS to the tools folder" : "";
   try
   {
-    if (const int status = run_program(command); status != 0)
-      failure = "exit " + std::to_string(status);
+    if (!chosen.empty())
+      if (const int status = run_program(command); status != 0)
+        failure = "exit " + std::to_string(status);
   }
   catch (const ChildProcessError &e)
   {
     failure = e.what();
   }
   if (!failure.empty())
-    std::cerr << "magbrush sweep: the comparison plots failed (" << failure << ": " << python << " " << chosen.string()
+    std::cerr << "magbrush sweep: the comparison plots failed (" << failure << ": " << python << " " << chosen
               << " --dir " << sweep_dir.string() << "); the CSV files are written\n";
   if (failures > 0)
   {

@@ -1,6 +1,9 @@
 // magbrush — the user-facing driver. `magbrush <subcommand> --help` explains each step.
 #include "app/subcommand.h"
 
+#include <cstdlib>
+#include <filesystem>
+#include <vector>
 #include <algorithm>
 #include <climits>
 #include <cstdio>
@@ -44,6 +47,26 @@ std::string executable_dir()
     return ".";
   std::string path(buffer, static_cast<size_t>(n));
   return path.substr(0, path.find_last_of('/'));
+}
+
+std::string find_tool_script(const std::string &name)
+{
+  namespace fs = std::filesystem;
+  std::vector<fs::path> candidates;
+  if (const char *env = std::getenv("MAGBRUSH_TOOLS"))
+    candidates.push_back(fs::path(env) / name);
+  candidates.push_back(fs::path(MAGBRUSH_SOURCE_TOOLS_DIR) / name);
+  const fs::path exe = executable_dir();
+  candidates.push_back(exe / ".." / ".." / "tools" / name);
+  candidates.push_back(exe / ".." / "tools" / name);
+  candidates.push_back(exe / ".." / "share" / "magbrush" / "tools" / name);
+  for (const auto &c : candidates)
+  {
+    std::error_code ec;
+    if (fs::is_regular_file(c, ec))
+      return fs::weakly_canonical(c, ec).string();
+  }
+  return "";
 }
 
 } // namespace magbrush

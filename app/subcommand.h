@@ -34,4 +34,9 @@ const Subcommand *find_subcommand(const std::string &name);
 // Directory holding the magbrush executables (to find magbrush-field, magbrush-dem).
 std::string executable_dir();
 
+// The plotting script tools/<name> (report.py, plot_sweep.py, plot_flux.py): from
+// $MAGBRUSH_TOOLS, the tools/ folder of the source tree this binary was built from, or next to
+// the executable (build/bin → ../../tools, an install's share/magbrush/tools); "" if none.
+std::string find_tool_script(const std::string &name);
+
 } // namespace magbrush

@@ -264,6 +264,8 @@ std::vector<ResolvedEntry> resolved_entries(const Case &c)
   e.q("dem.settle_time", "dem.settle_time", d.settle_time);
   e.q("dem.max_kinetic_energy_growth", "dem.max_kinetic_energy_growth", d.max_kinetic_energy_growth);
 
+  e.q("statistics.steady_drift", "statistics.steady_drift", c.statistics.steady_drift);
+  e.i("statistics.blocks", "statistics.blocks", c.statistics.blocks);
   e.q("nip.average_from", "nip.average_from", c.nip.average_from);
   e.q("nip.sample_interval", "nip.sample_interval", c.nip.sample_interval);
   e.q("nip.bin_width", "nip.bin_width", c.nip.bin_width);

@@ -21,6 +21,15 @@ std::vector<KeySpec> measurement_keys()
       quantity("nip.chain_half_angle", D::angle, "The chain-inclination profile covers sleeve angles within this of the gap centre.")
           .def("30 deg").positive().max(180.0 * pi / 180.0),
 
+      section("statistics", "How a run's measured means are judged (every measurement's summary, dem/summary.csv): "
+                            "standard errors by block averaging, steady state by the drift between halves."),
+      number("statistics.steady_drift", "A mean counts as steady when the means of the two halves of its averaging "
+                                        "window differ by less than this fraction of it.")
+          .def("0.02").positive().max(1.0),
+      integer("statistics.blocks", "Contiguous blocks of the standard error by block averaging (each should be much "
+                                   "longer than the correlation time of the samples).")
+          .def("10").min(2),
+
       section("compression", "Kawamoto's compression test: the plate measurement of a box scene with a moving "
                              "plate and a stage (forces, touching beads, chain spacing, contact maps; docs/compression_study.md)."),
       text("compression.plate", "Name of the moving plane wall (the pseudo-photoreceptor plate).").def("plate"),

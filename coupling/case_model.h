@@ -247,6 +247,13 @@ struct CompressionSettings
   double map_interval = 0.0;        // time between per-bead contact maps [s] (0 = one at the end)
 };
 
+// How the measurements' summaries judge their means (dem/measurements/sample_series.h).
+struct StatisticsSettings
+{
+  double steady_drift = 0.02; // steady: halves of the averaging window within this fraction
+  int blocks = 10;            // blocks of the block-averaged standard error
+};
+
 struct OutputSettings
 {
   std::string directory = "results";
@@ -273,6 +280,7 @@ struct Case
   DemSettings dem;
   NipSettings nip;                    // added by the nip measurements
   CompressionSettings compression; // added by the compression study
+  StatisticsSettings statistics;   // standard errors and the steady-state test of every summary
   OutputSettings output;
   std::string measured_flux_file;     // optional gaussmeter scan to overlay in the report
   double measured_flux_angle_origin = 0.0; // [rad] roller angle = scan angle + this (the encoder offset)

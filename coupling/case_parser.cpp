@@ -771,6 +771,9 @@ private:
     build_dem(c.dem, top.child("dem"));
     build_nip(c.nip, top.child("nip"));
     build_compression(c.compression, top.child("compression"));
+    const Scope st = top.child("statistics");
+    c.statistics.steady_drift = q(st, "steady_drift");
+    c.statistics.blocks = static_cast<int>(integer(st, "blocks"));
     const Scope o = top.child("output");
     c.output.directory = str(o, "directory");
     c.output.vtu = flag(o, "vtu");

@@ -1,5 +1,7 @@
 // A whole DEM run with its outputs (see dem_run.h).
 #include "dem/dem_run.h"
+
+#include "dem/run_summary.h"
 #include "dem/openmp_waiting.h"
 
 #include <omp.h>
@@ -102,6 +104,7 @@ void DemRun::write_measurements() const
     m->write(out_dir_);
     log_ << "measurement '" << m->name() << "' written to " << out_dir_ << "\n";
   }
+  write_run_summary(out_dir_, measurements_, case_.statistics);
 }
 
 void DemRun::run()

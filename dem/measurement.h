@@ -8,11 +8,28 @@
 // they start accumulating afresh from the restart time (say so in their output).
 #pragma once
 
+#include <limits>
 #include <string>
+#include <vector>
 
 namespace magbrush::dem {
 
 class DemSystem;
+
+// One number of a measurement's summary: what a study tabulates and plots across its points
+// (`magbrush sweep` gathers them from every point's dem/summary.csv).
+struct SummaryValue
+{
+  std::string key;  // unique column name with its unit spelled in it: tma_kg_per_m2, slip_at_gap_centre_m_s
+  double value = std::numeric_limits<double>::quiet_NaN();
+  // Block-averaged standard error of the mean (NaN: not a sampled mean, or too few samples).
+  double standard_error = std::numeric_limits<double>::quiet_NaN();
+  // Relative drift between the halves of the averaging window (NaN: not tested for steady
+  // state). The run is steady when every tested drift is below statistics.steady_drift.
+  double drift = std::numeric_limits<double>::quiet_NaN();
+  std::string unit;    // for people: "kg/m^2"
+  std::string meaning; // one line
+};
 
 class Measurement
 {
@@ -26,6 +43,10 @@ public:
   // Writes the results into `directory` (the run's output folder) at the end of the run,
   // and when the run stops on a stability guard (what was gathered so far is kept).
   virtual void write(const std::string &directory) const = 0;
+  // The key numbers of the measurement (optional): means with standard errors and drifts, and
+  // the physical bounds they are to be judged against (a key ending in "_bound" bounds the key
+  // before it, e.g. tma_kg_per_m2 and tma_kg_per_m2_bound).
+  virtual std::vector<SummaryValue> summary() const { return {}; }
 };
 
 } // namespace magbrush::dem

@@ -1,10 +1,15 @@
 #!/usr/bin/env python3
-"""Comparison plots of a `magbrush sweep`: the nip profiles of every point side by side.
+"""Comparison plots of a `magbrush sweep`: each key number against the varied value, and the nip profiles of every point side by side.
 
-    plot_sweep.py --dir RESULTS/sweep_NAME
+    plot_sweep.py --dir RESULTS/sweep_NAME [--key KEY ...]
 
-Reads sweep_profiles.csv and sweep_summary.csv there and writes (atomically) sweep_slip.png,
-sweep_pressure.png, sweep_density.png (Kawamoto Fig. 17-19 and 22-27: one curve per point).
+Reads sweep_summary.csv there and writes (atomically) sweep_<key>.png for every key that has a
+standard error, a physical bound (<key>_bound) or a measured comparison (or the keys named with
+--key): the mean with its standard-error bars against the first varied value (in SI), the bound
+as a dashed line, the measured points with their relative error and the within-tolerance flag,
+the steady-state verdict and the run time of each point. For nip scenes it also reads
+sweep_profiles.csv and writes sweep_slip.png, sweep_pressure.png, sweep_density.png (Kawamoto
+Fig. 17-19 and 22-27: one curve per point).
 Exit status 3 when matplotlib is missing, 2 for unreadable inputs.
 """
 import argparse
@@ -25,9 +30,77 @@ def save(fig, path):
     os.replace(tmp, path)
 
 
+def number(text):
+    try:
+        return float(text)
+    except ValueError:
+        return float("nan")
+
+
+def plot_keys(plt, directory, header, rows, requested):
+    """One plot per key: mean ± standard error against the first varied value (SI)."""
+    col = {name: i for i, name in enumerate(header)}
+    x_columns = [h for h in header if " [" in h and h.endswith("]")]
+    if not x_columns or not rows:
+        return
+    x_name = x_columns[0]
+    xs = [number(r[col[x_name]]) for r in rows]
+    if any(x != x for x in xs):
+        return  # the varied value is not a number: no axis to plot against
+    keys = list(requested)
+    for h in header:
+        base = None
+        if h.endswith("_stderr"):
+            base = h[: -len("_stderr")]
+        elif h.endswith("_bound"):
+            base = h[: -len("_bound")]
+        elif h.startswith("measured_"):
+            base = h[len("measured_"):]
+        if base and base in col and base not in keys:
+            keys.append(base)
+    for key in keys:
+        if key not in col:
+            print(f"plot_sweep.py: no column '{key}' in the sweep summary", file=sys.stderr)
+            continue
+        ys = [number(r[col[key]]) for r in rows]
+        errors = [number(r[col[key + "_stderr"]]) if key + "_stderr" in col else 0.0 for r in rows]
+        errors = [0.0 if e != e else e for e in errors]
+        fig, ax = plt.subplots(figsize=(7, 4.2))
+        ax.errorbar(xs, ys, yerr=errors, fmt="o-", capsize=4, label="magbrush (± standard error)")
+        if key + "_bound" in col:
+            bound = [number(r[col[key + "_bound"]]) for r in rows]
+            ax.plot(xs, bound, "k--", lw=1.2, label="physical bound")
+        measured = "measured_" + key
+        if measured in col:
+            mys = [number(r[col[measured]]) for r in rows]
+            ax.plot(xs, mys, "s", mfc="none", mec="C3", ms=8, label="measured")
+            flag = [h for h in header if h.startswith("within_") and h.endswith("_" + key)]
+            errs = [number(r[col["relative_error_" + key]]) for r in rows]
+            for x, y, e, r in zip(xs, mys, errs, rows):
+                if e == e:
+                    ok = flag and r[col[flag[0]]] == "1"
+                    ax.annotate(f"{100 * e:+.1f} %" + (" ✓" if ok else " ✗"), (x, y), textcoords="offset points",
+                                xytext=(6, -12), fontsize=8, color="C2" if ok else "C3")
+        notes = []
+        for x, r in zip(xs, rows):
+            steady = r[col["steady_state"]] if "steady_state" in col else "nan"
+            run = r[col["run_time_s"]] if "run_time_s" in col else "?"
+            notes.append(f"{x:g}: {'steady' if steady == '1' else 'NOT steady' if steady == '0' else 'steady ?'}, {run} s")
+        ax.set_title("; ".join(notes), fontsize=7)
+        ax.set_xlabel(x_name)
+        ax.set_ylabel(key)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+        path = os.path.join(directory, f"sweep_{key}.png")
+        save(fig, path)
+        plt.close(fig)
+        print(f"  plot        {path}")
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--dir", required=True)
+    p.add_argument("--key", action="append", default=[], help="a summary key to plot (repeatable)")
     args = p.parse_args()
     try:
         import matplotlib
@@ -37,10 +110,15 @@ def main():
         print(f"plot_sweep.py: {e}", file=sys.stderr)
         return 3
     try:
-        header, rows = read(os.path.join(args.dir, "sweep_profiles.csv"))
+        summary_header, summary_rows = read(os.path.join(args.dir, "sweep_summary.csv"))
     except (OSError, IndexError) as e:
-        print(f"plot_sweep.py: cannot read the sweep profiles: {e}", file=sys.stderr)
+        print(f"plot_sweep.py: cannot read the sweep summary: {e}", file=sys.stderr)
         return 2
+    plot_keys(plt, args.dir, summary_header, summary_rows, args.key)
+    try:
+        header, rows = read(os.path.join(args.dir, "sweep_profiles.csv"))
+    except (OSError, IndexError):
+        return 0  # not a nip scene: no profiles to compare
     col = {name: i for i, name in enumerate(header)}
     points = []
     for r in rows:

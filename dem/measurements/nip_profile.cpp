@@ -79,7 +79,7 @@ DrumContactInFrame resolve_drum_contact(const NipFrame &f, const DrumContact &c)
   return out;
 }
 
-NipProfile::NipProfile(const Case &c) : settings_(c.nip), frame_(NipFrame::from_case(c))
+NipProfile::NipProfile(const Case &c) : settings_(c.nip), statistics_(c.statistics), frame_(NipFrame::from_case(c))
 {
   if (settings_.bin_width <= 0.0 || settings_.half_width < 0.5 * settings_.bin_width)
     throw std::invalid_argument("nip profile: nip.half_width (" + std::to_string(settings_.half_width) +
@@ -137,6 +137,8 @@ void NipProfile::add_sample(double time, const std::vector<DrumContact> &contact
     t_first_ = time;
   t_last_ = time;
   ++samples_;
+  double fn = 0.0, ft = 0.0, centre_slip = 0.0;
+  long touching = 0, centre = 0;
   for (const auto &c : contacts)
   {
     const DrumContactInFrame r = resolve_drum_contact(frame_, c);
@@ -149,7 +151,17 @@ void NipProfile::add_sample(double time, const std::vector<DrumContact> &contact
     slip_[k] += r.slip;
     slip2_[k] += r.slip * r.slip;
     ++count_[k];
+    fn += r.normal;
+    ft += r.tangential;
+    ++touching;
+    if (b == bins_half_)
+      centre_slip += r.slip, ++centre;
   }
+  normal_force_.add(fn / frame_.slab_depth);
+  tangential_force_.add(ft / frame_.slab_depth);
+  touching_.add(static_cast<double>(touching));
+  if (centre > 0) // a sample without a bead in the centre bin says nothing about its slip
+    centre_slip_.add(centre_slip / static_cast<double>(centre));
 }
 
 std::vector<NipBin> NipProfile::bins() const
@@ -281,6 +293,36 @@ std::string NipProfile::summary_csv() const
   row("gap_centre_field", gap_field_, "T", "|B| of the applied field at the gap centre");
   row("magnetic_pressure", gap_field_ * gap_field_ / (2.0 * mu0), "Pa", "B^2/2mu0 at the gap centre");
   return o.str();
+}
+
+std::vector<SummaryValue> NipProfile::summary() const
+{
+  const auto blocks = static_cast<std::size_t>(statistics_.blocks);
+  auto sampled = [&](const char *key, const SampleSeries &s, const char *unit, const char *meaning) {
+    return SummaryValue{key, s.mean(), s.standard_error(blocks), s.drift(), unit, meaning};
+  };
+  auto plain = [](const char *key, double value, const char *unit, const char *meaning) {
+    SummaryValue v;
+    v.key = key, v.value = value, v.unit = unit, v.meaning = meaning;
+    return v;
+  };
+  const auto all = bins();
+  const NipBin &centre = all[static_cast<std::size_t>(bins_half_)];
+  SummaryValue slip = sampled("slip_at_gap_centre_m_s", centre_slip_, "m/s",
+                              "slip of the beads touching the drum in the centre bin (mean of sample means)");
+  slip.drift = std::numeric_limits<double>::quiet_NaN(); // a slip near 0 makes a relative drift meaningless
+  return {
+      slip,
+      plain("relative_surface_speed_m_s", frame_.relative_surface_speed(), "m/s", "sleeve minus drum surface speed"),
+      plain("peak_normal_pressure_Pa", peak_normal_pressure(), "Pa", "largest bin normal pressure"),
+      plain("normal_pressure_at_gap_centre_Pa", centre.normal_pressure, "Pa", "normal pressure of the centre bin"),
+      plain("tangential_over_normal", tangential_over_normal(), "1", "sum of tangential over sum of normal drum forces"),
+      plain("density_at_gap_centre_per_mm2", centre.density * 1e-6, "1/mm^2", "touching beads per drum area, centre bin"),
+      sampled("normal_force_per_length_N_m", normal_force_, "N/m", "normal force on the drum per slab depth"),
+      sampled("tangential_force_per_length_N_m", tangential_force_, "N/m", "tangential force on the drum per slab depth"),
+      sampled("touching_beads", touching_, "1", "beads touching the drum within the profile"),
+      plain("magnetic_pressure_Pa", gap_field_ * gap_field_ / (2.0 * mu0), "Pa", "B^2/2mu0 at the gap centre"),
+  };
 }
 
 void NipProfile::write(const std::string &directory) const

@@ -22,6 +22,7 @@
 
 #include "dem/dem_system.h"
 #include "dem/measurement.h"
+#include "dem/measurements/sample_series.h"
 #include "dem/measurements/nip_frame.h"
 #include "dem/vector3.h"
 
@@ -90,9 +91,13 @@ public:
 
   std::string csv() const;
   std::string summary_csv() const;
+  // The key numbers for studies: the forces on the drum, the touching beads and the slip at
+  // the gap centre with block-averaged standard errors and their drift (steady state).
+  std::vector<SummaryValue> summary() const override;
 
 private:
   NipSettings settings_;
+  StatisticsSettings statistics_;
   NipFrame frame_;
   std::size_t drum_wall_ = 0;
   int bins_half_ = 0;                 // bins k = −bins_half_ … +bins_half_
@@ -100,6 +105,8 @@ private:
   std::vector<long> count_;
   long samples_ = 0;
   double t_first_ = -1.0, t_last_ = -1.0;
+  // Per-sample totals over the profile (for standard errors and the steady-state test).
+  SampleSeries normal_force_, tangential_force_, touching_, centre_slip_;
   double gap_field_;
   std::vector<WallContactRecord> records_; // reused between samples
   std::vector<DrumContact> contacts_;

@@ -8,6 +8,7 @@
 #include "dem/measurements/nip_time_series.h"
 
 #include "dem/dem_system.h"
+#include "dem/run_summary.h"
 
 #include "coupling/case_parser.h"
 
@@ -325,4 +326,56 @@ TEST(NipCaseKeys, DefaultsEqualTheContractStruct)
                            {"nip.average_from=1ms", "nip.bin_width=0.1mm"});
   EXPECT_NEAR(o.nip.average_from, 1e-3, 1e-18);
   EXPECT_NEAR(o.nip.bin_width, 1e-4, 1e-18);
+}
+
+// The study summary (dem/summary.csv via dem/run_summary.h): per-sample totals give the means
+// with their standard error, and the drift between halves decides the steady state.
+TEST(NipProfile, SummaryJudgesSteadyStateByTheDriftOfItsMeans)
+{
+  const Case c = nip_case(0.0);
+  const double r = 30e-6, overlap = 0.2e-6;
+  auto bead_pressing = [&](const NipProfile &p, double newtons) {
+    DrumContact b;
+    b.position = on_drum(p.frame(), 0.0, r - overlap);
+    b.radius = r;
+    b.force_on_wall = {newtons * p.frame().nx, newtons * p.frame().ny, 0.0};
+    return b;
+  };
+  auto value = [](const std::vector<SummaryValue> &s, const std::string &key) {
+    for (const auto &v : s)
+      if (v.key == key)
+        return v;
+    ADD_FAILURE() << "no " << key;
+    return SummaryValue{};
+  };
+  // Steady: the same 1 mN bead every sample, alternating with a second one of 1 mN.
+  NipProfile steady(c);
+  for (int k = 0; k < 100; ++k)
+  {
+    std::vector<DrumContact> beads = {bead_pressing(steady, 1e-3)};
+    if (k % 2)
+      beads.push_back(bead_pressing(steady, 1e-3));
+    steady.add_sample(k * 1e-6, beads);
+  }
+  const SummaryValue fn = value(steady.summary(), "normal_force_per_length_N_m");
+  const double Lz = c.dem.periodic_length;
+  EXPECT_NEAR(fn.value, 1.5e-3 / Lz, 1e-12);
+  EXPECT_NEAR(fn.drift, 0.0, 1e-12);
+  // Ten blocks of ten samples, each with five 1-bead and five 2-bead samples: no spread.
+  EXPECT_NEAR(fn.standard_error, 0.0, 1e-12);
+  std::vector<std::unique_ptr<Measurement>> m;
+  m.push_back(std::make_unique<NipProfile>(steady));
+  EXPECT_NE(run_summary_csv(m, c.statistics).find("steady_state,1,"), std::string::npos);
+
+  // Draining: the force falls linearly from 2 mN to 1 mN over the window; drift between the
+  // halves = 0.5 / 1.5 = 33 %, far beyond 2 %: not a steady state.
+  NipProfile draining(c);
+  for (int k = 0; k < 100; ++k)
+    draining.add_sample(k * 1e-6, {bead_pressing(draining, 2e-3 - 1e-3 * k / 100.0)});
+  const SummaryValue d = value(draining.summary(), "normal_force_per_length_N_m");
+  EXPECT_NEAR(d.drift, (0.5e-3) / (1.505e-3), 1e-9);
+  EXPECT_GT(d.standard_error, 0.0);
+  m.clear();
+  m.push_back(std::make_unique<NipProfile>(draining));
+  EXPECT_NE(run_summary_csv(m, c.statistics).find("steady_state,0,"), std::string::npos);
 }

@@ -1,0 +1,43 @@
+// One observable sampled during a run (the normal force on the drum per length, the toner
+// mass developed per area, ...), and the two statements a study makes about it:
+//
+//  * its mean with a STANDARD ERROR. Successive samples of a DEM run are correlated (a chain
+//    of beads takes many samples to pass the nip), so the naive σ/√n underestimates the error,
+//    by √((1+ρ)/(1−ρ)) for an AR(1) series with lag-one correlation ρ (≈ 4.4× for ρ = 0.9).
+//    Block averaging (Flyvbjerg & Petersen 1989) cuts the series into B contiguous blocks
+//    much longer than the correlation time; the block means are then nearly independent and
+//    their spread / √B estimates the standard error of the mean.
+//  * whether it is at a STEADY STATE: the relative drift between the means of the first and
+//    the second half of the averaging window, |m₂ − m₁| / |m|, below a tolerance (2 % by
+//    default, `measurements.steady_drift`). A series still rising or draining fails it; a
+//    stationary one passes once its halves' noise is below the tolerance.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+namespace magbrush::dem {
+
+class SampleSeries
+{
+public:
+  void add(double value) { values_.push_back(value); }
+  void clear() { values_.clear(); }
+  std::size_t size() const { return values_.size(); }
+  const std::vector<double> &values() const { return values_; }
+
+  double mean() const; // NaN when empty
+  // Standard error of the mean by block averaging over `blocks` contiguous blocks of equal
+  // length (the oldest samples that do not fill a block are left out). NaN with fewer than
+  // two samples per block.
+  double standard_error(std::size_t blocks = default_blocks) const;
+  // |mean(second half) − mean(first half)| / |mean| (NaN with fewer than 4 samples or a zero mean).
+  double drift() const;
+
+  static constexpr std::size_t default_blocks = 10;
+
+private:
+  std::vector<double> values_;
+};
+
+} // namespace magbrush::dem

@@ -1,0 +1,116 @@
+// `magbrush sweep` end to end on a small box scene (two points, DEM only): the summary table
+// has the varied value as given and in SI, the steady-state verdict, the run time and status of
+// each point; a measured series is compared point by point; a malformed one is refused.
+#include "common/child_process.h"
+#include "common/study_table.h"
+
+#include "tests/test_temp_dir.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const char *box_case = R"(name: sweep_box
+scene: box
+planes:
+  - {name: stage, point: [0 mm, 0 mm, 0 mm], normal: [0, 0, 1], material: wall}
+materials:
+  carrier: {youngs_modulus: 100 MPa, poisson_ratio: 0.35, density: 2200 kg/m^3, friction: 0.45, damping: 0.6}
+  wall: {youngs_modulus: 5e4 MPa, poisson_ratio: 0.3, friction: 0.35}
+populations:
+  - {name: carrier, kind: carrier, material: carrier, diameter: 100 um, count: 100, insert_box: [[0 mm, 0 mm, 0.05 mm], [1 mm, 1 mm, 1 mm]]}
+dem: {duration: 20 us, output_interval: 10 us, periodic_length_x: 1 mm, periodic_length_y: 1 mm, gravity: [0, 0, -9.81 m/s^2]}
+)";
+
+struct Result
+{
+  int status;
+  std::string output;
+};
+
+Result magbrush_run(const fs::path &dir, const std::vector<std::string> &args)
+{
+  std::vector<std::string> command = {std::string(MAGBRUSH_BINARY_DIR) + "/bin/magbrush"};
+  command.insert(command.end(), args.begin(), args.end());
+  magbrush::ChildOutput output;
+  output.stdout_path = (dir / "log.txt").string();
+  output.stderr_to_stdout = true;
+  Result r{magbrush::run_program(command, output), {}};
+  std::ifstream in(dir / "log.txt");
+  std::ostringstream text;
+  text << in.rdbuf();
+  r.output = text.str();
+  return r;
+}
+
+std::vector<std::vector<std::string>> rows_of(const fs::path &csv)
+{
+  std::vector<std::vector<std::string>> rows;
+  std::ifstream in(csv);
+  std::string line;
+  while (std::getline(in, line))
+  {
+    if (line.empty() || line[0] == '#')
+      continue;
+    std::vector<std::string> cells;
+    std::stringstream l(line);
+    for (std::string c; std::getline(l, c, ',');)
+      cells.push_back(c);
+    rows.push_back(cells);
+  }
+  return rows;
+}
+
+} // namespace
+
+TEST(Sweep, TabulatesEveryPointWithItsSIValueRunTimeAndMeasuredComparison)
+{
+  const fs::path dir = magbrush::testing::test_temp_dir("app_sweep");
+  std::ofstream(dir / "box.yaml") << box_case;
+  // The box scene has no measurement with a summary; its steady-state verdict is "nan" (nothing
+  // tested), which the comparison must carry through as "no verdict".
+  std::ofstream(dir / "measured.csv") << "# a measured series\npopulations.carrier.diameter,steady_state\n100um,1\n";
+  const Result r = magbrush_run(dir, {"sweep", (dir / "box.yaml").string(), "--vary",
+                                      "populations.carrier.diameter=100um,120um", "--skip", "mesh,field,report",
+                                      "--set", "output.directory=" + (dir / "out").string(), "--measured",
+                                      (dir / "measured.csv").string()});
+  ASSERT_EQ(r.status, 0) << r.output;
+  const auto rows = rows_of(dir / "out" / "sweep_diameter" / "sweep_summary.csv");
+  ASSERT_EQ(rows.size(), 3u) << r.output;
+  const auto &h = rows[0];
+  auto column = [&](const std::string &name) {
+    for (std::size_t k = 0; k < h.size(); ++k)
+      if (h[k] == name)
+        return k;
+    ADD_FAILURE() << "no column " << name;
+    return std::size_t(0);
+  };
+  EXPECT_EQ(rows[1][column("populations.carrier.diameter")], "100um");
+  EXPECT_DOUBLE_EQ(std::stod(rows[1][column("populations.carrier.diameter [m]")]), 100e-6);
+  EXPECT_DOUBLE_EQ(std::stod(rows[2][column("populations.carrier.diameter [m]")]), 120e-6);
+  // Keeping the layer: 100 × (100/120)³ = 57.87 → 58 beads at 120 µm.
+  EXPECT_EQ(rows[2][column("count")], "58");
+  EXPECT_EQ(rows[1][column("steady_state")], "nan");
+  EXPECT_EQ(rows[1][column("measured_steady_state")], "1");
+  EXPECT_EQ(rows[2][column("measured_steady_state")], "nan"); // no measured value at 120 µm
+  EXPECT_EQ(rows[1][column("within_10_percent_steady_state")], "nan");
+  EXPECT_GE(std::stod(rows[1][column("run_time_s")]), 0.0);
+  EXPECT_EQ(rows[1][column("status")], "ok");
+
+  // A measured file whose header does not name the varied key is refused, saying what it expects.
+  std::ofstream(dir / "bad.csv") << "bias,tma_kg_per_m2\n-500V,0.004\n";
+  const Result bad = magbrush_run(dir, {"sweep", (dir / "box.yaml").string(), "--vary",
+                                        "populations.carrier.diameter=100um", "--skip", "mesh,field,report", "--set",
+                                        "output.directory=" + (dir / "out2").string(), "--measured",
+                                        (dir / "bad.csv").string()});
+  EXPECT_NE(bad.status, 0);
+  EXPECT_NE(bad.output.find("expected the header 'populations.carrier.diameter,<summary key>'"), std::string::npos)
+    << bad.output;
+  fs::remove_all(dir);
+}

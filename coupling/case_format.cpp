@@ -264,6 +264,10 @@ std::vector<ResolvedEntry> resolved_entries(const Case &c)
   e.q("dem.settle_time", "dem.settle_time", d.settle_time);
   e.q("dem.max_kinetic_energy_growth", "dem.max_kinetic_energy_growth", d.max_kinetic_energy_growth);
 
+  e.q("development.measure_from", "development.measure_from", c.development.measure_from);
+  e.q("development.measure_to", "development.measure_to", c.development.measure_to);
+  e.q("development.sample_interval", "development.sample_interval", c.development.sample_interval);
+  e.q("development.average_from", "development.average_from", c.development.average_from);
   e.q("statistics.steady_drift", "statistics.steady_drift", c.statistics.steady_drift);
   e.i("statistics.blocks", "statistics.blocks", c.statistics.blocks);
   e.q("nip.average_from", "nip.average_from", c.nip.average_from);

@@ -21,6 +21,18 @@ std::vector<KeySpec> measurement_keys()
       quantity("nip.chain_half_angle", D::angle, "The chain-inclination profile covers sleeve angles within this of the gap centre.")
           .def("30 deg").positive().max(180.0 * pi / 180.0),
 
+      section("development", "Toner development onto the drum (a nip scene with a nip field and toner): toner mass "
+                             "per area on the image and the background after the nip, developed q/m, "
+                             "neutralisation of the latent image, where toner transfers (docs/development.md)."),
+      quantity("development.measure_from", D::length, "The measuring window starts at this nip coordinate x "
+                                                      "(downstream of the gap centre, past the brush).")
+          .def("1 mm"),
+      quantity("development.measure_to", D::length, "The measuring window ends at this nip coordinate x.").def("4 mm"),
+      quantity("development.sample_interval", D::time, "Time between samples of the toner on the drum.")
+          .def("2 us").positive(),
+      quantity("development.average_from", D::time, "Sample from this time on (after the transient).")
+          .def("0 s").non_negative(),
+
       section("statistics", "How a run's measured means are judged (every measurement's summary, dem/summary.csv): "
                             "standard errors by block averaging, steady state by the drift between halves."),
       number("statistics.steady_drift", "A mean counts as steady when the means of the two halves of its averaging "

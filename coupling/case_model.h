@@ -247,6 +247,16 @@ struct CompressionSettings
   double map_interval = 0.0;        // time between per-bead contact maps [s] (0 = one at the end)
 };
 
+// Toner development onto the drum (dem/measurements/toner_development.h): the measuring window
+// downstream of the nip, in nip coordinate x (see NipSettings).
+struct DevelopmentSettings
+{
+  double measure_from = 1e-3;     // [m]
+  double measure_to = 4e-3;       // [m]
+  double sample_interval = 2e-6;  // [s]
+  double average_from = 0.0;      // [s]
+};
+
 // How the measurements' summaries judge their means (dem/measurements/sample_series.h).
 struct StatisticsSettings
 {
@@ -281,6 +291,7 @@ struct Case
   NipSettings nip;                    // added by the nip measurements
   CompressionSettings compression; // added by the compression study
   StatisticsSettings statistics;   // standard errors and the steady-state test of every summary
+  DevelopmentSettings development; // the toner-development measurement
   OutputSettings output;
   std::string measured_flux_file;     // optional gaussmeter scan to overlay in the report
   double measured_flux_angle_origin = 0.0; // [rad] roller angle = scan angle + this (the encoder offset)

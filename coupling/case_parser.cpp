@@ -771,6 +771,11 @@ private:
     build_dem(c.dem, top.child("dem"));
     build_nip(c.nip, top.child("nip"));
     build_compression(c.compression, top.child("compression"));
+    const Scope dv = top.child("development");
+    c.development.measure_from = q(dv, "measure_from");
+    c.development.measure_to = q(dv, "measure_to");
+    c.development.sample_interval = q(dv, "sample_interval");
+    c.development.average_from = q(dv, "average_from");
     const Scope st = top.child("statistics");
     c.statistics.steady_drift = q(st, "steady_drift");
     c.statistics.blocks = static_cast<int>(integer(st, "blocks"));

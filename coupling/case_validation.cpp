@@ -331,6 +331,14 @@ void check_dem(const Case &c, std::vector<CaseIssue> &out)
                                               " is shorter than the time step " + T(d.time_step)});
 }
 
+void check_measurements(const Case &c, std::vector<CaseIssue> &out)
+{
+  const auto L = [](double x) { return format_quantity(x, Dimension::length); };
+  if (c.development.measure_to <= c.development.measure_from)
+    out.push_back({"development.measure_to", "the measuring window ends at " + L(c.development.measure_to) +
+                                                 ", not downstream of its start " + L(c.development.measure_from)});
+}
+
 } // namespace
 
 double polygon_signed_area(const std::vector<Vec2> &p)
@@ -397,6 +405,7 @@ std::vector<CaseIssue> validate_case(const Case &c)
   check_populations(c, out);
   check_fields(c, out);
   check_dem(c, out);
+  check_measurements(c, out);
   return out;
 }
 

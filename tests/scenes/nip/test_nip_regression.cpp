@@ -93,6 +93,29 @@ void pipeline_runs_to_the_report(const ReducedNipRun &run)
                         "chain_inclination.png", "flux_profile.png", "time_series.png"})
     EXPECT_TRUE(fs::exists(run.dir / "results" / "report" / f)) << f;
   EXPECT_TRUE(fs::exists(run.dir / "results" / "run_times.csv"));
+  // The study summary (dem/summary.csv) carries the nip's numbers with standard errors and the
+  // steady-state verdict; its slip is the profile's.
+  std::ifstream in(run.dem() / "summary.csv");
+  std::map<std::string, std::vector<std::string>> rows;
+  for (std::string line; std::getline(in, line);)
+  {
+    std::vector<std::string> cells;
+    std::stringstream l(line);
+    for (std::string c; std::getline(l, c, ',');)
+      cells.push_back(c);
+    if (cells.size() >= 4 && line[0] != '#')
+      rows[cells[0]] = cells;
+  }
+  ASSERT_TRUE(rows.count("slip_at_gap_centre_m_s") && rows.count("normal_force_per_length_N_m") &&
+              rows.count("steady_state"));
+  const auto nip = read_summary(run.dem() / "nip_summary.csv");
+  EXPECT_NEAR(std::stod(rows["slip_at_gap_centre_m_s"][1]), nip.at("slip_at_gap_centre"),
+              1e-5 * std::abs(nip.at("slip_at_gap_centre")));
+  const double fn = std::stod(rows["normal_force_per_length_N_m"][1]), fn_error = std::stod(rows["normal_force_per_length_N_m"][2]);
+  EXPECT_NEAR(fn, nip.at("normal_force_per_length"), 1e-5 * fn);
+  EXPECT_GT(fn_error, 0.0);
+  EXPECT_LT(fn_error, 0.5 * fn);
+  EXPECT_TRUE(rows["steady_state"][1] == "0" || rows["steady_state"][1] == "1") << rows["steady_state"][1];
 }
 
 void slip_at_the_gap_centre_equals_the_relative_surface_speed(const ReducedNipRun &run)

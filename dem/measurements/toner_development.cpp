@@ -1,0 +1,289 @@
+// Toner development onto the drum (see toner_development.h).
+#include "dem/measurements/toner_development.h"
+
+#include "dem/dem_system.h"
+#include "dem/measurements/measurement_registry.h"
+#include "dem/snapshot_writer.h" // write_file_atomically
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+namespace magbrush::dem {
+
+namespace {
+constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+constexpr double epsilon0 = 8.8541878128e-12; // [F/m]
+
+double wrapped(double a) { return std::remainder(a, 2.0 * M_PI); } // into [−π, π]
+
+// Cumulative exposed share of the strip pattern at u = s/period + duty/2 (per period).
+double exposed_cumulative(double u, double duty)
+{
+  const double whole = std::floor(u);
+  return whole * duty + std::min(u - whole, duty);
+}
+
+// The development contrast ΔV = |V_bias − V_exposed| of the case's latent image.
+double contrast_of(const Case &c)
+{
+  const LatentImage &im = c.electric.image;
+  double exposed = 0.0;
+  if (im.kind == LatentImage::Kind::surface_potential)
+    exposed = im.light_value;
+  else if (im.kind == LatentImage::Kind::surface_charge && c.drum.pc_eps_r > 0.0)
+    exposed = im.light_value * c.drum.pc_thickness / (epsilon0 * c.drum.pc_eps_r);
+  return std::abs(c.electric.bias - exposed);
+}
+} // namespace
+
+// ---------------------------------------------------------------------------------------
+DrumImage::DrumImage(const LatentImage &image, const NipFrame &frame)
+  : period_(image.period), duty_(image.duty), frame_(frame),
+    nip_angle_(std::atan2(frame.sy - frame.cy, frame.sx - frame.cx))
+{
+}
+
+double DrumImage::drum_arc(double px, double py, double t) const
+{
+  const double s_lab = frame_.drum_radius * wrapped(std::atan2(py - frame_.cy, px - frame_.cx) - nip_angle_);
+  return s_lab - frame_.drum_omega * frame_.drum_radius * t;
+}
+
+bool DrumImage::exposed(double s) const
+{
+  if (period_ <= 0.0)
+    return false; // no period: uniformly dark, as in the field stage
+  const double u = s / period_ + 0.5 * duty_;
+  return u - std::floor(u) < duty_;
+}
+
+double DrumImage::exposed_length(double a, double b) const
+{
+  if (period_ <= 0.0)
+    return 0.0;
+  return period_ * (exposed_cumulative(b / period_ + 0.5 * duty_, duty_) -
+                    exposed_cumulative(a / period_ + 0.5 * duty_, duty_));
+}
+
+// ---------------------------------------------------------------------------------------
+bool TonerDevelopment::applies(const Case &c)
+{
+  if (!NipFrame::applies(c) || !c.electric.enabled)
+    return false;
+  return std::any_of(c.populations.begin(), c.populations.end(),
+                     [](const Population &p) { return p.kind == ParticleKind::toner; });
+}
+
+TonerDevelopment::TonerDevelopment(const Case &c)
+  : settings_(c.development), statistics_(c.statistics), frame_(NipFrame::from_case(c)),
+    image_(c.electric.image, frame_)
+{
+  if (!(settings_.measure_to > settings_.measure_from))
+    throw std::invalid_argument("toner development: development.measure_to must lie downstream of "
+                                "development.measure_from");
+  if (c.drum.pc_thickness > 0.0)
+    eps_layer_over_l_ = epsilon0 * c.drum.pc_eps_r / c.drum.pc_thickness;
+  contrast_ = contrast_of(c);
+  for (const auto &p : c.populations)
+  {
+    is_toner_.push_back(p.kind == ParticleKind::toner);
+    if (p.kind == ParticleKind::toner && toner_q_over_m_ == 0.0)
+      toner_q_over_m_ = p.charge_to_mass;
+  }
+  bin_width_ = c.nip.bin_width;
+  bins_half_ = static_cast<int>(std::lround(c.nip.half_width / c.nip.bin_width));
+  arrived_.assign(static_cast<std::size_t>(2 * bins_half_ + 1), 0.0);
+  left_ = arrived_;
+}
+
+double TonerDevelopment::tma_bound() const
+{
+  return toner_q_over_m_ != 0.0 ? eps_layer_over_l_ * contrast_ / std::abs(toner_q_over_m_) : nan;
+}
+
+void TonerDevelopment::sample(const DemSystem &system)
+{
+  if (system.time() < settings_.average_from)
+    return;
+  std::size_t drum = system.walls().size();
+  for (std::size_t w = 0; w < system.walls().size(); ++w)
+    if (system.walls().name(w) == "drum")
+      drum = w;
+  if (drum == system.walls().size())
+    throw std::runtime_error("toner development: the run has no wall named 'drum'");
+  system.wall_contacts(drum, records_);
+  const ParticleState &p = system.particles();
+  toner_.clear();
+  for (const auto &r : records_)
+  {
+    const auto s = static_cast<std::size_t>(p.species[r.particle]);
+    if (s < is_toner_.size() && is_toner_[s])
+      toner_.push_back({p.id[r.particle], p.x[r.particle], p.y[r.particle], p.mass[r.particle], p.charge[r.particle]});
+  }
+  add_sample(system.time(), toner_);
+}
+
+void TonerDevelopment::add_sample(double time, const std::vector<DrumToner> &on_drum_now)
+{
+  std::vector<DrumToner> now = on_drum_now;
+  std::sort(now.begin(), now.end(), [](const DrumToner &a, const DrumToner &b) { return a.id < b.id; });
+  if (first_time_ < 0.0)
+    first_time_ = time;
+  last_time_ = time;
+
+  // Transfer: merge the id-sorted lists of this and the previous sample.
+  double arrived_mass = 0.0;
+  if (previous_time_ >= 0.0)
+  {
+    auto bin = [&](const DrumToner &t) {
+      const long k = std::lround(frame_.x_along(t.x, t.y) / bin_width_);
+      return std::abs(k) <= bins_half_ ? static_cast<int>(k) + bins_half_ : -1;
+    };
+    std::size_t i = 0, j = 0;
+    while (i < now.size() || j < before_.size())
+    {
+      if (j == before_.size() || (i < now.size() && now[i].id < before_[j].id))
+      {
+        arrived_mass += now[i].mass;
+        if (const int b = bin(now[i]); b >= 0)
+          arrived_[static_cast<std::size_t>(b)] += now[i].mass;
+        ++i;
+      }
+      else if (i == now.size() || before_[j].id < now[i].id)
+      {
+        if (const int b = bin(before_[j]); b >= 0)
+          left_[static_cast<std::size_t>(b)] += before_[j].mass;
+        ++j;
+      }
+      else
+        ++i, ++j;
+    }
+  }
+
+  // The measuring window in the drum's frame at this time.
+  auto surface_arc = [&](double x) {
+    const double psi = frame_.drum_angle_of_x(x);
+    const double px = frame_.cx + frame_.drum_radius * (-frame_.nx * std::cos(psi) + frame_.tx * std::sin(psi));
+    const double py = frame_.cy + frame_.drum_radius * (-frame_.ny * std::cos(psi) + frame_.ty * std::sin(psi));
+    return image_.drum_arc(px, py, time);
+  };
+  const double s1 = surface_arc(settings_.measure_from), s2 = surface_arc(settings_.measure_to);
+  const double a = std::min(s1, s2), b = std::max(s1, s2);
+  const double depth = frame_.slab_depth;
+  const double image_area = image_.exposed_length(a, b) * depth, dark_area = (b - a) * depth - image_area;
+  double m_image = 0, q_image = 0, m_dark = 0;
+  long n_image = 0, n_dark = 0;
+  for (const auto &t : now)
+  {
+    const double x = frame_.x_along(t.x, t.y);
+    if (x < settings_.measure_from || x > settings_.measure_to)
+      continue;
+    if (image_.exposed(image_.drum_arc(t.x, t.y, time)))
+      m_image += t.mass, q_image += t.charge, ++n_image;
+    else
+      m_dark += t.mass, ++n_dark;
+  }
+  Row row{time, nan, nan, nan, nan, nan, n_image, n_dark};
+  if (image_area > 0.0)
+  {
+    row.tma = m_image / image_area;
+    tma_.add(row.tma);
+    if (eps_layer_over_l_ > 0.0 && contrast_ > 0.0)
+      ratio_.add(row.ratio = std::abs(q_image / image_area) / (eps_layer_over_l_ * contrast_));
+  }
+  if (dark_area > 0.0)
+    fog_.add(row.fog = m_dark / dark_area);
+  if (m_image > 0.0)
+    q_over_m_.add(row.q_over_m = q_image / m_image);
+  if (previous_time_ >= 0.0 && time > previous_time_)
+    transfer_.add(row.transfer = arrived_mass / ((time - previous_time_) * depth));
+  rows_.push_back(row);
+  previous_time_ = time;
+  before_ = std::move(now);
+}
+
+std::vector<SummaryValue> TonerDevelopment::summary() const
+{
+  const auto blocks = static_cast<std::size_t>(statistics_.blocks);
+  auto sampled = [&](const char *key, const SampleSeries &s, bool steady_test, const char *unit, const char *meaning) {
+    return SummaryValue{key, s.mean(), s.standard_error(blocks), steady_test ? s.drift() : nan, unit, meaning};
+  };
+  SummaryValue bound;
+  bound.key = "tma_kg_per_m2_bound";
+  bound.value = tma_bound();
+  bound.unit = "kg/m^2";
+  bound.meaning = "complete neutralisation of the contrast: eps0 epsr dV / (L |q/m|)";
+  SummaryValue contrast;
+  contrast.key = "contrast_potential_V";
+  contrast.value = contrast_;
+  contrast.unit = "V";
+  contrast.meaning = "|bias - exposed potential|";
+  return {
+      sampled("tma_kg_per_m2", tma_, true, "kg/m^2", "toner mass per exposed drum area after the nip"),
+      bound,
+      sampled("fog_kg_per_m2", fog_, false, "kg/m^2", "toner mass per dark (background) drum area after the nip"),
+      sampled("developed_q_over_m_C_per_kg", q_over_m_, false, "C/kg", "charge per mass of the toner on the image"),
+      sampled("neutralisation_ratio", ratio_, false, "1", "developed charge per area / (eps0 epsr dV / L)"),
+      sampled("toner_transfer_rate_kg_per_s_m", transfer_, true, "kg/(s m)",
+              "toner mass arriving on the drum per time and slab depth"),
+      contrast,
+  };
+}
+
+std::string TonerDevelopment::csv() const
+{
+  std::ostringstream o;
+  o << "# toner on the drum between x = " << settings_.measure_from * 1e3 << " and " << settings_.measure_to * 1e3
+    << " mm after the nip (magbrush toner development); NaN: no area or no toner\n";
+  o << "time_s,tma_kg_per_m2,fog_kg_per_m2,developed_q_over_m_C_per_kg,neutralisation_ratio,"
+       "transfer_rate_kg_per_s_m,image_toner,dark_toner\n";
+  char line[256];
+  for (const Row &r : rows_)
+  {
+    std::snprintf(line, sizeof line, "%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%ld,%ld\n", r.time, r.tma, r.fog, r.q_over_m,
+                  r.ratio, r.transfer, r.image_toner, r.dark_toner);
+    o << line;
+  }
+  return o.str();
+}
+
+std::string TonerDevelopment::transfer_profile_csv() const
+{
+  std::ostringstream o;
+  const double span = (last_time_ - first_time_) * frame_.slab_depth;
+  o << "# where toner arrives on and leaves the drum along the nip, per time, slab depth and bin width "
+       "(magbrush toner development)\n";
+  o << "x_mm,arriving_kg_per_s_m2,leaving_kg_per_s_m2\n";
+  char line[128];
+  for (int k = -bins_half_; k <= bins_half_; ++k)
+  {
+    const auto i = static_cast<std::size_t>(k + bins_half_);
+    const double per = span > 0.0 ? 1.0 / (span * bin_width_) : nan;
+    std::snprintf(line, sizeof line, "%.6g,%.6g,%.6g\n", k * bin_width_ * 1e3, arrived_[i] * per, left_[i] * per);
+    o << line;
+  }
+  return o.str();
+}
+
+void TonerDevelopment::write(const std::string &directory) const
+{
+  write_file_atomically((std::filesystem::path(directory) / "toner_development.csv").string(), csv());
+  write_file_atomically((std::filesystem::path(directory) / "toner_transfer_profile.csv").string(),
+                        transfer_profile_csv());
+}
+
+namespace {
+const bool registered =
+  register_measurement({"toner development", [](const Case &c) -> std::unique_ptr<Measurement> {
+                          if (!TonerDevelopment::applies(c))
+                            return nullptr;
+                          return std::make_unique<TonerDevelopment>(c);
+                        }});
+} // namespace
+
+} // namespace magbrush::dem

@@ -1,0 +1,203 @@
+// The toner-development measurement against values computed independently here: toner placed
+// by hand on the drum surface at known drum-frame positions on exposed and dark strips (TMA and
+// fog from masses and strip areas integrated numerically), the neutralisation ratio and the
+// bound from their definitions, the image moving with the drum, and a toner arriving on the
+// drum between two samples (transfer rate and where).
+#include "dem/measurements/toner_development.h"
+
+#include "dem/run_summary.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <memory>
+
+using namespace magbrush;
+using namespace magbrush::dem;
+
+namespace {
+
+constexpr double eps0 = 8.8541878128e-12;
+
+Case development_case()
+{
+  Case c;
+  c.name = "development_test";
+  c.source_file = "(test)";
+  Sleeve s;
+  s.radius = 10e-3;
+  s.rpm = 400.0;
+  c.sleeve = s;
+  c.drum.present = true;
+  c.drum.radius = 15e-3;
+  c.drum.rpm = -170.0;
+  c.drum.gap = 0.35e-3;
+  c.drum.angle = 0.3;
+  c.drum.pc_thickness = 20e-6;
+  c.drum.pc_eps_r = 3.0;
+  c.dem.periodic_length = 0.2e-3;
+  c.electric.enabled = true;
+  c.electric.bias = -650.0;
+  c.electric.image.kind = LatentImage::Kind::surface_potential;
+  c.electric.image.light_value = 0.0;
+  c.electric.image.dark_value = -800.0;
+  c.electric.image.period = 2e-3;
+  c.electric.image.duty = 0.5;
+  Population carrier;
+  carrier.name = "carrier";
+  carrier.kind = ParticleKind::carrier;
+  Population toner;
+  toner.name = "toner";
+  toner.kind = ParticleKind::toner;
+  toner.charge_to_mass = -0.03;
+  c.populations = {carrier, toner};
+  return c;
+}
+
+// The drum surface point at drum-frame arc s (counter-clockwise about the drum centre from the
+// nip point) at time t: the image has turned by ω R t since t = 0.
+std::pair<double, double> on_drum(const NipFrame &f, double s, double t)
+{
+  const double nip = std::atan2(f.sy - f.cy, f.sx - f.cx);
+  const double angle = nip + (s + f.drum_omega * f.drum_radius * t) / f.drum_radius;
+  return {f.cx + f.drum_radius * std::cos(angle), f.cy + f.drum_radius * std::sin(angle)};
+}
+
+// Exposed length of [a, b] by brute force (the pattern of latent_image_value); each strip edge
+// inside the interval costs at most one sampling step (b − a)/2e6 of error.
+double exposed_by_sampling(double a, double b, double period, double duty)
+{
+  const int n = 2000000;
+  double len = 0.0;
+  for (int k = 0; k < n; ++k)
+  {
+    const double s = a + (k + 0.5) * (b - a) / n;
+    const double u = s / period + 0.5 * duty;
+    len += (u - std::floor(u) < duty) ? (b - a) / n : 0.0;
+  }
+  return len;
+}
+
+} // namespace
+
+TEST(DrumImage, StripsAreThoseOfTheFieldStageAndMoveWithTheDrum)
+{
+  const Case c = development_case();
+  const NipFrame f = NipFrame::from_case(c);
+  const DrumImage image(c.electric.image, f);
+  // An exposed strip centred on the nip at t = 0: exposed for |s| < 0.5 mm, dark for 0.5–1.5 mm.
+  EXPECT_TRUE(image.exposed(0.0));
+  EXPECT_TRUE(image.exposed(0.49e-3));
+  EXPECT_FALSE(image.exposed(0.51e-3));
+  EXPECT_FALSE(image.exposed(-0.51e-3));
+  EXPECT_TRUE(image.exposed(1.6e-3));
+  // A point fixed on the drum surface keeps its drum-frame coordinate as the drum turns.
+  for (double t : {0.0, 1e-4, 3.3e-3})
+  {
+    const auto [x, y] = on_drum(f, 0.7e-3, t);
+    EXPECT_NEAR(image.drum_arc(x, y, t), 0.7e-3, 1e-12);
+  }
+  // Exposed lengths against brute-force sampling.
+  for (auto [a, b] : {std::pair{0.0, 2e-3}, std::pair{-0.3e-3, 0.2e-3}, std::pair{0.4e-3, 5.3e-3}, std::pair{-7.1e-3, -1.2e-3}})
+    EXPECT_NEAR(image.exposed_length(a, b), exposed_by_sampling(a, b, 2e-3, 0.5), 8.0 * (b - a) / 2e6) << a << " " << b;
+}
+
+TEST(TonerDevelopment, HandPlacedTonerGivesExactTmaFogChargeAndBound)
+{
+  const Case c = development_case();
+  TonerDevelopment m(c);
+  const NipFrame f = NipFrame::from_case(c);
+  const DrumImage image(c.electric.image, f);
+  const double t = 2.5e-3;
+  // The window's ends on the drum surface, in the drum frame (independently: the nip coordinate
+  // x of a drum surface point is R sin ψ, its arc R ψ downstream = −(counter-clockwise arc) here).
+  auto arc_of_x = [&](double x) {
+    const double psi = std::asin(x / f.drum_radius);
+    // downstream is clockwise about the drum centre for a counter-clockwise sleeve
+    const double ccw = (f.tx * (f.ny) - f.ty * (f.nx)) > 0 ? 1.0 : -1.0;
+    return ccw * f.drum_radius * psi - f.drum_omega * f.drum_radius * t;
+  };
+  const double s1 = arc_of_x(1e-3), s2 = arc_of_x(4e-3);
+  const double a = std::min(s1, s2), b = std::max(s1, s2);
+  const double depth = c.dem.periodic_length;
+  const double image_area = exposed_by_sampling(a, b, 2e-3, 0.5) * depth;
+  const double dark_area = (b - a) * depth - image_area;
+  // Toner at drum-frame positions inside the window: find exposed and dark spots by sampling.
+  std::vector<DrumToner> toner;
+  double m_img = 0, q_img = 0, m_dark = 0;
+  int id = 0;
+  for (double s = a + 0.05e-3; s < b; s += 0.173e-3)
+  {
+    const auto [x, y] = on_drum(f, s, t);
+    const double mass = 2e-13 * (1 + 0.1 * id), charge = -0.03 * mass * (1 + 0.05 * (id % 3));
+    toner.push_back({id++, x, y, mass, charge});
+    const double u = s / 2e-3 + 0.25;
+    if (u - std::floor(u) < 0.5)
+      m_img += mass, q_img += charge;
+    else
+      m_dark += mass;
+  }
+  // One toner before the window (on the drum but still in the nip): not counted.
+  const auto [xn, yn] = on_drum(f, 0.0 - f.drum_omega * f.drum_radius * 0.0, t);
+  toner.push_back({id++, xn, yn, 1e-12, -3e-14});
+  m.add_sample(t, toner);
+  ASSERT_GT(m_img, 0.0);
+  ASSERT_GT(m_dark, 0.0);
+  EXPECT_NEAR(m.tma().mean(), m_img / image_area, 1e-5 * m_img / image_area); // sampling of the area
+  EXPECT_NEAR(m.fog().mean(), m_dark / dark_area, 1e-5 * m_dark / dark_area);
+  const double contrast = 650.0; // |−650 V − 0 V|
+  EXPECT_DOUBLE_EQ(m.contrast_potential(), contrast);
+  const double sigma_limit = eps0 * 3.0 * contrast / 20e-6;
+  EXPECT_NEAR(m.neutralisation().mean(), std::abs(q_img / image_area) / sigma_limit, 1e-5 * std::abs(q_img / image_area) / sigma_limit);
+  EXPECT_NEAR(m.tma_bound(), sigma_limit / 0.03, 1e-9 * sigma_limit / 0.03);
+}
+
+TEST(TonerDevelopment, ArrivalsAreCountedWhereAndWhenTheyHappen)
+{
+  const Case c = development_case();
+  TonerDevelopment m(c);
+  const NipFrame f = NipFrame::from_case(c);
+  // Sample 1: toner 1 on the drum. Sample 2 (5 µs later): toner 1 and toner 2, which arrived at
+  // x ≈ −0.5 mm (in the nip, upstream of the centre). Sample 3: toner 2 has left again.
+  auto at_x = [&](double x) {
+    const double psi = std::asin(x / f.drum_radius);
+    return std::pair{f.cx + f.drum_radius * (-f.nx * std::cos(psi) + f.tx * std::sin(psi)),
+                     f.cy + f.drum_radius * (-f.ny * std::cos(psi) + f.ty * std::sin(psi))};
+  };
+  const auto [x1, y1] = at_x(0.2e-3);
+  const auto [x2, y2] = at_x(-0.5e-3);
+  m.add_sample(0.0, {{1, x1, y1, 3e-13, -1e-14}});
+  m.add_sample(5e-6, {{2, x2, y2, 4e-13, -1.2e-14}, {1, x1, y1, 3e-13, -1e-14}});
+  m.add_sample(10e-6, {{1, x1, y1, 3e-13, -1e-14}});
+  const std::string profile = m.transfer_profile_csv();
+  // Over the 10 µs span and a 0.2 mm depth, in the 0.25 mm bin at −0.5 mm: 4e-13 kg arrived
+  // and left.
+  const double per = 1.0 / (10e-6 * 0.2e-3 * 0.25e-3);
+  char expected[128];
+  std::snprintf(expected, sizeof expected, "-0.5,%.6g,%.6g\n", 4e-13 * per, 4e-13 * per);
+  EXPECT_NE(profile.find(expected), std::string::npos) << profile;
+  const auto summary = m.summary();
+  const auto rate = std::find_if(summary.begin(), summary.end(),
+                                 [](const SummaryValue &v) { return v.key == "toner_transfer_rate_kg_per_s_m"; });
+  ASSERT_NE(rate, summary.end());
+  // Two intervals: 4e-13 kg in the first, nothing in the second.
+  EXPECT_NEAR(rate->value, 0.5 * 4e-13 / (5e-6 * 0.2e-3), 1e-9 * 4e-13 / (5e-6 * 0.2e-3));
+  std::vector<std::unique_ptr<Measurement>> all;
+  all.push_back(std::make_unique<TonerDevelopment>(m));
+  const std::string csv = run_summary_csv(all, c.statistics);
+  for (const char *key : {"tma_kg_per_m2,", "tma_kg_per_m2_bound,", "fog_kg_per_m2,", "developed_q_over_m_C_per_kg,",
+                          "neutralisation_ratio,", "toner_transfer_rate_kg_per_s_m,", "steady_state,"})
+    EXPECT_NE(csv.find(key), std::string::npos) << key;
+}
+
+TEST(TonerDevelopment, AppliesToNipScenesWithTonerAndAField)
+{
+  Case c = development_case();
+  EXPECT_TRUE(TonerDevelopment::applies(c));
+  c.electric.enabled = false;
+  EXPECT_FALSE(TonerDevelopment::applies(c));
+  c = development_case();
+  c.populations.pop_back();
+  EXPECT_FALSE(TonerDevelopment::applies(c));
+}

@@ -20,6 +20,8 @@
 #include "dem/pair_kernel.h"
 
 #include "coupling/case_parser.h"
+#include "dem/wall_contacts.h"
+#include "geometry/wall_primitives.h"
 
 #include <gtest/gtest.h>
 #include <omp.h>
@@ -435,4 +437,36 @@ TEST(Adhesion, CaseKeysParseAndNameTheirErrors)
     EXPECT_NE(m.find("adhesion_pairs[0].hamaker"), std::string::npos) << m;
     EXPECT_NE(m.find("expected an energy"), std::string::npos) << m;
   }
+}
+
+TEST(Adhesion, TheKweonCaseGivesEveryPairItsHamakerConstant)
+{
+  // The full-roller case sets Hamaker constants for the toner and every material it meets,
+  // with 50 nm asperities: its contact table builds, and the toner's pull-off forces are
+  // nN, not the µN of smooth 7 µm spheres.
+  const Case c = load_case(std::string(MAGBRUSH_SOURCE_DIR) + "/cases/kweon_full_roller.yaml");
+  std::vector<std::string> species;
+  for (const auto &p : c.populations)
+    species.push_back(p.material);
+  const DemWalls walls(build_wall_primitives(c));
+  ContactTable t;
+  t.build(c, species, walls.materials());
+  ASSERT_TRUE(t.adhesive());
+  const int toner = species[0] == "toner" ? 0 : 1, carrier = 1 - toner;
+  const double r_t = 0.5 * c.populations[static_cast<std::size_t>(toner)].diameter_mean;
+  const double r_c = 0.5 * c.populations[static_cast<std::size_t>(carrier)].diameter_mean;
+  const double z0 = t.adhesion_cutoff();
+  const auto &tc = t.adhesion_pair(toner, carrier);
+  const double F_tc = HamakerAdhesion::force(tc.hamaker, HamakerAdhesion::radius(r_t, tc.asperity_i, r_c, tc.asperity_j), 0.0, z0);
+  std::printf("Kweon case: toner-carrier pull-off %.3g N (A %.3g J)\n", F_tc, tc.hamaker);
+  for (std::size_t w = 0; w < walls.size(); ++w)
+  {
+    const auto &a = t.adhesion_wall(toner, static_cast<int>(w));
+    const double F = HamakerAdhesion::force(a.hamaker, HamakerAdhesion::wall_radius(r_t, a.asperity_i, a.asperity_j), 0.0, z0);
+    std::printf("Kweon case: toner-%s (%s) pull-off %.3g N (A %.3g J)\n", walls.name(w).c_str(),
+                walls.material(w).c_str(), F, a.hamaker);
+    EXPECT_LT(F, 1e-7);
+  }
+  EXPECT_GT(F_tc, 1e-9);
+  EXPECT_LT(F_tc, 1e-7);
 }

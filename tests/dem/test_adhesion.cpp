@@ -9,7 +9,8 @@
 //  * 1 vs 2 threads give the same bits, and so does a restart; the adhesive kernel with A = 0
 //    gives the values of the adhesion-free one;
 //  * the case input: combining rule, per-pair override, and the errors for a missing partner
-//    constant, an unknown material and a wrong unit.
+//    constant, an unknown material and a wrong unit; the Kweon case gives every pair its
+//    constant.
 #include "tests/dem/adhesion_scenes.h"
 #include "tests/dem/dem_test_scenes.h"
 #include "tests/test_temp_dir.h"

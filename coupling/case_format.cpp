@@ -161,6 +161,7 @@ std::vector<ResolvedEntry> resolved_entries(const Case &c)
     e.q(at + ".damping", "materials.*.damping", m.damping);
     e.q(at + ".restitution", "materials.*.restitution", m.restitution);
     e.q(at + ".hamaker", "materials.*.hamaker", m.hamaker);
+    e.q(at + ".adhesion_radius", "materials.*.adhesion_radius", m.adhesion_radius);
   }
   for (const auto &p : c.populations)
   {
@@ -190,6 +191,14 @@ std::vector<ResolvedEntry> resolved_entries(const Case &c)
       e.entries.push_back({at + ".insert_box", "populations[].insert_box", ex + "]", pr + "]"});
     }
     e.q(at + ".layer_thickness", "populations[].layer_thickness", p.layer_thickness);
+  }
+  for (std::size_t k = 0; k < c.adhesion_pairs.size(); ++k)
+  {
+    const AdhesionPair &a = c.adhesion_pairs[k];
+    const std::string at = "adhesion_pairs[" + std::to_string(k) + "]";
+    e.s(at + ".material_a", "adhesion_pairs[].material_a", a.material_a);
+    e.s(at + ".material_b", "adhesion_pairs[].material_b", a.material_b);
+    e.q(at + ".hamaker", "adhesion_pairs[].hamaker", a.hamaker);
   }
   e.b("electric.enabled", "electric.enabled", c.electric.enabled);
   e.q("electric.bias", "electric.bias", c.electric.bias);
@@ -263,6 +272,9 @@ std::vector<ResolvedEntry> resolved_entries(const Case &c)
   e.s("dem.restitution_model", "dem.restitution_model", d.restitution_model);
   e.q("dem.settle_time", "dem.settle_time", d.settle_time);
   e.q("dem.max_kinetic_energy_growth", "dem.max_kinetic_energy_growth", d.max_kinetic_energy_growth);
+  e.q("dem.adhesion_cutoff", "dem.adhesion_cutoff", d.adhesion_cutoff);
+  e.q("dem.adhesion_range_fraction", "dem.adhesion_range_fraction", d.adhesion_range_fraction);
+  e.q("dem.toner_stiffness_factor", "dem.toner_stiffness_factor", d.toner_stiffness_factor);
 
   e.q("development.measure_from", "development.measure_from", c.development.measure_from);
   e.q("development.measure_to", "development.measure_to", c.development.measure_to);

@@ -31,6 +31,15 @@ std::vector<KeySpec> dem_keys()
       quantity("dem.settle_time", D::time, "After insertion, settle this long with the walls at rest.").def("0 s").non_negative(),
       number("dem.max_kinetic_energy_growth", "Stability guard: kinetic energy may not grow by more than this factor between checks.")
           .def("1000").min(1.0, false),
+      quantity("dem.adhesion_cutoff", D::length,
+               "Van der Waals adhesion: the gap z0 at which the force saturates (contact distance).")
+          .def("0.4 nm").positive(),
+      number("dem.adhesion_range_fraction",
+             "Van der Waals adhesion is cut beyond the gap where it has fallen to this fraction of its contact value.")
+          .def("0.01").positive().max(1.0, false),
+      number("dem.toner_stiffness_factor",
+             "Toner contacts use Young's modulus x this (a larger time step; see dem/README.md for its error).")
+          .def("1").positive().max(1.0),
   };
 }
 

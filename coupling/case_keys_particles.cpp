@@ -25,8 +25,14 @@ std::vector<KeySpec> particle_keys()
       number("materials.*.damping", "Kawamoto's Voigt damping constant alpha.").def("0").non_negative(),
       number("materials.*.restitution", "Coefficient of restitution (LIGGGHTS form); -1 = unused.")
           .def("-1").min(-1.0).max(1.0),
-      quantity("materials.*.hamaker", D::energy, "Hamaker constant for van der Waals adhesion.")
+      quantity("materials.*.hamaker", D::energy,
+               "Hamaker constant A for van der Waals adhesion (pairs: sqrt(A1 A2) unless in adhesion_pairs; "
+               "a material with A > 0 needs it written, 0 J included, for every material it touches).")
           .def("0 J").non_negative(),
+      quantity("materials.*.adhesion_radius", D::length,
+               "Asperity radius through which it touches, sets the adhesion force (0 = the particle radius; "
+               "walls: 0 = flat).")
+          .def("0 nm").non_negative(),
 
       list("populations", "Particle populations (carrier, toner)."),
       text("populations[].name", "Population name.").required(),
@@ -57,6 +63,12 @@ std::vector<KeySpec> particle_keys()
           .dim(D::length),
       quantity("populations[].layer_thickness", D::length, "Insert as a layer of this thickness on the sleeve.")
           .def("0 mm").non_negative(),
+
+      list("adhesion_pairs", "Hamaker constants of material pairs, overriding sqrt(A1 A2) (e.g. toner on the drum)."),
+      text("adhesion_pairs[].material_a", "First material (key in materials).").required(),
+      text("adhesion_pairs[].material_b", "Second material (key in materials; may equal the first).").required(),
+      quantity("adhesion_pairs[].hamaker", D::energy, "Hamaker constant A12 of the pair (0 J = no adhesion).")
+          .required().non_negative(),
   };
 }
 

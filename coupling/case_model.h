@@ -97,6 +97,16 @@ struct Material
   double damping = 0.0;         // Kawamoto's Voigt damping constant α (c_n = α √(m* k_n) δ^¼)
   double restitution = -1.0;    // coefficient of restitution e (LIGGGHTS ln e form); < 0 = unused
   double hamaker = 0.0;         // Hamaker constant A [J] for van der Waals adhesion
+  bool hamaker_given = false;   // `hamaker` was written (an explicit 0 J means: no adhesion)
+  double adhesion_radius = 0.0; // asperity radius where it touches [m]; 0 = the particle radius
+                                // (walls: 0 = flat)
+};
+
+// A Hamaker constant for one pair of materials, overriding the combining rule √(A₁ A₂).
+struct AdhesionPair
+{
+  std::string material_a, material_b;
+  double hamaker = 0.0;         // A₁₂ [J]
 };
 
 enum class ParticleKind { carrier, toner };
@@ -220,6 +230,10 @@ struct DemSettings
   double settle_time = 0.0;          // after insertion, settle this long with walls at rest [s]
   double max_kinetic_energy_growth = 1e3; // stability guard: KE may not grow by more than this
                                           // factor between two guard checks (100 steps)
+  // Van der Waals adhesion (dem/contact_law.h, HamakerAdhesion):
+  double adhesion_cutoff = 0.4e-9;   // z0: the gap is floored here (contact distance) [m]
+  double adhesion_range_fraction = 0.01; // the force is cut where it has fallen to this × F0
+  double toner_stiffness_factor = 1.0;   // toner contacts use E × this (time step, dem/README.md)
 };
 
 // The development-nip measurements (dem/measurements/nip_profile.h, chain_inclination.h,
@@ -284,6 +298,7 @@ struct Case
   std::vector<PlaneWall> planes;      // explicit plane walls (box scenes)
   std::vector<Material> materials;    // by name: "carrier", "toner", "wall", "drum", ...
   std::vector<Population> populations;
+  std::vector<AdhesionPair> adhesion_pairs; // per-pair Hamaker constants (dem/contact_parameters)
   Electric electric;
   AppliedField applied_field;
   FieldSettings field;

@@ -765,6 +765,8 @@ private:
       c.materials.push_back(build_material(s));
     for (const auto &s : elements(top.child("populations"), "[]"))
       c.populations.push_back(build_population(s));
+    for (const auto &s : elements(top.child("adhesion_pairs"), "[]"))
+      c.adhesion_pairs.push_back({str(s, "material_a"), str(s, "material_b"), q(s, "hamaker")});
     build_electric(c, top.child("electric"));
     build_applied_field(c, top.child("applied_field"));
     build_field(c.field, top.child("field"));
@@ -894,6 +896,8 @@ private:
     m.damping = q(s, "damping");
     m.restitution = q(s, "restitution");
     m.hamaker = q(s, "hamaker");
+    m.hamaker_given = has(s, "hamaker");
+    m.adhesion_radius = q(s, "adhesion_radius");
     return m;
   }
 
@@ -1042,6 +1046,9 @@ private:
     d.restitution_model = str(s, "restitution_model");
     d.settle_time = q(s, "settle_time");
     d.max_kinetic_energy_growth = q(s, "max_kinetic_energy_growth");
+    d.adhesion_cutoff = q(s, "adhesion_cutoff");
+    d.adhesion_range_fraction = q(s, "adhesion_range_fraction");
+    d.toner_stiffness_factor = q(s, "toner_stiffness_factor");
   }
 };
 

@@ -124,6 +124,57 @@ struct RollingFriction
   }
 };
 
+// Van der Waals adhesion: the Derjaguin limit of Hamaker's sphere–sphere interaction,
+//   F = A R / (6 z²),  R = ρ_i ρ_j / (ρ_i + ρ_j),
+// attractive, along the line of centres, with z the gap between the surfaces. The plane is
+// the limit ρ_j → ∞ (F = A ρ_i / (6 z²)). It is exact to first order in z/ρ: the relative
+// error of the Derjaguin form against the exact Hamaker force is ≈ z/ρ (tests/dem/
+// test_adhesion.cpp measures it). The gap is floored at the cut-off distance z0 (≈ 0.4 nm,
+// the interatomic distance at contact): for z ≤ z0, and throughout a Hertz overlap, the force
+// is the pull-off force F0 = A R / (6 z0²). Beyond the range z_c = z0 / √f, where it has
+// fallen to the fraction f of F0, it is cut to zero (the neighbour list and the wall
+// detection reach that far: ContactTable::adhesion_range()).
+//
+// ρ is the radius of the bodies where they touch: real toner touches through asperities and
+// silica additives (10–100 nm); a smooth 7 µm toner would stick with ≈ 0.3 µN, tens of
+// times any electric force on it. Each material may give it (materials.*.adhesion_radius); ρ = min(particle radius,
+// asperity radius), ∞ for a wall without one (a flat wall).
+//
+// In the contact law the attraction is added to the normal force (DMT): it loads the Hertz
+// spring, so at rest the elastic force is the external load PLUS F0, and the Coulomb limit
+// μ F_n and the rolling torque μ_r F_n, which use that elastic force, see the adhesion. The
+// body detaches when the other forces exceed F0.
+struct AdhesionCoefficients
+{
+  double hamaker = 0.0;     // A₁₂ [J]; 0: no adhesion
+  double asperity_i = 0.0;  // asperity radius of i's material [m]; +∞: the particle's radius
+  double asperity_j = 0.0;  // the partner's (a wall: +∞ = flat)
+};
+
+struct HamakerAdhesion
+{
+  // The radius that sets the force: ρ = min(r, asperity) for each body, combined in series.
+  static double radius(double r_i, double asperity_i, double r_j, double asperity_j)
+  {
+    const double a = std::min(r_i, asperity_i), b = std::min(r_j, asperity_j);
+    return a * b / (a + b);
+  }
+  // A particle against a wall (asperity_w = +∞: a flat wall, R = ρ_i).
+  static double wall_radius(double r_i, double asperity_i, double asperity_w)
+  {
+    const double a = std::min(r_i, asperity_i);
+    return std::isinf(asperity_w) ? a : a * asperity_w / (a + asperity_w);
+  }
+  // Magnitude of the attraction at gap z (z < 0: overlapping), z floored at z0.
+  static double force(double A, double R, double z, double z0)
+  {
+    const double s = std::max(z, z0);
+    return A * R / (6.0 * s * s);
+  }
+  // The gap beyond which the force is cut: there it has fallen to `fraction` of F0.
+  static double range(double z0, double fraction) { return z0 / std::sqrt(fraction); }
+};
+
 // What one contact needs to know about its two bodies.
 struct ContactKinematics
 {

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <stdexcept>
 
 namespace magbrush::dem {
@@ -151,28 +152,107 @@ ContactCoefficients mix_materials(const Material &a, const Material &b, bool b_i
   return c;
 }
 
+double hamaker_of_pair(const Case &c, const Material &a, const Material &b)
+{
+  for (const AdhesionPair &p : c.adhesion_pairs)
+    if ((p.material_a == a.name && p.material_b == b.name) || (p.material_a == b.name && p.material_b == a.name))
+      return p.hamaker;
+  if ((a.hamaker > 0.0 && !b.hamaker_given) || (b.hamaker > 0.0 && !a.hamaker_given))
+  {
+    const Material &has = a.hamaker > 0.0 ? a : b, &lacks = a.hamaker > 0.0 ? b : a;
+    throw std::invalid_argument("adhesion between '" + a.name + "' and '" + b.name + "': material '" +
+                                has.name + "' has a Hamaker constant but '" + lacks.name +
+                                "' has none: give materials." + lacks.name +
+                                ".hamaker (0 J for no adhesion) or an adhesion_pairs entry "
+                                "{material_a: " + a.name + ", material_b: " + b.name + ", hamaker: ...}");
+  }
+  return std::sqrt(a.hamaker * b.hamaker);
+}
+
+Material contact_material(const Case &c, std::size_t population)
+{
+  const Population &p = c.populations.at(population);
+  Material m = c.material(p.material);
+  if (p.kind == ParticleKind::toner)
+    m.youngs_modulus *= c.dem.toner_stiffness_factor;
+  return m;
+}
+
+namespace {
+double asperity_of(const Material &m)
+{
+  return m.adhesion_radius > 0.0 ? m.adhesion_radius : std::numeric_limits<double>::infinity();
+}
+
+void check_adhesion_pairs(const Case &c)
+{
+  for (std::size_t k = 0; k < c.adhesion_pairs.size(); ++k)
+  {
+    const AdhesionPair &p = c.adhesion_pairs[k];
+    for (const std::string *name : {&p.material_a, &p.material_b})
+    {
+      bool known = false;
+      for (const Material &m : c.materials)
+        known = known || m.name == *name;
+      if (!known)
+        throw std::invalid_argument("adhesion_pairs[" + std::to_string(k) + "]: no material '" + *name + "'");
+    }
+    for (std::size_t l = 0; l < k; ++l)
+    {
+      const AdhesionPair &q = c.adhesion_pairs[l];
+      if ((q.material_a == p.material_a && q.material_b == p.material_b) ||
+          (q.material_a == p.material_b && q.material_b == p.material_a))
+        throw std::invalid_argument("adhesion_pairs[" + std::to_string(k) + "]: the pair '" + p.material_a +
+                                    "'–'" + p.material_b + "' is already given in adhesion_pairs[" +
+                                    std::to_string(l) + "]");
+    }
+  }
+}
+} // namespace
+
 void ContactTable::build(const Case &c, const std::vector<std::string> &species_materials,
                          const std::vector<std::string> &wall_materials)
 {
   n_species_ = species_materials.size();
   columns_ = n_species_ + wall_materials.size();
   table_.assign(n_species_ * columns_, {});
+  adhesion_.assign(n_species_ * columns_, {});
   names_.assign(n_species_ * columns_, {});
+  check_adhesion_pairs(c);
+  adhesive_ = particles_adhesive_ = false;
   const std::string &model = c.dem.restitution_model;
+  // Species s is population s when the table is built for the case's populations (the
+  // engine); the toner stiffness factor then applies to toner populations.
+  const auto material_of = [&](std::size_t s) {
+    return s < c.populations.size() && c.populations[s].material == species_materials[s]
+               ? contact_material(c, s)
+               : c.material(species_materials[s]);
+  };
   for (std::size_t s = 0; s < n_species_; ++s)
   {
-    const Material &ms = c.material(species_materials[s]);
+    const Material ms = material_of(s);
     for (std::size_t t = 0; t < n_species_; ++t)
     {
-      table_[s * columns_ + t] = mix_materials(ms, c.material(species_materials[t]), false, model);
+      const Material mt = material_of(t);
+      table_[s * columns_ + t] = mix_materials(ms, mt, false, model);
+      adhesion_[s * columns_ + t] = {hamaker_of_pair(c, ms, mt), asperity_of(ms), asperity_of(mt)};
+      particles_adhesive_ = particles_adhesive_ || adhesion_[s * columns_ + t].hamaker > 0.0;
       names_[s * columns_ + t] = species_materials[s] + "–" + species_materials[t];
     }
     for (std::size_t w = 0; w < wall_materials.size(); ++w)
     {
-      table_[s * columns_ + n_species_ + w] = mix_materials(ms, c.material(wall_materials[w]), true, model);
+      const Material &mw = c.material(wall_materials[w]);
+      table_[s * columns_ + n_species_ + w] = mix_materials(ms, mw, true, model);
+      adhesion_[s * columns_ + n_species_ + w] = {hamaker_of_pair(c, ms, mw), asperity_of(ms), asperity_of(mw)};
+      adhesive_ = adhesive_ || adhesion_[s * columns_ + n_species_ + w].hamaker > 0.0;
       names_[s * columns_ + n_species_ + w] = species_materials[s] + "–wall:" + wall_materials[w];
     }
   }
+  adhesive_ = adhesive_ || particles_adhesive_;
+  cutoff_ = c.dem.adhesion_cutoff;
+  if (adhesive_ && !(cutoff_ > 0.0 && c.dem.adhesion_range_fraction > 0.0 && c.dem.adhesion_range_fraction < 1.0))
+    throw std::invalid_argument("adhesion: dem.adhesion_cutoff must be > 0 and dem.adhesion_range_fraction in (0, 1)");
+  range_ = adhesive_ ? HamakerAdhesion::range(cutoff_, c.dem.adhesion_range_fraction) : 0.0;
 }
 
 std::string ContactTable::describe() const
@@ -187,6 +267,18 @@ std::string ContactTable::describe() const
                   names_[k].c_str(), c.effective_modulus, c.effective_shear, c.friction,
                   c.rolling_friction, c.damping_normal,
                   c.damping_normal > 0 ? hertz_restitution(c.damping_normal) : 1.0, c.damping_tangential);
+    out += line;
+    const auto &a = adhesion_[k];
+    if (a.hamaker > 0.0)
+    {
+      std::snprintf(line, sizeof line, "  %-28s Hamaker %.3g J, asperity radii %.3g / %.3g m\n", "", a.hamaker,
+                    a.asperity_i, a.asperity_j);
+      out += line;
+    }
+  }
+  if (adhesive_)
+  {
+    std::snprintf(line, sizeof line, "  adhesion: cut-off gap z0 %.3g m, range %.3g m\n", cutoff_, range_);
     out += line;
   }
   return out;

@@ -46,6 +46,27 @@ public:
   void build(const Case &c, const std::vector<std::string> &species_materials,
              const std::vector<std::string> &wall_materials);
 
+  // Van der Waals adhesion of each interaction type (same layout as the coefficients). The
+  // Hamaker constant of two materials is √(A₁ A₂) unless the case lists the pair in
+  // adhesion_pairs; a material with A > 0 that meets one without a written hamaker is an
+  // error naming the pair (write 0 J there for none). Asperity radii of 0 (not given) are +∞.
+  const AdhesionCoefficients &adhesion_pair(int s, int t) const
+  {
+    return adhesion_[static_cast<std::size_t>(s) * columns_ + static_cast<std::size_t>(t)];
+  }
+  const AdhesionCoefficients &adhesion_wall(int s, int w) const
+  {
+    return adhesion_[static_cast<std::size_t>(s) * columns_ + n_species_ + static_cast<std::size_t>(w)];
+  }
+  const AdhesionCoefficients *adhesion_data() const { return adhesion_.data(); }
+  // Whether any pair of the particles, or any particle and wall, sticks.
+  bool adhesive() const { return adhesive_; }
+  bool particles_adhesive() const { return particles_adhesive_; }
+  // The cut-off gap z0 and the range z_c of the force (0 when nothing sticks): the neighbour
+  // list and the wall detection must reach this far beyond contact.
+  double adhesion_cutoff() const { return cutoff_; }
+  double adhesion_range() const { return adhesive_ ? range_ : 0.0; }
+
   const ContactCoefficients &particle_pair(int s, int t) const
   {
     return table_[static_cast<std::size_t>(s) * columns_ + static_cast<std::size_t>(t)];
@@ -65,11 +86,22 @@ public:
 private:
   std::size_t n_species_ = 0, columns_ = 0;
   std::vector<ContactCoefficients> table_;
+  std::vector<AdhesionCoefficients> adhesion_;
   std::vector<std::string> names_;
+  bool adhesive_ = false, particles_adhesive_ = false;
+  double cutoff_ = 0.0, range_ = 0.0;
 };
 
 // The coefficients of one pair of materials (used by the table and by tests).
 ContactCoefficients mix_materials(const Material &a, const Material &b, bool b_is_wall,
                                   const std::string &restitution_model);
+
+// The Hamaker constant of two materials that meet: the case's adhesion_pairs entry, else
+// √(A_a A_b). Throws, naming the pair, when one has A > 0 and the other none written.
+double hamaker_of_pair(const Case &c, const Material &a, const Material &b);
+
+// The material of population `s` as its contacts see it: a toner's Young's modulus scaled by
+// dem.toner_stiffness_factor (a softer toner allows a larger time step).
+Material contact_material(const Case &c, std::size_t population);
 
 } // namespace magbrush::dem

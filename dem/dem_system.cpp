@@ -64,7 +64,7 @@ void DemSystem::setup_derived()
   {
     species_materials.push_back(p.material);
     species_names.push_back(p.name);
-    materials.push_back(case_.material(p.material));
+    materials.push_back(contact_material(case_, materials.size())); // toner stiffness factor
   }
   for (std::size_t i = 0; i < n; ++i)
     if (particles_.species[i] < 0 || U(particles_.species[i]) >= species_materials.size())
@@ -74,13 +74,15 @@ void DemSystem::setup_derived()
   table_.build(case_, species_materials, walls_.materials());
   // The table again, one array per field (the pair kernel gathers from these).
   const std::size_t types = table_.species() * table_.columns();
-  coefficient_fields_.assign(6 * types, 0.0);
+  coefficient_fields_.assign(9 * types, 0.0);
   for (std::size_t t = 0; t < types; ++t)
   {
     const ContactCoefficients &k = table_.data()[t];
-    const double fields[6] = {k.effective_modulus, k.effective_shear, k.friction,
-                              k.rolling_friction, k.damping_normal, k.damping_tangential};
-    for (std::size_t f = 0; f < 6; ++f)
+    const AdhesionCoefficients &a = table_.adhesion_data()[t];
+    const double fields[9] = {k.effective_modulus, k.effective_shear, k.friction,
+                              k.rolling_friction, k.damping_normal, k.damping_tangential,
+                              a.hamaker, a.asperity_i, a.asperity_j};
+    for (std::size_t f = 0; f < 9; ++f)
       coefficient_fields_[f * types + t] = fields[f];
   }
   stable_ = stable_time_step(particles_, materials, species_names, table_, walls_.size(),
@@ -136,7 +138,9 @@ void DemSystem::permute_particles(const std::vector<std::int32_t> &order)
 void DemSystem::rebuild_neighbour_list()
 {
   PhaseTimer timer(times_.neighbour);
-  list_.rebuild(particles_, box_, skin_, [this](const std::vector<std::int32_t> &order) { permute_particles(order); });
+  // Pairs are listed out to contact + adhesion range (0 without adhesion) + skin.
+  const double reach = table_.particles_adhesive() ? table_.adhesion_range() : 0.0;
+  list_.rebuild(particles_, box_, skin_ + reach, [this](const std::vector<std::int32_t> &order) { permute_particles(order); });
   x0_ = particles_.x;
   y0_ = particles_.y;
   z0_ = particles_.z;
@@ -242,7 +246,9 @@ void DemSystem::pair_and_row_phase(StepFlags &mine)
                          static_cast<std::int64_t>(table_.columns()), table_.species() == 1, dt_,
                          case_.dem.max_overlap_fraction, W.hist_x.data(), W.hist_y.data(), W.hist_z.data(),
                          W.force_x.data(), W.force_y.data(), W.force_z.data(), W.torque_j_x.data(),
-                         W.torque_j_y.data(), W.torque_j_z.data(), W.touching.data()};
+                         W.torque_j_y.data(), W.torque_j_z.data(), W.touching.data(),
+                         coef + 6 * types, coef + 7 * types, coef + 8 * types, table_.adhesion_cutoff(),
+                         table_.adhesion_range(), table_.particles_adhesive()};
   const std::int32_t *row_start = L.row_start.data();
   ForceBuffers &f = forces_;
   const long blocks = (n + contact_block_rows - 1) / contact_block_rows;
@@ -367,6 +373,9 @@ void DemSystem::wall_phase(StepFlags &mine)
   const long n = static_cast<long>(s.size());
   const std::size_t W = walls_.size();
   const double dt = dt_, guard = case_.dem.max_overlap_fraction;
+  // Van der Waals adhesion reaches across a gap (0 without adhesion: only touching walls).
+  const bool adhesive = table_.adhesive();
+  const double range = adhesive ? table_.adhesion_range() : 0.0, z0 = table_.adhesion_cutoff();
   // This thread's scratch (constructed once, not per particle).
   WallContactGeometry g[max_wall_contacts + 1];
   int which[max_wall_contacts + 1];
@@ -380,7 +389,7 @@ void DemSystem::wall_phase(StepFlags &mine)
     int m = 0;
     for (std::size_t w = 0; w < W; ++w)
     {
-      if (!walls_.contact(w, p, r, g[m]))
+      if (!walls_.contact(w, p, r, g[m], range))
         continue;
       which[m] = static_cast<int>(w);
       if (m == max_wall_contacts)
@@ -411,7 +420,17 @@ void DemSystem::wall_phase(StepFlags &mine)
       ck.radius_i = r;
       ck.inv_inertia_i = s.inv_inertia[i];
       Vector3 xi_t = wall_slots_.history(sl);
-      const ContactOutcome o = evaluate_contact(table_.particle_wall(s.species[i], which[c]), ck, xi_t, dt);
+      ContactOutcome o;
+      if (ck.overlap > 0.0) // always, without adhesion
+        o = evaluate_contact(table_.particle_wall(s.species[i], which[c]), ck, xi_t, dt);
+      else
+        xi_t = {}; // held across a gap by adhesion only: no contact, no history
+      if (adhesive)
+      {
+        const AdhesionCoefficients &a = table_.adhesion_wall(s.species[i], which[c]);
+        const double R_a = HamakerAdhesion::wall_radius(r, a.asperity_i, a.asperity_j);
+        o.force_i += HamakerAdhesion::force(a.hamaker, R_a, -ck.overlap, z0) * ck.n;
+      }
       wall_slots_.set_history(sl, xi_t);
       f.fx[i] += o.force_i.x;
       f.fy[i] += o.force_i.y;

@@ -4,7 +4,9 @@
 //   rows by i. A transposed index (rows by j) lets a per-particle gather collect both sides
 //   in a fixed order — that is what makes the forces bit-identical on any number of threads.
 // * Verlet skin: pairs closer than r_i + r_j + skin are listed; the list stays valid until some
-//   particle has moved more than skin/2 since the build (the engine checks that).
+//   particle has moved more than skin/2 since the build (the engine checks that). With van
+//   der Waals adhesion, which reaches a few nm beyond contact, the engine passes skin +
+//   adhesion range here and keeps checking the drift against the skin alone.
 // * Spatial sorting: every build first re-sorts the particles in cell order (a stable counting
 //   sort), so neighbours are close in memory.
 // * Contact history (the Mindlin ξ of each touching pair) is keyed by the particles' stable

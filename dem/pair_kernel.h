@@ -45,6 +45,13 @@ struct PairKernelData
   double *hx, *hy, *hz;
   double *fx, *fy, *fz, *tjx, *tjy, *tjz;
   std::int32_t *touching;
+  // Van der Waals adhesion (contact_law.h, HamakerAdhesion) by interaction type, like the
+  // coefficients. `adhesive`: some particle pair sticks; then pairs closer than contact +
+  // adhesion_range attract, touching or not. Scenes without it run the kernel without these
+  // lines at all (a template parameter, chosen once per call), so they cost nothing there.
+  const double *hamaker, *asperity_i, *asperity_j;
+  double adhesion_cutoff, adhesion_range;
+  bool adhesive;
 };
 
 // Torque on i of the pairs p_begin + k, k = 0 .. block size (a per-thread buffer).
@@ -55,7 +62,8 @@ struct RowTorques
 
 // The kernel for pairs [p_begin, p_end): each pair's contact force on i (into the pair's
 // slot), torque on i (into T, indexed from p_begin) and on j (into the pair's slot), the
-// updated history and the touching flag. Returns 1 when some pair overlaps by more than the
+// updated history and the touching flag ("touching" means overlapping: a pair held only by
+// adhesion across a gap has no contact and no history). Returns 1 when some pair overlaps by more than the
 // guard fraction of the smaller radius.
 int particle_pair_kernel(const PairKernelData &D, const RowTorques &T, std::int64_t p_begin, std::int64_t p_end);
 

@@ -158,8 +158,11 @@ void DemWalls::prepare(double t, bool frozen)
   }
 }
 
-bool DemWalls::contact(std::size_t w, const Vector3 &p, double r, WallContactGeometry &g) const
+bool DemWalls::contact(std::size_t w, const Vector3 &p, double r_touch, WallContactGeometry &g, double range) const
 {
+  // Detected out to r_touch + range; the overlap stays measured from r_touch. (range = 0:
+  // r_touch + 0 is r_touch exactly.)
+  const double r = r_touch + range;
   const Wall &wall = walls_[w];
   switch (wall.kind)
   {
@@ -171,7 +174,7 @@ bool DemWalls::contact(std::size_t w, const Vector3 &p, double r, WallContactGeo
     const double gap = c.particles_outside ? d - c.radius : c.radius - d;
     if (gap >= r || d == 0.0)
       return false;
-    g.overlap = r - gap;
+    g.overlap = r_touch - gap;
     // Outside: the wall is towards the axis; inside: away from it.
     const double s = c.particles_outside ? -1.0 / d : 1.0 / d;
     g.n = {s * dx, s * dy, 0.0};
@@ -190,7 +193,7 @@ bool DemWalls::contact(std::size_t w, const Vector3 &p, double r, WallContactGeo
     const double gap = dot(p - current_[w].point, n);
     if (gap >= r)
       return false;
-    g.overlap = r - gap;
+    g.overlap = r_touch - gap;
     g.n = -n;
     g.surface_velocity = current_[w].velocity;
     g.angular_velocity = {};
@@ -211,7 +214,7 @@ bool DemWalls::contact(std::size_t w, const Vector3 &p, double r, WallContactGeo
     const double gap = inside ? -d : d;
     if (gap >= r || d == 0.0)
       return false;
-    g.overlap = r - gap;
+    g.overlap = r_touch - gap;
     // Outside: from the centre towards the closest boundary point; inside: the opposite
     // (push the particle back out through the nearest face).
     const double s = inside ? 1.0 / d : -1.0 / d;

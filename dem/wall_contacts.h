@@ -15,7 +15,7 @@ namespace magbrush::dem {
 
 struct WallContactGeometry
 {
-  double overlap = 0.0;     // δ > 0 when touching
+  double overlap = 0.0;     // δ > 0 when touching (−gap within an adhesion range)
   Vector3 n;                // unit normal from the particle centre towards the wall
   Vector3 surface_velocity; // velocity of the wall material at the contact point
   Vector3 angular_velocity; // the wall's rigid-body angular velocity
@@ -38,8 +38,9 @@ public:
   void prepare(double t, bool frozen);
 
   // Contact of a sphere (centre p, radius r) with wall w at the prepared time. Returns false
-  // when not touching.
-  bool contact(std::size_t w, const Vector3 &p, double r, WallContactGeometry &g) const;
+  // when the gap is `range` or more (range > 0: van der Waals adhesion reaches across a gap;
+  // then g.overlap may be ≤ 0, the negative gap).
+  bool contact(std::size_t w, const Vector3 &p, double r, WallContactGeometry &g, double range = 0.0) const;
 
   // Signed distance from p to wall w's surface at time t (> 0 on the particle side).
   double distance(std::size_t w, const Vector3 &p, double t) const;

@@ -171,6 +171,9 @@ TEST(ModuleDefaults, DemSettingsOfADefaultCaseAreTheStructDefaults)
   EXPECT_SAME_EXACT(from_case, built, restitution_model);
   EXPECT_SAME(from_case, built, settle_time);
   EXPECT_SAME(from_case, built, max_kinetic_energy_growth);
+  EXPECT_SAME(from_case, built, adhesion_cutoff);
+  EXPECT_SAME(from_case, built, adhesion_range_fraction);
+  EXPECT_SAME(from_case, built, toner_stiffness_factor);
 }
 
 // The field solver (field section) and the nip electrostatics (electric section).
@@ -259,6 +262,8 @@ TEST(ModuleDefaults, ParticlesOfADefaultCaseAreTheStructDefaults)
   EXPECT_SAME(wall, m, damping);
   EXPECT_SAME(wall, m, restitution);
   EXPECT_SAME(wall, m, hamaker);
+  EXPECT_SAME_EXACT(wall, m, hamaker_given);
+  EXPECT_SAME(wall, m, adhesion_radius);
 
   ASSERT_EQ(c.populations.size(), 1u);
   const Population p;

@@ -515,9 +515,11 @@ auto checkpoint_arrays(State &s, Forces &f)
 }
 } // namespace
 
-void DemSystem::write_checkpoint(const std::string &path)
+void DemSystem::write_checkpoint(const std::string &path) { write_checkpoint(path, CheckpointIdentity{}); }
+
+void DemSystem::write_checkpoint(const std::string &path, const CheckpointIdentity &identity)
 {
-  CheckpointWriter out(path);
+  CheckpointWriter out(path, identity);
   out.put(step_);
   out.put(time_);
   out.put(dt_);

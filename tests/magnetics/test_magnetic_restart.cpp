@@ -116,13 +116,15 @@ bool bit_identical(const std::vector<double> &a, const std::vector<double> &b)
 struct Outcome
 {
   bool identical = false;
+  bool unperturbed = false; // the straight run with a checkpoint = the one without
   bool control_identical = true;
   bool control_restored = true;
   long evaluations = 0, local_refreshes = 0, list_rebuilds = 0;
 };
 
-// Straight run A (checkpoint after `half` steps) vs restart B from that checkpoint, and the
-// control C (restart under settings with another max_sweeps: no held state restored).
+// Straight run A (checkpoint after `half` steps) vs restart B from that checkpoint, the
+// control C (restart under settings with another max_sweeps: no held state restored), and
+// the straight run without a checkpoint.
 Outcome straight_vs_restart(const std::string &mode, const std::string &far_field, const std::string &model,
                             int half)
 {
@@ -150,8 +152,14 @@ Outcome straight_vs_restart(const std::string &mode, const std::string &far_fiel
   for (int k = 0; k < half; ++k)
     control->step();
 
+  // Writing the checkpoint changed nothing in the run that wrote it.
+  auto plain = make_system(c, true);
+  for (int k = 0; k < 2 * half; ++k)
+    plain->step();
+
   Outcome o;
   o.identical = a->step_count() == b->step_count() && bit_identical(state_by_id(*a), state_by_id(*b));
+  o.unperturbed = bit_identical(state_by_id(*a), state_by_id(*plain));
   o.control_identical = bit_identical(state_by_id(*a), state_by_id(*control));
   o.control_restored = magnetics_of(*control).restored_state();
   const MagneticForceTerm &m = magnetics_of(*a);
@@ -179,6 +187,7 @@ TEST_P(MagneticRestart, ContinuesBitIdentically)
   const auto [mode, far_field, model] = GetParam();
   const Outcome o = straight_vs_restart(mode, far_field, model, 300);
   EXPECT_TRUE(o.identical);
+  EXPECT_TRUE(o.unperturbed);
   EXPECT_FALSE(o.control_restored);
   EXPECT_FALSE(o.control_identical) << "the comparison could not tell a restart without magnetic state";
   // The paths that hold state were taken: more than the first evaluation, and local

@@ -25,8 +25,7 @@ inline cli::CommandSpec engine_command_line(const std::string &program)
       cli::set_option(),
       {"--restart", {}, "FILE", "continue from a checkpoint, bit-identically to an uninterrupted run"},
       {"--restart-anyway", {}, {},
-       "restart even when the checkpoint's case differs from this one beyond run control\n(particle counts, materials, walls, settings: refused otherwise, with the keys)",
-       /*repeatable=*/false, /*choices=*/{}, /*for_pipeline=*/false},
+       "restart even when the checkpoint's case differs from this one beyond run control\n(particle counts, materials, walls, settings: refused otherwise, with the keys)"},
       {"--threads", {}, "N", "OpenMP threads (default: dem.threads, then all cores); results do not\ndepend on it"},
       {"--output", {}, "DIR", "write the outputs here instead of <output.directory>/dem",
        /*repeatable=*/false, /*choices=*/{}, /*for_pipeline=*/false}};

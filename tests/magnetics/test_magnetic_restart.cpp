@@ -196,7 +196,9 @@ TEST_P(MagneticRestart, ContinuesBitIdentically)
   EXPECT_GT(o.list_rebuilds, 1);
   // (With the hard cutoff the slab tail is on in this slab, and it has no local version.)
   if (std::string(mode) != "absolute" && std::string(far_field) != "none")
+  {
     EXPECT_GT(o.local_refreshes, 0);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(

@@ -537,6 +537,7 @@ void DemSystem::write_checkpoint(const std::string &path, const CheckpointIdenti
   out.put_array(y0_);
   out.put_array(z0_);
   out.put(rebuilds_);
+  out.put<std::uint8_t>(force_rebuild_); // a rebuild requested for the next step
   list_.write_history(out);
   wall_slots_.write(out);
   // Each force term's own state, framed by its name so that a restart under a different set
@@ -572,6 +573,7 @@ void DemSystem::read_checkpoint(const std::string &path)
   in.get_array(y0);
   in.get_array(z0);
   const long rebuilds = in.get<long>();
+  const bool rebuild_requested = in.get<std::uint8_t>() != 0;
   const std::size_t n = particles_.size();
   for (const auto *a : checkpoint_arrays(particles_, forces_))
     if (a->size() != n)
@@ -598,6 +600,7 @@ void DemSystem::read_checkpoint(const std::string &path)
     in.fail("does not reproduce its neighbour list (the particles were re-sorted): restart with the "
             "magbrush that wrote it");
   rebuilds_ = rebuilds;
+  force_rebuild_ = rebuild_requested;
   list_.read_history(in);
   wall_slots_.read(in);
   const auto n_terms = in.get<std::uint64_t>();

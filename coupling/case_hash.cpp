@@ -36,7 +36,9 @@ std::vector<std::pair<std::string, std::string>> field_inputs(const Case &c, Fie
   return inputs;
 }
 
-std::string field_hash(const Case &c, FieldKind k)
+namespace {
+// FNV-1a 64 of a tag line and "key=value" lines, as 16 hex digits.
+std::string digest(const std::string &tag, const std::vector<std::pair<std::string, std::string>> &inputs)
 {
   std::uint64_t h = 1469598103934665603ull; // FNV-1a 64 offset basis
   const auto feed = [&](const std::string &s) {
@@ -46,12 +48,28 @@ std::string field_hash(const Case &c, FieldKind k)
       h *= 1099511628211ull; // FNV prime
     }
   };
-  feed(k == FieldKind::magnetic ? "magnetic-v1\n" : "electric-v1\n");
-  for (const auto &[key, value] : field_inputs(c, k))
+  feed(tag);
+  for (const auto &[key, value] : inputs)
     feed(key + "=" + value + "\n");
   char b[17];
   std::snprintf(b, sizeof(b), "%016llx", static_cast<unsigned long long>(h));
   return b;
 }
+} // namespace
+
+std::string field_hash(const Case &c, FieldKind k)
+{
+  return digest(k == FieldKind::magnetic ? "magnetic-v1\n" : "electric-v1\n", field_inputs(c, k));
+}
+
+std::vector<std::pair<std::string, std::string>> case_inputs(const Case &c)
+{
+  std::vector<std::pair<std::string, std::string>> inputs;
+  for (const auto &e : resolved_entries(c))
+    inputs.emplace_back(e.path, e.exact);
+  return inputs;
+}
+
+std::string case_hash(const Case &c) { return digest("case-v1\n", case_inputs(c)); }
 
 } // namespace magbrush

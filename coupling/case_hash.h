@@ -1,6 +1,7 @@
 // Which case inputs a stored field depends on, and a stable digest of them. A field file
 // records the hash; a stage regenerates the field only when the hash of the current case
-// differs (and can say which key changed by comparing field_inputs()).
+// differs (and can say which key changed by comparing field_inputs()). The same for the
+// whole case (case_inputs), which a DEM checkpoint records.
 #pragma once
 
 #include "coupling/case_model.h"
@@ -24,5 +25,11 @@ std::vector<std::pair<std::string, std::string>> field_inputs(const Case &c, Fie
 
 // FNV-1a 64-bit digest of field_inputs as 16 hex digits.
 std::string field_hash(const Case &c, FieldKind k);
+
+// Every resolved input of the case, "key path" -> value (SI, full precision), in schema
+// order: the identity of a case, which a DEM checkpoint carries (dem/checkpoint_file.h).
+std::vector<std::pair<std::string, std::string>> case_inputs(const Case &c);
+// FNV-1a 64-bit digest of case_inputs as 16 hex digits.
+std::string case_hash(const Case &c);
 
 } // namespace magbrush

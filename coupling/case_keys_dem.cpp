@@ -15,7 +15,12 @@ std::vector<KeySpec> dem_keys()
       number("dem.time_step_safety", "Automatic step = this x Rayleigh time.").def("0.2").positive().max(1.0),
       quantity("dem.duration", D::time, "Simulated time.").def("0 s").non_negative(),
       quantity("dem.output_interval", D::time, "Snapshot interval (0 = only at the end).").def("0 s").non_negative(),
-      quantity("dem.checkpoint_interval", D::time, "Checkpoint interval (0 = only at the end).").def("0 s").non_negative(),
+      quantity("dem.checkpoint_interval", D::time,
+               "Simulated time between checkpoints (0 = only at the end). Each one is written atomically and the one before it is kept (checkpoint.previous.bin); writing one changes nothing in the run (dem/README.md).")
+          .def("250 us").non_negative(),
+      quantity("dem.checkpoint_wall_interval", D::time,
+               "Wall-clock time between checkpoints besides dem.checkpoint_interval (0 = none), so that a crash or a kill loses at most this much work; the results do not depend on it.")
+          .def("10 min").non_negative(),
       quantity("dem.periodic_length", D::length, "Periodic slab length along the roller axis z (0 = none).").def("0 mm").non_negative(),
       quantity("dem.periodic_length_x", D::length, "Periodic length along x (0 = none).").def("0 mm").non_negative(),
       quantity("dem.periodic_length_y", D::length, "Periodic length along y (0 = none).").def("0 mm").non_negative(),

@@ -196,7 +196,8 @@ struct DemSettings
   double time_step_safety = 0.2;     // auto step = safety × Rayleigh time
   double duration = 0.0;             // simulated time [s]
   double output_interval = 0.0;      // snapshot interval [s]
-  double checkpoint_interval = 0.0;  // [s] (0 = only at the end)
+  double checkpoint_interval = 250e-6; // simulated time between checkpoints [s] (0 = only at the end)
+  double checkpoint_wall_interval = 600.0; // wall-clock time between checkpoints [s] (0 = none)
   double periodic_length = 0.0;      // slab length along the roller axis z [m] (0 = none)
   double periodic_length_x = 0.0;    // optional periodic length along x [m]
   double periodic_length_y = 0.0;    // optional periodic length along y [m]

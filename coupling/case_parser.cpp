@@ -1025,6 +1025,7 @@ private:
     d.duration = q(s, "duration");
     d.output_interval = q(s, "output_interval");
     d.checkpoint_interval = q(s, "checkpoint_interval");
+    d.checkpoint_wall_interval = q(s, "checkpoint_wall_interval");
     d.periodic_length = q(s, "periodic_length");
     d.periodic_length_x = q(s, "periodic_length_x");
     d.periodic_length_y = q(s, "periodic_length_y");

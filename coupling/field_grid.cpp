@@ -375,12 +375,25 @@ struct Writer
     check(H5Awrite(attr, H5T_NATIVE_INT, &value), "attribute " + name);
   }
 
+  // Every dataset is chunked with HDF5's Fletcher-32 checksum filter, so that a value damaged
+  // on disk fails the read instead of entering a run (docs/field_grid_format.md). A chunk
+  // holds whole rows, at most about 1 MiB.
   void dataset(hid_t group, const std::string &name, const std::vector<double> &data,
                const std::vector<hsize_t> &dims, const std::string &units) const
   {
     Handle space(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr), H5Sclose);
-    Handle set(H5Dcreate2(group, name.c_str(), H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT,
-                          H5P_DEFAULT),
+    Handle dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+    hsize_t row = 1;
+    for (size_t d = 1; d < dims.size(); ++d)
+      row *= dims[d];
+    std::vector<hsize_t> chunk = dims;
+    if (!dims.empty() && !data.empty())
+    {
+      chunk[0] = std::max<hsize_t>(1, std::min<hsize_t>(dims[0], (hsize_t{1} << 17) / std::max<hsize_t>(row, 1)));
+      check(H5Pset_chunk(dcpl, static_cast<int>(chunk.size()), chunk.data()), "dataset " + name + " (chunks)");
+      check(H5Pset_fletcher32(dcpl), "dataset " + name + " (Fletcher-32 filter)");
+    }
+    Handle set(H5Dcreate2(group, name.c_str(), H5T_IEEE_F64LE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT),
                H5Dclose);
     if (!set.valid())
       check(-1, "dataset " + name);
@@ -444,7 +457,11 @@ void write_atomically(const std::string &path, Fill fill)
   AtomicFile file(path);
   QuietHdf5 quiet;
   {
-    Handle h5(H5Fcreate(file.temp_path().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
+    // The 1.8 object-header format checksums the metadata (the attributes: provenance, grid
+    // layout) as the filter does the values.
+    Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+    H5Pset_libver_bounds(fapl, H5F_LIBVER_V18, H5F_LIBVER_LATEST);
+    Handle h5(H5Fcreate(file.temp_path().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl), H5Fclose);
     if (!h5.valid())
       throw FieldGridError("file " + path + ": cannot create '" + file.temp_path() +
                            "' (does the directory exist and is it writable?)");
@@ -689,10 +706,24 @@ struct Reader
     size_t count = 1;
     for (hsize_t d : dims)
       count *= d;
+    if (count > 0 && !has_checksum(set))
+      fail("dataset " + full + " carries no Fletcher-32 checksum (every format_version " +
+           std::to_string(field_grid_format_version) +
+           " dataset does): the file was not written by this magbrush; regenerate it with `magbrush field CASE`");
     std::vector<double> data(count);
     if (count > 0 && H5Dread(set, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()) < 0)
-      fail("cannot read dataset " + full);
+      fail("dataset " + full + " is damaged: its Fletcher-32 checksum does not match its values (the file "
+           "changed on disk after it was written); regenerate it with `magbrush field CASE`");
     return data;
+  }
+
+  static bool has_checksum(hid_t set)
+  {
+    Handle dcpl(H5Dget_create_plist(set), H5Pclose);
+    unsigned flags = 0;
+    size_t n_values = 0;
+    return dcpl.valid() &&
+           H5Pget_filter_by_id2(dcpl, H5Z_FILTER_FLETCHER32, &flags, &n_values, nullptr, 0, nullptr, nullptr) >= 0;
   }
 
   // The axis must be the uniform one the attributes describe (strictly increasing).

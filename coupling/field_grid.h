@@ -227,7 +227,9 @@ struct ElectricGridFile
 // File format
 
 inline constexpr const char *field_grid_format_name = "magbrush-field-grid";
-inline constexpr int field_grid_format_version = 1;
+// Version 2: every dataset carries HDF5's Fletcher-32 checksum, the metadata the 1.8 object
+// headers' checksums; a version 1 file is refused ("regenerate").
+inline constexpr int field_grid_format_version = 2;
 
 // Write atomically: a temporary file next to `path` first (common/atomic_file.h), renamed onto
 // `path` only when complete. On failure (unwritable directory, invalid grid, ...) throws

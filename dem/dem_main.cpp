@@ -29,6 +29,7 @@ int run_engine(const magbrush::cli::ParsedArguments &args)
 {
   magbrush::dem::RunOptions options;
   options.restart_file = args.value("--restart");
+  options.restart_anyway = args.has("--restart-anyway");
   options.output_dir = args.value("--output");
   if (args.has("--threads"))
     options.threads = static_cast<int>(args.whole_number("--threads", 0, 1, 1024));

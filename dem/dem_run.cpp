@@ -3,6 +3,9 @@
 
 #include "dem/run_summary.h"
 #include "dem/openmp_waiting.h"
+#include "dem/restart_check.h"
+
+#include "coupling/case_hash.h"
 
 #include <omp.h>
 
@@ -11,6 +14,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <ostream>
+#include <stdexcept>
 
 namespace magbrush::dem {
 
@@ -26,9 +30,51 @@ DemRun::DemRun(const Case &c, const RunOptions &options, std::ostream &log)
   fs::create_directories(out_dir_);
   system_ = std::make_unique<DemSystem>(case_);
   force_terms_ = add_case_force_terms(*system_, case_);
+  identity_.case_hash = case_hash(case_);
+  identity_.inputs = case_inputs(case_);
 }
 
 std::string DemRun::checkpoint_path() const { return (fs::path(out_dir_) / "checkpoint.bin").string(); }
+
+// The checkpoint must be the state of this case: only run control may differ, unless the user
+// said --restart-anyway (restart_check.h). The file's checksum is verified on the way.
+void DemRun::check_restart_case() const
+{
+  const CheckpointIdentity written = CheckpointReader(options_.restart_file).identity();
+  const std::vector<CaseDifference> differences = case_differences(written, identity_);
+  std::vector<CaseDifference> scene, control;
+  for (const CaseDifference &d : differences)
+    (d.run_control ? control : scene).push_back(d);
+  if (!control.empty())
+    log_ << "restart: run control changed since the checkpoint (the state continues):\n" << describe(control);
+  if (scene.empty())
+    return;
+  if (!options_.restart_anyway)
+    throw std::runtime_error("checkpoint '" + options_.restart_file + "' was written by case hash " + written.case_hash +
+                             ", this case has " + identity_.case_hash + "; they differ in " +
+                             std::to_string(scene.size()) + (scene.size() == 1 ? " key" : " keys") +
+                             " beyond run control:\n" + describe(scene) +
+                             "restart with the case that wrote it, or pass --restart-anyway to continue its "
+                             "state under this case (the run is then not a continuation of the one that wrote it)");
+  log_ << "restart anyway (--restart-anyway): the checkpoint's case differs in\n" << describe(scene);
+}
+
+// Atomically, keeping the one before it.
+void DemRun::write_checkpoint()
+{
+  if (system_->step_count() == last_checkpoint_step_)
+    return; // (the end fell on an interval: written already)
+  last_checkpoint_step_ = system_->step_count();
+  const std::string path = checkpoint_path();
+  keep_previous_checkpoint(path);
+  system_->write_checkpoint(path, identity_);
+  ++checkpoints_;
+  char line[256];
+  std::snprintf(line, sizeof line, "checkpoint at t = %.6g s (step %ld): %s\n", system_->time(),
+                system_->step_count(), path.c_str());
+  log_ << line;
+  log_.flush();
+}
 
 void DemRun::log_setup() const
 {
@@ -115,6 +161,7 @@ void DemRun::run()
   const bool restart = !options_.restart_file.empty();
   if (restart)
   {
+    check_restart_case();
     s.read_checkpoint(options_.restart_file);
     log_ << "restarted from '" << options_.restart_file << "' at step " << s.step_count() << ", t = " << s.time()
          << " s\n";
@@ -155,6 +202,10 @@ void DemRun::run()
   for (const auto &m : measurements_)
     sample_every.push_back(std::max(1L, std::lround(m->interval() / dt)));
   double last_progress = omp_get_wtime();
+  // Wall-clock checkpoints: a checkpoint leaves the run's bits alone, so taking one at a
+  // moment set by the clock keeps the results independent of the machine's speed.
+  const double wall_every = case_.dem.checkpoint_wall_interval;
+  double last_checkpoint_wall = omp_get_wtime();
   try
   {
     while (s.step_count() < end_step)
@@ -180,8 +231,12 @@ void DemRun::run()
       for (std::size_t m = 0; m < measurements_.size(); ++m)
         if (k % sample_every[m] == 0)
           measurements_[m]->sample(s);
-      if (ckpt_every > 0 && k % ckpt_every == 0)
-        s.write_checkpoint(checkpoint_path());
+      const bool wall_due = wall_every > 0.0 && omp_get_wtime() - last_checkpoint_wall >= wall_every;
+      if ((ckpt_every > 0 && k % ckpt_every == 0) || wall_due)
+      {
+        write_checkpoint();
+        last_checkpoint_wall = omp_get_wtime();
+      }
       const double now = omp_get_wtime();
       if (now - last_progress >= options_.progress_interval)
       {
@@ -203,9 +258,11 @@ void DemRun::run()
   {
     log_ << e.what() << "\n";
     if (fs::exists(checkpoint_path()))
-      log_ << "the last good checkpoint is kept: " << checkpoint_path() << " (restart from it with --restart)\n";
+      log_ << "the last good checkpoint is kept: " << checkpoint_path() << " (restart from it with --restart; the one "
+           << "before it: " << previous_checkpoint_path(checkpoint_path()) << ")\n";
     else
-      log_ << "no checkpoint was written before the failure (set dem.checkpoint_interval to keep one)\n";
+      log_ << "no checkpoint was written before the failure (dem.checkpoint_interval and "
+              "dem.checkpoint_wall_interval set how often one is)\n";
     write_measurements();
     log_timings(omp_get_wtime() - t_wall0);
     throw;
@@ -214,7 +271,7 @@ void DemRun::run()
     snapshots.write(s);
   if (s.step_count() % series_every != 0)
     series.record(s);
-  s.write_checkpoint(checkpoint_path());
+  write_checkpoint();
   write_measurements();
   const double wall = omp_get_wtime() - t_wall0;
   char line[256];
@@ -223,7 +280,8 @@ void DemRun::run()
                 static_cast<double>(s.step_count() - start_step) * static_cast<double>(s.particles().size()) / std::max(wall, 1e-9),
                 s.neighbour_rebuilds());
   log_ << line;
-  log_ << "outputs: " << out_dir_ << "/{particles.xdmf, snapshots/, time_series.csv, checkpoint.bin}\n";
+  log_ << "outputs: " << out_dir_ << "/{particles.xdmf, snapshots/, time_series.csv, checkpoint.bin, "
+       << "checkpoint.previous.bin}\n";
   log_timings(wall);
 }
 

@@ -5,9 +5,15 @@
 //
 // or, with a checkpoint, restart at its step and continue bit-identically. The run owns the
 // outputs: <output.directory>/dem/{particles.xdmf, snapshots/, time_series.csv,
-// checkpoint.bin}.
+// checkpoint.bin, checkpoint.previous.bin}.
+//
+// Checkpoints are written every dem.checkpoint_interval of simulated time, every
+// dem.checkpoint_wall_interval of wall time and at the end; each replaces checkpoint.bin
+// atomically and the one before it is kept as checkpoint.previous.bin. A restart checks that
+// the checkpoint was written by this case (restart_check.h).
 #pragma once
 
+#include "dem/checkpoint_file.h"
 #include "dem/dem_system.h"
 #include "dem/force_terms/force_term_registry.h"
 #include "dem/measurement.h"
@@ -25,6 +31,7 @@ namespace magbrush::dem {
 struct RunOptions
 {
   std::string restart_file;  // continue from this checkpoint ("" = fresh run)
+  bool restart_anyway = false; // restart even when the checkpoint's case differs beyond run control
   std::string output_dir;    // "" = <case.output.directory>/dem
   int threads = 0;           // 0 = case.dem.threads, then the OpenMP default
   double progress_interval = 5.0; // seconds of wall time between progress lines
@@ -51,6 +58,8 @@ public:
 
   const std::string &output_dir() const { return out_dir_; }
   std::string checkpoint_path() const;
+  // Checkpoints written by this run so far.
+  long checkpoints_written() const { return checkpoints_; }
 
 private:
   Case case_;
@@ -60,7 +69,12 @@ private:
   std::unique_ptr<DemSystem> system_;
   std::vector<std::unique_ptr<Measurement>> measurements_;
   std::vector<ForceTermChoice> force_terms_;
+  CheckpointIdentity identity_; // of case_, written into every checkpoint
+  long checkpoints_ = 0;
+  long last_checkpoint_step_ = -1;
 
+  void check_restart_case() const;
+  void write_checkpoint();
   void log_setup() const;
   void log_timings(double wall) const;
   void write_measurements() const;

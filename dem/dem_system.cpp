@@ -534,9 +534,11 @@ auto checkpoint_arrays(State &s, Forces &f)
 }
 } // namespace
 
-void DemSystem::write_checkpoint(const std::string &path)
+void DemSystem::write_checkpoint(const std::string &path) { write_checkpoint(path, CheckpointIdentity{}); }
+
+void DemSystem::write_checkpoint(const std::string &path, const CheckpointIdentity &identity)
 {
-  CheckpointWriter out(path);
+  CheckpointWriter out(path, identity);
   out.put(step_);
   out.put(time_);
   out.put(dt_);
@@ -547,6 +549,14 @@ void DemSystem::write_checkpoint(const std::string &path)
   out.put_array(particles_.species);
   out.put_array(particles_.id);
   out.put_array(contact_count_);
+  // The positions the neighbour list was built from: a restart builds the same list from
+  // them (the same pairs in the same order), so that writing a checkpoint changes nothing in
+  // the run that writes it — a checkpoint taken at a wall-clock moment leaves the bits alone.
+  out.put_array(x0_);
+  out.put_array(y0_);
+  out.put_array(z0_);
+  out.put(rebuilds_);
+  out.put<std::uint8_t>(force_rebuild_); // a rebuild requested for the next step
   list_.write_history(out);
   wall_slots_.write(out);
   // Each force term's own state, framed by its name so that a restart under a different set
@@ -559,9 +569,6 @@ void DemSystem::write_checkpoint(const std::string &path)
     term->write_state(out);
   }
   out.commit();
-  // Both this run and a run restarted from the file rebuild the list at the next step, so
-  // that they continue through identical lists.
-  force_rebuild_ = true;
 }
 
 void DemSystem::read_checkpoint(const std::string &path)
@@ -580,10 +587,39 @@ void DemSystem::read_checkpoint(const std::string &path)
   in.get_array(particles_.species);
   in.get_array(particles_.id);
   in.get_array(contact_count_);
+  std::vector<double> x0, y0, z0;
+  in.get_array(x0);
+  in.get_array(y0);
+  in.get_array(z0);
+  const long rebuilds = in.get<long>();
+  const bool rebuild_requested = in.get<std::uint8_t>() != 0;
+  const std::size_t n = particles_.size();
+  for (const auto *a : checkpoint_arrays(particles_, forces_))
+    if (a->size() != n)
+      in.fail("is corrupt (particle arrays of different lengths)");
+  if (particles_.species.size() != n || particles_.id.size() != n || contact_count_.size() != n ||
+      x0.size() != n || y0.size() != n || z0.size() != n)
+    in.fail("is corrupt (particle arrays of different lengths)");
   // Derived set-up (contact table, time-step check, skin) as for a fresh run, then the state.
   const ForceBuffers saved_forces = forces_;
   const std::vector<std::int32_t> saved_counts = contact_count_;
   setup_derived();
+  // The neighbour list of the run that wrote the file, built again from the positions it was
+  // built from. The particles are already in that build's cell order, so the build's stable
+  // re-sort leaves them in place (checked: a changed order would continue differently).
+  std::swap(particles_.x, x0);
+  std::swap(particles_.y, y0);
+  std::swap(particles_.z, z0);
+  const std::vector<std::int32_t> ids = particles_.id;
+  rebuild_neighbour_list();
+  std::swap(particles_.x, x0);
+  std::swap(particles_.y, y0);
+  std::swap(particles_.z, z0);
+  if (particles_.id != ids) // (x0_ … now hold the build positions again, as in the writer)
+    in.fail("does not reproduce its neighbour list (the particles were re-sorted): restart with the "
+            "magbrush that wrote it");
+  rebuilds_ = rebuilds;
+  force_rebuild_ = rebuild_requested;
   list_.read_history(in);
   wall_slots_.read(in);
   const auto n_terms = in.get<std::uint64_t>();
@@ -605,10 +641,6 @@ void DemSystem::read_checkpoint(const std::string &path)
   time_ = time;
   guards_.set_last_energy(last_energy);
   dt_ = dt;
-  x0_ = particles_.x; // drift reference; the list is rebuilt at the next step anyway
-  y0_ = particles_.y;
-  z0_ = particles_.z;
-  force_rebuild_ = true;
   initialized_ = true;
 }
 

@@ -36,6 +36,8 @@
 
 namespace magbrush::dem {
 
+struct CheckpointIdentity;
+
 // Wall time spent in each phase of the step [s].
 struct PhaseTimes
 {
@@ -105,8 +107,10 @@ public:
   std::size_t memory_bytes() const;   // particle, list, history and wall-slot storage
 
   // Checkpoint: the complete dynamic state (particles in their current order, forces,
-  // neighbour list with contact history, wall slots, clock). Written atomically.
+  // neighbour list with contact history, wall slots, clock, each force term's own state),
+  // with the identity of the case that wrote it (checkpoint_file.h). Written atomically.
   void write_checkpoint(const std::string &path);
+  void write_checkpoint(const std::string &path, const CheckpointIdentity &identity);
   // Replaces the state by the checkpoint's; the case must be the same scene.
   void read_checkpoint(const std::string &path);
 

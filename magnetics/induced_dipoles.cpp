@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -186,7 +187,8 @@ void InducedDipoles::update_cells(const BeadArrays &beads, double radius_sum, Ma
   if (!list.built() || list.particle_count() != n ||
       list.max_displacement(n, beads.x, beads.y, beads.z) > 0.5 * skin)
   {
-    far_->build(n, beads.x, beads.y, beads.z, settings_.far_cell_diameters * mean_diameter);
+    far_cell_size_ = settings_.far_cell_diameters * mean_diameter;
+    far_->build(n, beads.x, beads.y, beads.z, far_cell_size_);
     list.set_pairs(n, beads.x, beads.y, beads.z, box_, 0.0,
                    std::vector<MagneticNeighbourList::Pair>(far_->near_pairs()));
     stats.list_rebuilt = true;
@@ -580,6 +582,89 @@ void InducedDipoles::reevaluate_local_forces(const BeadArrays &beads, MagneticSt
     stats.corrected_pairs += correction_.evaluate_list_force(state, k);
   for (const std::uint32_t b : local_.gathered())
     gather_bead(b);
+}
+
+// ---------------------------------------------------------------------------------------
+// Restart.
+
+namespace {
+// Every setting, printed exactly: held state is restored only under the same settings.
+std::string settings_fingerprint(const MagneticSettings &s)
+{
+  std::string f;
+  auto add = [&f](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.17g ", v);
+    f += buf;
+  };
+  for (double v : {static_cast<double>(s.model), static_cast<double>(s.torque), s.cutoff_diameters,
+                   s.cutoff_length, s.skin_fraction, s.tolerance, static_cast<double>(s.max_sweeps),
+                   s.refresh_interval, s.staleness_fraction, static_cast<double>(s.staleness_mode),
+                   s.local_region_limit, s.local_region_radius, s.local_batch_fraction, s.local_dipole_change,
+                   s.relative_check_radius, s.absolute_factor, s.switch_begin, s.switch_end,
+                   static_cast<double>(s.slab_tail_correction), static_cast<double>(s.far_field),
+                   s.far_cell_diameters, static_cast<double>(s.far_order), static_cast<double>(s.far_near_reach),
+                   static_cast<double>(s.far_passes), static_cast<double>(s.far_single_precision)})
+    add(v);
+  return f;
+}
+} // namespace
+
+void InducedDipoles::write_state(StateOut &out) const
+{
+  out.put_string(settings_fingerprint(settings_));
+  out.put(box_);
+  out.put<std::uint8_t>(computed_);
+  out.put<std::uint8_t>(zero_field_);
+  out.put(skin_);
+  out.put(far_cell_size_);
+  for (const auto *v : {&beta_, &Ms_, &B0_, &gradB0_, &p_, &p_next_, &B_local_, &B_far_, &gradB_far_, &force_, &torque_})
+    out.put_array(*v);
+  near_.write_state(out);
+  pair_forces_.write_state(out);
+  correction_.write_state(out);
+  out.put<std::uint8_t>(correction_.has_tables());
+  staleness_.write_state(out);
+  if (tail_)
+    tail_->write_state(out);
+}
+
+bool InducedDipoles::read_state(StateIn &in)
+{
+  if (in.get_string() != settings_fingerprint(settings_) || in.get<std::array<double, 3>>() != box_)
+    return false;
+  computed_ = in.get<std::uint8_t>() != 0;
+  zero_field_ = in.get<std::uint8_t>() != 0;
+  skin_ = in.get<double>();
+  far_cell_size_ = in.get<double>();
+  for (auto *v : {&beta_, &Ms_, &B0_, &gradB0_, &p_, &p_next_, &B_local_, &B_far_, &gradB_far_, &force_, &torque_})
+    in.get_array(*v);
+  near_.read_state(in);
+  pair_forces_.read_state(in);
+  correction_.read_state(in);
+  if (in.get<std::uint8_t>() != 0)
+    correction_.prepare_tables(beta_);
+  staleness_.read_state(in);
+  if (tail_)
+    tail_->read_state(in);
+  // The far field's cells: built from the positions the near list was built from, they are
+  // the cells of the run that wrote the state (a build depends on those positions and the
+  // cell size only; the next evaluation moves the beads within them or rebuilds).
+  const MagneticNeighbourList &list = near_.list();
+  if (far_ && list.built() && list.particle_count() > 0 && far_cell_size_ > 0.0)
+  {
+    const std::vector<double> &xr = list.reference_positions();
+    const std::size_t n = list.particle_count();
+    std::vector<double> x(n), y(n), z(n);
+    for (std::size_t b = 0; b < n; ++b)
+    {
+      x[b] = xr[3 * b];
+      y[b] = xr[3 * b + 1];
+      z[b] = xr[3 * b + 2];
+    }
+    far_->build(n, x.data(), y.data(), z.data(), far_cell_size_);
+  }
+  return true;
 }
 
 } // namespace magbrush::magnetics

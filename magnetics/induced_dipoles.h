@@ -27,6 +27,8 @@
 // everything, and add_held_forces() adds the forces of the last evaluation.
 #pragma once
 
+#include "common/state_stream.h"
+
 #include "magnetics/bead_arrays.h"
 #include "magnetics/cell_multipole_field.h"
 #include "magnetics/jacobi_solver.h"
@@ -125,6 +127,16 @@ public:
   // and reference positions follow, and the neighbour list is rebuilt at the next compute.
   void particles_reordered(const std::vector<std::int32_t> &order);
 
+  // Restart (common/state_stream.h): everything a later evaluation or local refresh reads —
+  // the held forces, the dipoles (the next solve's start), the fields, the near pairs and
+  // their stored forces, the staleness references — so that a restarted run continues bit
+  // for bit. The far field's cells are rebuilt from the near list's reference positions
+  // (the positions they were built from: the same cells). The state opens with the
+  // settings; read_state() returns false and restores nothing when they differ from these
+  // (the next evaluation then starts afresh).
+  void write_state(StateOut &out) const;
+  bool read_state(StateIn &in);
+
   const MagneticSettings &settings() const { return settings_; }
   // relative: the pairs whose relative displacement is watched.
   std::size_t watched_pairs() const { return staleness_.close_pairs().size(); }
@@ -158,6 +170,7 @@ private:
   bool computed_ = false;
   bool zero_field_ = false; // the last compute() found no applied field at any bead
   double skin_ = 0.0;       // Verlet skin of the last compute [m]
+  double far_cell_size_ = 0.0; // fine cell size of the last far-field build [m]
 
   // compute(), step by step.
   void set_materials(const BeadArrays &beads);

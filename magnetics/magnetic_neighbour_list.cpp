@@ -234,4 +234,32 @@ double MagneticNeighbourList::max_displacement(std::size_t n, const double *x,
   return std::sqrt(max2);
 }
 
+// ---------------------------------------------------------------------------------------
+// Restart: the list as built (its pairs refer to the reference positions, which decide when
+// it expires), so that a restarted run rebuilds it at the same step as the run that wrote it.
+
+void MagneticNeighbourList::write_state(StateOut &out) const
+{
+  out.put<std::uint8_t>(built_);
+  out.put(list_radius_);
+  out.put(box_);
+  out.put_array(x_ref_);
+  out.put_array(pairs_);
+  out.put_array(incident_begin_);
+  out.put_array(incident_pair_);
+  out.put_array(incident_first_);
+}
+
+void MagneticNeighbourList::read_state(StateIn &in)
+{
+  built_ = in.get<std::uint8_t>() != 0;
+  list_radius_ = in.get<double>();
+  box_ = in.get<std::array<double, 3>>();
+  in.get_array(x_ref_);
+  in.get_array(pairs_);
+  in.get_array(incident_begin_);
+  in.get_array(incident_pair_);
+  in.get_array(incident_first_);
+}
+
 } // namespace magbrush::magnetics

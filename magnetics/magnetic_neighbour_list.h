@@ -17,6 +17,8 @@
 // never on the number of threads.
 #pragma once
 
+#include "common/state_stream.h"
+
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -88,6 +90,8 @@ public:
   double list_radius() const { return list_radius_; }
   const std::array<double, 3> &box() const { return box_; }
   const std::vector<Pair> &pairs() const { return pairs_; }
+  // The positions at build time (x, y, z interleaved), the reference of max_displacement.
+  const std::vector<double> &reference_positions() const { return x_ref_; }
 
   // Incidence of the pairs on the beads (CSR): the pairs touching bead b are
   //   incident_pair[incident_begin[b] .. incident_begin[b+1]), in increasing pair order,
@@ -96,6 +100,10 @@ public:
   const std::vector<std::size_t> &incident_begin() const { return incident_begin_; }
   const std::vector<std::uint32_t> &incident_pair() const { return incident_pair_; }
   const std::vector<std::uint8_t> &incident_first() const { return incident_first_; }
+
+  // Restart (common/state_stream.h): everything above, exactly.
+  void write_state(StateOut &out) const;
+  void read_state(StateIn &in);
 
 private:
   bool built_ = false;

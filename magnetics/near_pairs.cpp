@@ -117,4 +117,33 @@ void NearPairs::add_list_field(std::size_t b, const std::vector<double> &p, doub
   }
 }
 
+void NearPairs::write_state(StateOut &out) const
+{
+  list_.write_state(out);
+  out.put(cutoff_);
+  out.put_array(tensor_);
+  out.put_array(r_);
+  out.put_array(active_);
+  out.put<std::uint8_t>(!row_entry_.empty() && row_entry_.size() == 2 * list_.pairs().size());
+}
+
+void NearPairs::read_state(StateIn &in)
+{
+  list_.read_state(in);
+  cutoff_ = in.get<double>();
+  in.get_array(tensor_);
+  in.get_array(r_);
+  in.get_array(active_);
+  if (tensor_.size() != list_.pairs().size() || r_.size() != 3 * tensor_.size() || active_.size() != tensor_.size())
+    in.fail("is corrupt (magnetic near pairs: " + std::to_string(list_.pairs().size()) + " pairs, " +
+            std::to_string(tensor_.size()) + " tensors)");
+  const bool rows = in.get<std::uint8_t>() != 0;
+  row_begin_.clear();
+  row_other_.clear();
+  row_tensor_.clear();
+  row_entry_.clear();
+  if (rows)
+    build_rows(); // copies of the tensors, in the list's incidence order
+}
+
 } // namespace magbrush::magnetics

@@ -12,6 +12,8 @@
 // threads.
 #pragma once
 
+#include "common/state_stream.h"
+
 #include "magnetics/bead_arrays.h"
 #include "magnetics/dipole_physics.h"
 #include "magnetics/magnetic_neighbour_list.h"
@@ -51,6 +53,11 @@ public:
 
   // Forget the pairs (the caller re-sorted its beads: pair indices refer to the old order).
   void forget() { list_ = MagneticNeighbourList(); }
+
+  // Restart (common/state_stream.h): the list, the tensors and flags; the rows are rebuilt
+  // from the tensors (copies of them).
+  void write_state(StateOut &out) const;
+  void read_state(StateIn &in);
 
 private:
   MagneticNeighbourList list_;

@@ -37,4 +37,8 @@ void PairForces::scale(double ratio2)
     x *= ratio2;
 }
 
+void PairForces::write_state(StateOut &out) const { out.put_array(force_); }
+
+void PairForces::read_state(StateIn &in) { in.get_array(force_); }
+
 } // namespace magbrush::magnetics

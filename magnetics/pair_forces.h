@@ -9,6 +9,8 @@
 // pair is added to the same stored force.
 #pragma once
 
+#include "common/state_stream.h"
+
 #include "magnetics/near_pairs.h"
 #include "magnetics/two_sphere_correction.h"
 
@@ -34,6 +36,10 @@ public:
   }
   // The applied field was scaled by `ratio`: forces by ratio².
   void scale(double ratio2);
+
+  // Restart (common/state_stream.h): everything above, exactly.
+  void write_state(StateOut &out) const;
+  void read_state(StateIn &in);
 
 private:
   std::vector<double> force_; // per pair: the force on its j bead

@@ -105,4 +105,29 @@ void SlabTail::scale(double ratio)
       x *= ratio;
 }
 
+void SlabTail::write_state(StateOut &out) const
+{
+  out.put(normal_axis_);
+  out.put(area_);
+  out.put(cutoff_);
+  out.put_array(order_);
+  out.put_array(lo_);
+  out.put_array(hi_);
+  for (const auto *v : {&u_, &S0_, &S1_, &S2_, &B_, &dB_})
+    out.put_array(*v);
+}
+
+void SlabTail::read_state(StateIn &in)
+{
+  if (in.get<int>() != normal_axis_)
+    in.fail("holds a slab tail along another axis than this run's: restart with the case that wrote it");
+  area_ = in.get<double>();
+  cutoff_ = in.get<double>();
+  in.get_array(order_);
+  in.get_array(lo_);
+  in.get_array(hi_);
+  for (auto *v : {&u_, &S0_, &S1_, &S2_, &B_, &dB_})
+    in.get_array(*v);
+}
+
 } // namespace magbrush::magnetics

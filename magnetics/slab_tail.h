@@ -16,6 +16,8 @@
 // evaluation and every sweep takes prefix sums of the sheet moments q, q u and q u².
 #pragma once
 
+#include "common/state_stream.h"
+
 #include "magnetics/bead_arrays.h"
 
 #include <array>
@@ -44,6 +46,10 @@ public:
 
   // The dipoles were scaled by `ratio` (a linear ramp of the applied field).
   void scale(double ratio);
+
+  // Restart (common/state_stream.h): everything above, exactly.
+  void write_state(StateOut &out) const;
+  void read_state(StateIn &in);
 
 private:
   std::array<double, 3> box_;

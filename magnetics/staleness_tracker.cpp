@@ -145,4 +145,28 @@ void StalenessTracker::particles_reordered(const std::vector<std::int32_t> &orde
   close_of_pair_.clear();
 }
 
+void StalenessTracker::write_state(StateOut &out) const
+{
+  out.put_array(x_last_);
+  out.put(t_last_);
+  out.put_array(limit2_);
+  out.put_array(inv_radius2_);
+  out.put_array(close_);
+  out.put_array(close_of_pair_);
+  out.put(min_radius_);
+  out.put(max_radius_);
+}
+
+void StalenessTracker::read_state(StateIn &in)
+{
+  in.get_array(x_last_);
+  t_last_ = in.get<double>();
+  in.get_array(limit2_);
+  in.get_array(inv_radius2_);
+  in.get_array(close_);
+  in.get_array(close_of_pair_);
+  min_radius_ = in.get<double>();
+  max_radius_ = in.get<double>();
+}
+
 } // namespace magbrush::magnetics

@@ -18,6 +18,8 @@
 // once some bead has moved half the limit (|Δr| ≤ |Δx_i| + |Δx_j|).
 #pragma once
 
+#include "common/state_stream.h"
+
 #include "magnetics/bead_arrays.h"
 #include "magnetics/magnetic_settings.h"
 #include "magnetics/near_pairs.h"
@@ -85,6 +87,10 @@ public:
   // The caller re-sorted its beads (new[k] = old[order[k]]): the reference positions follow;
   // the watched pairs are dropped until the next full evaluation.
   void particles_reordered(const std::vector<std::int32_t> &order);
+
+  // Restart (common/state_stream.h): the reference positions, limits and watched pairs.
+  void write_state(StateOut &out) const;
+  void read_state(StateIn &in);
 
 private:
   MagneticSettings settings_;

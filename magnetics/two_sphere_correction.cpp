@@ -151,4 +151,16 @@ void TwoSphereCorrection::scale_forces(double ratio2)
     x *= ratio2;
 }
 
+void TwoSphereCorrection::write_state(StateOut &out) const
+{
+  list_.write_state(out);
+  out.put_array(force_);
+}
+
+void TwoSphereCorrection::read_state(StateIn &in)
+{
+  list_.read_state(in);
+  in.get_array(force_);
+}
+
 } // namespace magbrush::magnetics

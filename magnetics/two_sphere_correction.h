@@ -20,6 +20,8 @@
 // its pair forces like the near pairs: once per pair, applied ± (Newton's third law exact).
 #pragma once
 
+#include "common/state_stream.h"
+
 #include "magnetics/bead_arrays.h"
 #include "magnetics/dipole_physics.h"
 #include "magnetics/magnetic_neighbour_list.h"
@@ -72,6 +74,11 @@ public:
   void scale_forces(double ratio2);
   // Forget the list (the caller re-sorted its beads).
   void forget_list() { list_ = MagneticNeighbourList(); }
+
+  // Restart (common/state_stream.h): the own list and its stored forces; the tables are
+  // prepared again from β (they depend on nothing else).
+  void write_state(StateOut &out) const;
+  void read_state(StateIn &in);
 
 private:
   MagneticSettings settings_;

@@ -1,5 +1,6 @@
 #include "dem/force_terms/magnetic_force_term.h"
 
+#include "dem/checkpoint_file.h"
 #include "dem/dem_system.h"
 #include "dem/force_terms/force_term_registry.h"
 
@@ -281,6 +282,73 @@ void MagneticForceTerm::particles_reordered(const std::vector<std::int32_t> &ord
     new_index[static_cast<std::size_t>(order[k])] = static_cast<std::uint32_t>(k);
   for (auto &i : carrier_)
     i = new_index[i];
+}
+
+// ---------------------------------------------------------------------------------------
+// Checkpoint. The term's own state first, then the magnetics', in one block, so that a block
+// written under other settings can be skipped whole.
+
+void MagneticForceTerm::write_state(dem::CheckpointWriter &out) const
+{
+  MemoryStateOut block;
+  block.put<std::uint64_t>(state_size_);
+  block.put_array(carrier_);
+  for (const auto *v : {&x_, &y_, &z_, &radius_, &mu_r_, &Ms_, &fx_, &fy_, &fz_, &tx_, &ty_, &tz_})
+    block.put_array(*v);
+  block.put<std::uint8_t>(must_refresh_);
+  block.put(held_ramp_);
+  block.put(last_scale_);
+  block.put(evaluations_);
+  block.put(local_refreshes_);
+  block.put(counts_);
+  block.put(stats_);
+  block.put(local_stats_);
+  dipoles_.write_state(block);
+  out.put_string(block.bytes());
+}
+
+void MagneticForceTerm::read_state(dem::CheckpointReader &in)
+{
+  MemoryStateIn block(in.get_string(), "checkpoint '" + in.path() + "', magnetic state,");
+  restored_ = false;
+  const auto state_size = block.get<std::uint64_t>();
+  std::vector<std::uint32_t> carrier;
+  block.get_array(carrier);
+  std::vector<double> v[12];
+  for (auto &a : v)
+    block.get_array(a);
+  for (const auto &a : v)
+    if (a.size() != carrier.size())
+      block.fail("is corrupt (per-carrier arrays of different lengths)");
+  for (const std::uint32_t i : carrier)
+    if (i >= state_size)
+      block.fail("is corrupt (a carrier index beyond the particle count)");
+  const bool must_refresh = block.get<std::uint8_t>() != 0;
+  const double held_ramp = block.get<double>(), last_scale = block.get<double>();
+  const long evaluations = block.get<long>(), local_refreshes = block.get<long>();
+  const auto counts = block.get<RefreshCounts>();
+  const auto stats = block.get<MagneticStats>(), local_stats = block.get<MagneticStats>();
+  if (!dipoles_.read_state(block))
+  {
+    // Written under other magnetic settings (a restart that changes them on purpose): start
+    // afresh at the next step, as a new run would.
+    must_refresh_ = true;
+    return;
+  }
+  state_size_ = static_cast<std::size_t>(state_size);
+  carrier_ = std::move(carrier);
+  std::vector<double> *mine[12] = {&x_, &y_, &z_, &radius_, &mu_r_, &Ms_, &fx_, &fy_, &fz_, &tx_, &ty_, &tz_};
+  for (int k = 0; k < 12; ++k)
+    *mine[k] = std::move(v[k]);
+  must_refresh_ = must_refresh;
+  held_ramp_ = held_ramp;
+  last_scale_ = last_scale;
+  evaluations_ = evaluations;
+  local_refreshes_ = local_refreshes;
+  counts_ = counts;
+  stats_ = stats;
+  local_stats_ = local_stats;
+  restored_ = true;
 }
 
 namespace {

@@ -43,6 +43,13 @@ public:
   const char *name() const override { return "magnetic dipoles"; }
   void add_forces(const dem::ParticleState &state, dem::ForceBuffers &forces, double t) override;
   void particles_reordered(const std::vector<std::int32_t> &order) override;
+  // Checkpoint: the carrier selection and order, the unwrapped positions, the held forces and
+  // ramp, the counters, and the magnetics' whole held state (InducedDipoles::write_state), as
+  // one block. A checkpoint written under other magnetic settings restores nothing: the next
+  // step evaluates afresh (restored_state() is then false).
+  void write_state(dem::CheckpointWriter &out) const override;
+  void read_state(dem::CheckpointReader &in) override;
+  bool restored_state() const { return restored_; }
 
   // Statistics of the last full evaluation, and of the last local refresh.
   const MagneticStats &last_stats() const { return stats_; }
@@ -98,6 +105,7 @@ private:
   std::vector<double> x_, y_, z_, radius_, mu_r_, Ms_, fx_, fy_, fz_, tx_, ty_, tz_;
   bool must_refresh_ = true;
   bool enabled_ = true;
+  bool restored_ = false; // read_state() found state for these settings
   // The applied field's ramp factor s(t) when the held forces were evaluated.
   double held_ramp_ = 1.0;
   double last_scale_ = 1.0; // the ramp rescaling of the held forces at the last step

@@ -1,17 +1,23 @@
 // End-to-end: bin/magbrush-dem on a small case file (parser → insertion → run → outputs),
 // a restart from the checkpoint that reproduces the uninterrupted run's final snapshot bit for
-// bit, and the messages of a refused time step and an impossible insertion.
+// bit, the messages of a refused time step and an impossible insertion, a restart under
+// another case (refused) or other run control (proceeds), and a killed run's checkpoints.
 #include <gtest/gtest.h>
 #include "tests/test_temp_dir.h"
 #include <hdf5.h>
 
+#include <signal.h>
+#include <sys/types.h>
 #include <sys/wait.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <regex>
+#include <thread>
 #include <string>
 #include <vector>
 
@@ -164,4 +170,106 @@ TEST_F(DemCli, ImpossibleInsertionSaysWhatToDo)
   const CliResult r = run_dem(case_file + " --set populations.carrier.count=5000 --output " + (dir / "o").string());
   EXPECT_EQ(r.code, 1) << r.output;
   EXPECT_NE(r.output.find("enlarge the insertion region"), std::string::npos) << r.output;
+}
+
+// A restart under a case that differs beyond run control is refused with the keys that
+// differ (here another particle count) unless --restart-anyway is given; one that changes run
+// control only (the duration) proceeds and says what changed.
+TEST_F(DemCli, RestartUnderAnotherCaseIsRefusedRunControlMayChange)
+{
+  const std::string out = (dir / "first").string(), checkpoint = out + "/checkpoint.bin";
+  const CliResult a = run_dem(case_file + " --threads 1 --set dem.duration=40us --output " + out);
+  ASSERT_EQ(a.code, 0) << a.output;
+  const CliResult refused = run_dem(case_file + " --threads 1 --set populations.carrier.count=300 --output " +
+                                    (dir / "refused").string() + " --restart " + checkpoint);
+  EXPECT_EQ(refused.code, 1) << refused.output;
+  const std::size_t list = refused.output.find("beyond run control:");
+  ASSERT_NE(list, std::string::npos) << refused.output;
+  const std::string keys = refused.output.substr(list);
+  EXPECT_NE(keys.find("populations.carrier.count: 250 (checkpoint) -> 300 (this case)"), std::string::npos) << keys;
+  EXPECT_EQ(keys.find("dem.duration"), std::string::npos) << "run control is not a reason to refuse:\n" << keys;
+  EXPECT_NE(keys.find("--restart-anyway"), std::string::npos) << keys;
+  EXPECT_FALSE(fs::exists(dir / "refused" / "checkpoint.bin"));
+
+  const CliResult anyway = run_dem(case_file + " --threads 1 --set populations.carrier.count=300 --output " +
+                                   (dir / "anyway").string() + " --restart " + checkpoint + " --restart-anyway");
+  EXPECT_EQ(anyway.code, 0) << anyway.output;
+  EXPECT_NE(anyway.output.find("restart anyway (--restart-anyway)"), std::string::npos) << anyway.output;
+
+  const CliResult longer = run_dem(case_file + " --threads 1 --set dem.duration=60us --output " +
+                                   (dir / "longer").string() + " --restart " + checkpoint);
+  EXPECT_EQ(longer.code, 0) << longer.output;
+  EXPECT_NE(longer.output.find("run control changed since the checkpoint"), std::string::npos) << longer.output;
+  EXPECT_NE(longer.output.find("  dem.duration: "), std::string::npos) << longer.output;
+  EXPECT_NE(longer.output.find("restarted from"), std::string::npos) << longer.output;
+}
+
+// A run killed (SIGKILL) in the middle leaves good checkpoints by the default interval (the
+// case sets none), the last and the one before it; the log says where. A byte flipped in the
+// last one is refused with the file named and the one before offered; both restart.
+TEST_F(DemCli, KilledRunLeavesGoodCheckpointsByDefault)
+{
+  std::string text = case_text;
+  const std::string interval_line = "  checkpoint_interval: 50 us\n";
+  text.erase(text.find(interval_line), interval_line.size());
+  text.replace(text.find("duration: 100 us"), 16, "duration: 1 s");
+  const std::string killed_case = (dir / "long.yaml").string();
+  std::ofstream(killed_case) << text;
+  const fs::path out = dir / "killed", log = dir / "killed.log";
+  const std::string start = std::string(MAGBRUSH_BINARY_DIR) + "/bin/magbrush-dem " + killed_case +
+                            " --threads 1 --output " + out.string() + " > " + log.string() + " 2>&1 & echo $!";
+  FILE *p = popen(start.c_str(), "r");
+  ASSERT_NE(p, nullptr);
+  long pid = 0;
+  ASSERT_EQ(fscanf(p, "%ld", &pid), 1);
+  pclose(p);
+  // Wait for two checkpoints (at 250 and 500 µs of simulated time), then kill the run.
+  auto log_text = [&] {
+    std::ifstream in(log);
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  };
+  auto count = [](const std::string &s, const std::string &what) {
+    std::size_t n = 0;
+    for (std::size_t at = s.find(what); at != std::string::npos; at = s.find(what, at + 1))
+      ++n;
+    return n;
+  };
+  for (int waited = 0; waited < 3000 && count(log_text(), "checkpoint at t = ") < 2; ++waited)
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  kill(static_cast<pid_t>(pid), SIGKILL);
+  for (int waited = 0; waited < 100 && kill(static_cast<pid_t>(pid), 0) == 0; ++waited)
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  const std::string written = log_text();
+  ASSERT_GE(count(written, "checkpoint at t = "), 2u) << written;
+  // The first at 250 µs of simulated time (to the last digit of the step count's sum of steps).
+  EXPECT_TRUE(std::regex_search(written, std::regex(R"(checkpoint at t = 0\.000(25|249\d+) s \(step \d+\): )" +
+                                                     (out / "checkpoint.bin").string())))
+    << written;
+  EXPECT_EQ(written.find("done:"), std::string::npos) << "the run should have been killed";
+  ASSERT_TRUE(fs::exists(out / "checkpoint.bin"));
+  ASSERT_TRUE(fs::exists(out / "checkpoint.previous.bin"));
+
+  // Flip one byte of the last checkpoint: refused, the file named, the one before offered.
+  std::string bytes;
+  {
+    std::ifstream in(out / "checkpoint.bin", std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  bytes[bytes.size() / 2] = static_cast<char>(bytes[bytes.size() / 2] ^ 0x04);
+  std::ofstream(out / "checkpoint.bin", std::ios::binary | std::ios::trunc) << bytes;
+  const CliResult damaged = run_dem(killed_case + " --threads 1 --output " + (dir / "r0").string() + " --restart " +
+                                    (out / "checkpoint.bin").string());
+  EXPECT_EQ(damaged.code, 1) << damaged.output;
+  EXPECT_NE(damaged.output.find("checkpoint '" + (out / "checkpoint.bin").string() + "' is damaged"), std::string::npos)
+    << damaged.output;
+  EXPECT_NE(damaged.output.find("restart from the checkpoint kept before it, '" +
+                                (out / "checkpoint.previous.bin").string()),
+            std::string::npos)
+    << damaged.output;
+  // The one before restarts, and runs on (a little past where the killed run got).
+  const CliResult resumed = run_dem(killed_case + " --threads 1 --set dem.duration=0.3ms --output " +
+                                    (dir / "r1").string() + " --restart " + (out / "checkpoint.previous.bin").string());
+  EXPECT_EQ(resumed.code, 0) << resumed.output;
+  EXPECT_NE(resumed.output.find("restarted from"), std::string::npos) << resumed.output;
+  EXPECT_NE(resumed.output.find("done:"), std::string::npos) << resumed.output;
 }

@@ -150,6 +150,7 @@ TEST(ModuleDefaults, DemSettingsOfADefaultCaseAreTheStructDefaults)
   EXPECT_SAME(from_case, built, duration);
   EXPECT_SAME(from_case, built, output_interval);
   EXPECT_SAME(from_case, built, checkpoint_interval);
+  EXPECT_SAME(from_case, built, checkpoint_wall_interval);
   EXPECT_SAME(from_case, built, periodic_length);
   EXPECT_SAME(from_case, built, periodic_length_x);
   EXPECT_SAME(from_case, built, periodic_length_y);

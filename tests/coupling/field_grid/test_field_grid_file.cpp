@@ -103,15 +103,23 @@ void set_int_attribute(hid_t obj, const char *name, int value)
 }
 
 void replace_dataset(hid_t file, const char *name, const std::vector<double> &data,
-                     const std::vector<hsize_t> &dims, const char *units)
+                     const std::vector<hsize_t> &dims, const char *units, bool checksum = true)
 {
   H5Ldelete(file, name, H5P_DEFAULT);
   hid_t space = H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr);
-  hid_t set = H5Dcreate2(file, name, H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  // With the checksum filter every dataset of the format has (or the reader stops there).
+  hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
+  if (checksum)
+  {
+    H5Pset_chunk(dcpl, static_cast<int>(dims.size()), dims.data());
+    H5Pset_fletcher32(dcpl);
+  }
+  hid_t set = H5Dcreate2(file, name, H5T_IEEE_F64LE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
   H5Dwrite(set, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data());
   if (units)
     set_string_attribute(set, "units", units);
   H5Dclose(set);
+  H5Pclose(dcpl);
   H5Sclose(space);
 }
 
@@ -308,6 +316,48 @@ TEST(FieldGridFile, ReaderRejectsNonFiniteValuesAndNonMonotoneAxes)
   }
   const std::string axis = error_of([&] { read_electric_grid(path); });
   EXPECT_TRUE(contains(axis, "dataset /cartesian/x is not strictly increasing at index 3")) << axis;
+}
+
+// Damage on disk: one byte of one stored value flipped (its lowest mantissa byte: a change
+// of 1 ulp-ish that no range check could see). HDF5's Fletcher-32 filter fails the read, and
+// the reader turns that into a message naming the file, the dataset and the remedy. A dataset
+// without the filter (a file from before the checksums) is refused as well.
+TEST(FieldGridFile, DamagedValueIsRefusedByItsChecksum)
+{
+  const fs::path path = scratch_dir() / "roller_field.h5";
+  const PolarGrid g = some_polar_grid();
+  write_magnetic_grid(path, g, some_provenance());
+  std::string bytes;
+  {
+    std::ifstream in(path, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  // The stored bytes of A_z[1][5] (little-endian IEEE doubles, uncompressed chunks).
+  const double value = g.A_z[1 * static_cast<size_t>(g.n_theta) + 5];
+  const std::string pattern(reinterpret_cast<const char *>(&value), sizeof value);
+  const size_t at = bytes.find(pattern);
+  ASSERT_NE(at, std::string::npos);
+  ASSERT_EQ(bytes.find(pattern, at + 1), std::string::npos) << "the value should be stored once";
+  bytes[at] = static_cast<char>(bytes[at] ^ 0x01); // the lowest mantissa byte
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+  const std::string m = error_of([&] { read_magnetic_grid(path); });
+  EXPECT_TRUE(contains(m, path.string())) << m;
+  EXPECT_TRUE(contains(m, "dataset /polar/A_z is damaged: its Fletcher-32 checksum does not match")) << m;
+  EXPECT_TRUE(contains(m, "regenerate it with `magbrush field CASE`")) << m;
+  // Flipped back, the file reads again (so the refusal came from that byte alone).
+  bytes[at] = static_cast<char>(bytes[at] ^ 0x01);
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+  EXPECT_EQ(read_magnetic_grid(path).grid.A_z, g.A_z);
+
+  // The same values without the filter: not a file of this format version.
+  {
+    H5File f(path);
+    replace_dataset(f.id, "/polar/A_z", g.A_z, {static_cast<hsize_t>(g.n_r), static_cast<hsize_t>(g.n_theta)},
+                    "T*m", /*checksum=*/false);
+  }
+  const std::string old = error_of([&] { read_magnetic_grid(path); });
+  EXPECT_TRUE(contains(old, "/polar/A_z carries no Fletcher-32 checksum")) << old;
+  EXPECT_TRUE(contains(old, "regenerate")) << old;
 }
 
 TEST(FieldGridFile, ReaderRejectsMissingAndForeignFiles)

@@ -1,0 +1,51 @@
+#include "dem/restart_check.h"
+
+#include <map>
+
+namespace magbrush::dem {
+
+bool is_run_control_key(const std::string &key)
+{
+  static const char *const exact[] = {"dem.duration",           "dem.output_interval",
+                                      "dem.checkpoint_interval", "dem.checkpoint_wall_interval",
+                                      "dem.threads",             "nip.sample_interval",
+                                      "nip.average_from",        "compression.sample_interval",
+                                      "compression.map_interval"};
+  for (const char *k : exact)
+    if (key == k)
+      return true;
+  return key.rfind("output.", 0) == 0;
+}
+
+std::vector<CaseDifference> case_differences(const CheckpointIdentity &checkpoint, const CheckpointIdentity &now)
+{
+  std::map<std::string, std::string> current(now.inputs.begin(), now.inputs.end());
+  std::map<std::string, bool> seen;
+  std::vector<CaseDifference> out;
+  auto add = [&out](const std::string &key, const std::string &a, const std::string &b) {
+    out.push_back({key, a, b, is_run_control_key(key)});
+  };
+  for (const auto &[key, value] : checkpoint.inputs)
+  {
+    seen[key] = true;
+    const auto it = current.find(key);
+    if (it == current.end())
+      add(key, value, "(absent)");
+    else if (it->second != value)
+      add(key, value, it->second);
+  }
+  for (const auto &[key, value] : now.inputs)
+    if (!seen.count(key))
+      add(key, "(absent)", value);
+  return out;
+}
+
+std::string describe(const std::vector<CaseDifference> &differences)
+{
+  std::string text;
+  for (const CaseDifference &d : differences)
+    text += "  " + d.key + ": " + d.in_checkpoint + " (checkpoint) -> " + d.in_case + " (this case)\n";
+  return text;
+}
+
+} // namespace magbrush::dem

@@ -1,0 +1,38 @@
+// Whether a checkpoint may continue under the case at hand.
+//
+// A checkpoint carries the resolved inputs of the case that wrote it (checkpoint_file.h).
+// A restart compares them key by key with the case it runs under:
+//   * run control — how long to run, how often to write, where, on how many threads — may
+//     differ: the state is the same scene, continued (the differences are logged);
+//   * anything else (a particle count, a material, a wall, a field, a time step, a magnetic
+//     setting) means the checkpoint is not the state of this case: the restart is refused
+//     with the list of keys and both values, unless the user says --restart-anyway.
+#pragma once
+
+#include "dem/checkpoint_file.h"
+
+#include <string>
+#include <vector>
+
+namespace magbrush::dem {
+
+struct CaseDifference
+{
+  std::string key;            // the resolved key path, e.g. "populations[0].count"
+  std::string in_checkpoint;  // "(absent)" when only the case has it
+  std::string in_case;        // "(absent)" when only the checkpoint has it
+  bool run_control = false;   // may differ in a restart
+};
+
+// Run-control keys: dem.duration, the output, sample and checkpoint intervals, threads,
+// the measurements' sampling and averaging, the output directory and formats.
+bool is_run_control_key(const std::string &key);
+
+// The keys whose values differ between the checkpoint's case and this one, in the order of
+// the checkpoint's keys (then those only this case has).
+std::vector<CaseDifference> case_differences(const CheckpointIdentity &checkpoint, const CheckpointIdentity &now);
+
+// "  key: checkpoint value -> case value" lines.
+std::string describe(const std::vector<CaseDifference> &differences);
+
+} // namespace magbrush::dem

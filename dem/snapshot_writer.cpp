@@ -5,6 +5,7 @@
 
 #include <hdf5.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -72,10 +73,11 @@ void SnapshotWriter::write(const DemSystem &system)
   const ForceBuffers &f = system.forces();
   const std::size_t n = s.size();
   particles_ = n;
-  // Index of each id in the current (sorted) order.
+  // The particles in ascending id (ids are unique, not dense once particles enter and leave).
   std::vector<std::size_t> where(n);
   for (std::size_t i = 0; i < n; ++i)
-    where[static_cast<std::size_t>(s.id[i])] = i;
+    where[i] = i;
+  std::sort(where.begin(), where.end(), [&s](std::size_t a, std::size_t b) { return s.id[a] < s.id[b]; });
   auto vec3 = [&](const std::vector<double> &a, const std::vector<double> &b, const std::vector<double> &c) {
     std::vector<double> out(3 * n);
     for (std::size_t k = 0; k < n; ++k)

@@ -14,6 +14,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <map>
@@ -65,11 +66,18 @@ public:
     {
       const double r = 40e-6 + 20e-6 * u(rng_);
       const Vector3 p{3e-3 * u(rng_), 3e-3 * u(rng_), 1.2e-3 + 0.3e-3 * u(rng_)};
+      // Clear of every particle (periodic images along x and y), with room to spare.
+      auto apart = [&p](const Vector3 &q) {
+        Vector3 d = q - p;
+        d.x -= 3e-3 * std::round(d.x / 3e-3);
+        d.y -= 3e-3 * std::round(d.y / 3e-3);
+        return norm(d);
+      };
       bool clear = true;
       for (std::size_t i = 0; i < s.size() && clear; ++i)
-        clear = norm(Vector3{s.x[i], s.y[i], s.z[i]} - p) > r + s.radius[i] + 1e-4;
+        clear = apart(s.position(i)) > r + s.radius[i] + 1e-4;
       for (std::size_t i = 0; i < enter.size() && clear; ++i)
-        clear = norm(enter.position(i) - p) > r + enter.radius[i];
+        clear = apart(enter.position(i)) > r + enter.radius[i] + 1e-4;
       if (!clear)
         continue;
       enter.add(p, r, 2200, 0, 0.0);
@@ -108,6 +116,15 @@ std::unique_ptr<DemSystem> make_packing(const Case &c, long exchange_every)
   if (exchange_every > 0)
     sys->set_particle_exchange(std::make_unique<DrainAndRain>(exchange_every));
   sys->insert_particles();
+  std::mt19937_64 rng(3); // random initial velocities: contacts form within a few hundred steps
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  auto &p = sys->particles();
+  for (std::size_t i = 0; i < p.size(); ++i)
+  {
+    p.vx[i] = u(rng);
+    p.vy[i] = u(rng);
+    p.vz[i] = u(rng);
+  }
   sys->initialize();
   return sys;
 }
@@ -173,17 +190,43 @@ bool same_bits(const Vector3 &a, const Vector3 &b) { return std::memcmp(&a, &b, 
 
 } // namespace
 
+// A compressed simple-cubic stack (10 × 10 × 5 spheres of 100 µm at 99 µm spacing, periodic in
+// x and y, between the stage and a lid) shaken with random velocities: every neighbour pair and every bottom
+// sphere touches, and the tangential springs have stretched within a few hundred steps.
+std::unique_ptr<DemSystem> make_lattice(const Case &c)
+{
+  auto sys = std::make_unique<DemSystem>(c);
+  sys->add_force_term(std::make_unique<Gravity>(c.dem.gravity));
+  auto &p = sys->particles();
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const double a = 99e-6;
+  for (int k = 0; k < 5; ++k)
+    for (int j = 0; j < 10; ++j)
+      for (int i = 0; i < 10; ++i)
+      {
+        p.add({(i + 0.5) * a, (j + 0.5) * a, 49.5e-6 + k * a}, 50e-6, 2200, 0, 0.0);
+        p.vx.back() = 0.05 * u(rng);
+        p.vy.back() = 0.05 * u(rng);
+        p.wz.back() = 500.0 * u(rng);
+      }
+  sys->initialize();
+  return sys;
+}
+
 TEST(DemParticleExchange, SurvivingContactsKeepTheirHistoryBitForBit)
 {
   omp_set_num_threads(1);
-  const Case c = packing_case();
-  auto sys = make_packing(c, 0);
-  sys->advance(1500); // settled enough for many sliding contacts with history
+  Case c = packing_case();
+  c.dem.periodic_length_x = c.dem.periodic_length_y = 10 * 99e-6;
+  add_rigid_plane(c, {0, 0, 99e-6 + 4 * 99e-6}, {0, 0, -1}, 0.3, 0.35); // a lid: the stack stays compressed
+  auto sys = make_lattice(c);
+  sys->advance(300);
   const auto pairs_before = pair_history(*sys);
   const auto walls_before = wall_history(*sys);
   const std::int32_t next_id = sys->particles().next_id;
-  // Leave: every particle with an id divisible by 5 (many of them in contact). Enter: 30
-  // spheres high above, clear of everything.
+  // Leave: every particle with an id divisible by 5 (all of them in contact). Enter: 30
+  // small spheres in the voids of the lattice, clear of everything.
   std::vector<std::int32_t> leave;
   std::vector<int> left_ids;
   const auto &p = sys->particles();
@@ -195,7 +238,7 @@ TEST(DemParticleExchange, SurvivingContactsKeepTheirHistoryBitForBit)
     }
   ParticleState enter;
   for (int k = 0; k < 30; ++k)
-    enter.add({0.1e-3 * (k % 10) + 0.2e-3, 0.3e-3 * (k / 10) + 0.2e-3, 2e-3}, 45e-6, 2200, 0, 0.0);
+    enter.add({99e-6 * (k % 10 + 1), 99e-6 * (3 * (k / 10) + 1), 49.5e-6 + 1.5 * 99e-6}, 20e-6, 2200, 0, 0.0); // in voids
   const std::size_t n_before = p.size();
   sys->exchange_particles(leave, enter);
 
@@ -233,9 +276,13 @@ TEST(DemParticleExchange, SurvivingContactsKeepTheirHistoryBitForBit)
   std::printf("exchange: %zu particles, %zu left, 30 entered; %ld pair contacts kept bit for bit, %ld vanished with "
               "a leaver; %ld wall contacts kept\n",
               n_before, leave.size(), kept_pairs, pairs_with_leavers, kept_walls);
-  EXPECT_GT(kept_pairs, 500);
-  EXPECT_GT(pairs_with_leavers, 100);
+  EXPECT_GT(kept_pairs, 600);
+  EXPECT_GT(pairs_with_leavers, 200);
   EXPECT_GT(kept_walls, 100);
+  long nonzero = 0;
+  for (const auto &[key, xi] : pairs_after)
+    nonzero += norm(xi) > 0.0;
+  EXPECT_GT(nonzero, 500) << "the test needs contacts with a stretched tangential spring";
   // Ids: the leavers' are gone, the newcomers' are new and never reused.
   const auto &q = sys->particles();
   EXPECT_EQ(q.size(), n_before - leave.size() + 30);
@@ -250,7 +297,7 @@ TEST(DemParticleExchange, SurvivingContactsKeepTheirHistoryBitForBit)
   // The run goes on; a second exchange names ids after all earlier ones.
   sys->advance(50);
   ParticleState more;
-  more.add({1.5e-3, 1.5e-3, 2.5e-3}, 45e-6, 2200, 0, 0.0);
+  more.add({99e-6 * 5, 99e-6 * 8, 49.5e-6 + 2.5 * 99e-6}, 20e-6, 2200, 0, 0.0);
   sys->exchange_particles({0}, more);
   EXPECT_EQ(sys->particles().next_id, next_id + 31);
   EXPECT_EQ(sys->particles_entered(), 31);

@@ -620,6 +620,8 @@ void DemSystem::write_checkpoint(const std::string &path)
   out.put(particles_.next_id);
   out.put(entered_);
   out.put(left_);
+  out.put(skin_);         // set at initialize(): the set of particles may have changed since
+  out.put(energy_floor_); // (likewise)
   const std::string exchange = exchange_ ? exchange_->name() : "";
   out.put_array(std::vector<char>(exchange.begin(), exchange.end()));
   if (exchange_)
@@ -668,6 +670,8 @@ void DemSystem::read_checkpoint(const std::string &path)
   particles_.next_id = in.get<std::int32_t>();
   entered_ = in.get<long>();
   left_ = in.get<long>();
+  skin_ = in.get<double>();
+  energy_floor_ = in.get<double>();
   std::vector<char> exchange_name;
   in.get_array(exchange_name);
   const std::string exchange = exchange_ ? exchange_->name() : "";

@@ -220,7 +220,10 @@ void ParticleSource::create(const ParticleState &state, double t, ParticleState 
   if (dphi == 0.0)
     return;
   owed_carrier_ += carrier_share_ * areal_mass_ * R_ * std::abs(dphi) * Lz_;
-  gather_near(state, theta_in_, dphi);
+  // The arc the new carriers' centres go into: the one swept, but at least two diameters long
+  // (an exchange every few steps sweeps far less than a bead; what does not fit waits).
+  const double span = std::copysign(std::max(std::abs(dphi), 2.0 * carrier_.d_max / R_), dphi);
+  gather_near(state, theta_in_, span);
   for (;;)
   {
     const double d = pending_d_ > 0.0 ? pending_d_ : draw_diameter(carrier_);
@@ -228,7 +231,7 @@ void ParticleSource::create(const ParticleState &state, double t, ParticleState 
     // Whole particles; what is owed below half a particle waits for the next exchange.
     if (owed_carrier_ < 0.5 * sphere_mass(d, carrier_.density))
       break;
-    if (!place_carrier(d, theta_in_, dphi, t, enter))
+    if (!place_carrier(d, theta_in_, span, t, enter))
       break;
     owed_carrier_ -= sphere_mass(d, carrier_.density);
     pending_d_ = 0.0;

@@ -7,7 +7,8 @@
 //
 //     Δm = Γ R Δφ L_z        (mass flux Γ v L_z, L_z the periodic slab length)
 //
-// and places it in exactly that arc, θ_in … θ_in + Δφ (in the sense of rotation), within
+// and places it in that arc, θ_in … θ_in + Δφ (in the sense of rotation; at least two bead
+// diameters long, since an exchange every few steps sweeps far less than a bead), within
 // inflow.layer_height of the surface: carriers of the fed population, drawn from its size
 // distribution, at random (uniform in area), without overlap with the particles present, the
 // walls or each other. The previous exchange's particles have moved on by Δφ with the sleeve,

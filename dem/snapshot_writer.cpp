@@ -114,6 +114,7 @@ void SnapshotWriter::write(const DemSystem &system)
   }
   file.commit();
   snapshots_.emplace_back(system.time(), name);
+  counts_.push_back(n); // particles may enter and leave: each snapshot has its own count
   write_index();
 }
 
@@ -121,6 +122,7 @@ void SnapshotWriter::resume(double up_to_time)
 {
   // Rebuild the list from the files present, keeping those not later than the restart time.
   snapshots_.clear();
+  counts_.clear();
   const fs::path dir = fs::path(directory_) / "snapshots";
   std::vector<std::string> files;
   for (const auto &e : fs::directory_iterator(dir))
@@ -154,6 +156,7 @@ void SnapshotWriter::resume(double up_to_time)
     {
       snapshots_.emplace_back(t, "snapshots/" + f);
       particles_ = static_cast<std::size_t>(dims[0]);
+      counts_.push_back(particles_);
     }
   }
 }
@@ -163,9 +166,10 @@ void SnapshotWriter::write_index() const
   std::ostringstream x;
   x << "<?xml version=\"1.0\" ?>\n<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n<Xdmf Version=\"3.0\">\n<Domain>\n"
     << "<Grid Name=\"particles\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
-  const std::size_t n = particles_;
-  for (const auto &[t, file] : snapshots_)
+  for (std::size_t k = 0; k < snapshots_.size(); ++k)
   {
+    const auto &[t, file] = snapshots_[k];
+    const std::size_t n = counts_[k];
     char tbuf[32];
     std::snprintf(tbuf, sizeof tbuf, "%.9g", t);
     x << "  <Grid Name=\"t=" << tbuf << "\" GridType=\"Uniform\">\n"

@@ -153,7 +153,9 @@ MeanAndError over_blocks(const std::vector<double> &v)
 TEST(DemParticleFlow, ConveyorReachesSteadyStateWithFluxEqualToDensityTimesSpeed)
 {
   omp_set_num_threads(2);
-  const double slab = 3e-3, end = 40e-3, steady_from = 12e-3, block = 2e-3;
+  // Blocks of 4 ms: longer than a bead needs to cross the density window (16 deg, 2.8 ms), so
+  // that the blocks are close to independent and their standard error means what it says.
+  const double slab = 3e-3, end = 40e-3, steady_from = 12e-3, block = 4e-3;
   const Case c = conveyor_case(slab);
   auto sys = make_conveyor(c);
   FlowReport report(c);
@@ -215,7 +217,7 @@ TEST(DemParticleFlow, ConveyorReachesSteadyStateWithFluxEqualToDensityTimesSpeed
   std::printf("flux through 130 deg: %.5g kg/s +- %.2g (%zu blocks of %.3g s, %ld beads crossed); areal mass x v x L_z "
               "= %.5g +- %.2g; difference %.3g +- %.2g; source Gamma v L_z = %.5g kg/s\n",
               F.mean, F.error, flux.size(), block, crossings, D.mean, D.error, d.mean, d.error, nominal);
-  EXPECT_GE(flux.size(), 10u);
+  EXPECT_GE(flux.size(), 6u);
   EXPECT_LT(std::abs(d.mean), 3.0 * d.error) << "flux != density x speed";
   EXPECT_LT(std::abs(F.mean - nominal), 3.0 * F.error) << "flux != the source's areal mass x speed";
   EXPECT_LT(F.error, 0.05 * nominal) << "the check is too weak to mean anything";

@@ -301,3 +301,28 @@ TEST(DemParticleFlow, RestartInTheMiddleContinuesBitIdentically)
   EXPECT_TRUE(bit_identical(state_by_id(*a), state_by_id(b)));
   std::filesystem::remove(path);
 }
+
+TEST(DemParticleFlow, InflowThatCannotBeHeldIsRefusedNamingTheKey)
+{
+  auto refusal = [](Case c) -> std::string {
+    try
+    {
+      DemSystem sys(c);
+      ParticleFlow flow(c, sys);
+    }
+    catch (const std::invalid_argument &e)
+    {
+      return e.what();
+    }
+    return "";
+  };
+  Case thin = conveyor_case(2e-3);
+  thin.flow.inflow_layer_height = 0.12e-3; // 0.05 kg/m² of 100 um beads in 20 um of free height
+  EXPECT_NE(refusal(thin).find("inflow.layer_height"), std::string::npos) << refusal(thin);
+  Case unnamed = conveyor_case(2e-3);
+  unnamed.flow.inflow_population = "developer";
+  EXPECT_NE(refusal(unnamed).find("inflow.population"), std::string::npos) << refusal(unnamed);
+  Case no_slab = conveyor_case(0.0);
+  EXPECT_NE(refusal(no_slab).find("dem.periodic_length"), std::string::npos) << refusal(no_slab);
+  EXPECT_EQ(refusal(conveyor_case(2e-3)), "");
+}

@@ -15,6 +15,7 @@
 //   field_solver   case_keys_field_solver.cpp   field                (field_solver/, the field grids)
 //   dem            case_keys_dem.cpp            dem.* of the engine  (dem/: step, walls, guards)
 //   magnetics      case_keys_magnetics.cpp      dem.magnetic_*       (magnetics/magnetic_settings)
+//   flow           case_keys_flow.cpp           inflow, outflow, flow_report (dem/ particles entering and leaving)
 //   measurements   case_keys_measurements.cpp   nip, compression     (dem/measurements/)
 //   output         case_keys_output.cpp         output               (the driver, dem/ snapshots)
 //
@@ -71,6 +72,7 @@ std::vector<KeySpec> applied_field_keys();
 std::vector<KeySpec> field_solver_keys();
 std::vector<KeySpec> dem_keys();
 std::vector<KeySpec> magnetic_keys();
+std::vector<KeySpec> flow_keys();
 std::vector<KeySpec> measurement_keys();
 std::vector<KeySpec> output_keys();
 } // namespace case_keys

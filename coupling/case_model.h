@@ -279,6 +279,30 @@ struct StatisticsSettings
   int blocks = 10;            // blocks of the block-averaged standard error
 };
 
+// Particles entering and leaving a roller scene (dem/particle_source.h, dem/particle_sink.h):
+// developer fed onto the sleeve just downstream of an entry angle at the developer mass per
+// area `areal_mass` (DMA), carried in at the sleeve speed, so that the mass flux is
+// DMA × v_sleeve × slab length; toner populations with a concentration come attached to the
+// carriers in that proportion. Particles in the outflow sector (or beyond outer_radius) are
+// removed. Angles are roller angles (counter-clockwise from +x); sectors extend from their
+// angle in the direction the sleeve turns.
+struct FlowSettings
+{
+  std::string inflow_population;     // the carrier population fed ("" = the first carrier)
+  double inflow_areal_mass = 0.0;    // developer (carrier + toner) mass per sleeve area [kg/m²] (0 = no inflow)
+  double inflow_angle = 0.0;         // entry angle [rad]
+  double inflow_layer_height = 0.5e-3; // the new particles are placed within this of the sleeve surface [m]
+  double interval = 1e-6;            // time between exchanges [s]
+  double outflow_angle = 0.0;        // start of the removal sector [rad]
+  double outflow_width = 0.0;        // its angular extent [rad] (0 = no outflow sector)
+  double outflow_radius = 0.0;       // remove particles farther than this from the roller axis [m] (0 = none)
+  double sample_interval = 2e-6;     // flow report: time between samples [s]
+  double flux_angle = 0.0;           // flow report: the radial line the flux is counted through [rad]
+  double density_window = 10.0 * 3.14159265358979323846 / 180.0; // flow report: angular window of the areal mass [rad]
+  bool inflow() const { return inflow_areal_mass > 0.0; }
+  bool outflow() const { return outflow_width > 0.0 || outflow_radius > 0.0; }
+};
+
 struct OutputSettings
 {
   std::string directory = "results";
@@ -308,6 +332,7 @@ struct Case
   CompressionSettings compression; // added by the compression study
   StatisticsSettings statistics;   // standard errors and the steady-state test of every summary
   DevelopmentSettings development; // the toner-development measurement
+  FlowSettings flow;                  // particles entering and leaving (inflow, outflow, flow report)
   OutputSettings output;
   std::string measured_flux_file;     // optional gaussmeter scan to overlay in the report
   double measured_flux_angle_origin = 0.0; // [rad] roller angle = scan angle + this (the encoder offset)

@@ -781,6 +781,7 @@ private:
     const Scope st = top.child("statistics");
     c.statistics.steady_drift = q(st, "steady_drift");
     c.statistics.blocks = static_cast<int>(integer(st, "blocks"));
+    build_flow(c.flow, top);
     const Scope o = top.child("output");
     c.output.directory = str(o, "directory");
     c.output.vtu = flag(o, "vtu");
@@ -991,6 +992,22 @@ private:
     m.sample_interval = q(s, "sample_interval");
     m.average_window = q(s, "average_window");
     m.map_interval = q(s, "map_interval");
+  }
+
+  void build_flow(FlowSettings &f, const Scope &top)
+  {
+    const Scope in = top.child("inflow"), out = top.child("outflow"), report = top.child("flow_report");
+    f.inflow_population = str(in, "population");
+    f.inflow_areal_mass = q(in, "areal_mass");
+    f.inflow_angle = q(in, "angle");
+    f.inflow_layer_height = q(in, "layer_height");
+    f.interval = q(in, "interval");
+    f.outflow_angle = q(out, "angle");
+    f.outflow_width = q(out, "width");
+    f.outflow_radius = q(out, "outer_radius");
+    f.sample_interval = q(report, "sample_interval");
+    f.flux_angle = q(report, "flux_angle");
+    f.density_window = q(report, "density_window");
   }
 
   void build_field(FieldSettings &f, const Scope &s)

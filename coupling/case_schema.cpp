@@ -26,6 +26,7 @@ const std::vector<KeyDeclaration> &key_declarations()
       {"field_solver", "coupling/case_keys_field_solver.cpp", &case_keys::field_solver_keys},
       {"dem", "coupling/case_keys_dem.cpp", &case_keys::dem_keys},
       {"magnetics", "coupling/case_keys_magnetics.cpp", &case_keys::magnetic_keys},
+      {"flow", "coupling/case_keys_flow.cpp", &case_keys::flow_keys},
       {"measurements", "coupling/case_keys_measurements.cpp", &case_keys::measurement_keys},
       {"output", "coupling/case_keys_output.cpp", &case_keys::output_keys},
   };

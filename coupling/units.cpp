@@ -117,6 +117,7 @@ const std::vector<DimensionInfo> &dimension_table()
       {Dimension::force, {1, 1, -2, 0, 0}, "a force", "1 mN", "N"},
       {Dimension::electric_field, {1, 1, -3, -1, 0}, "an electric field", "2 kV/mm", "V/m"},
       {Dimension::inverse_angle_squared, {0, 0, 0, 0, -2}, "a shape factor per radian squared", "10 rad^-2", "rad^-2"},
+      {Dimension::areal_mass, {-2, 1, 0, 0, 0}, "a mass per area", "0.4 kg/m^2", "kg/m^2"},
   };
   return table;
 }
@@ -361,6 +362,7 @@ DisplayChoice display_units(Dimension d)
   case Dimension::force: return {{{"N", 1.0}, {"mN", 1e-3}, {"uN", 1e-6}, {"nN", 1e-9}}, 0};
   case Dimension::electric_field: return {{{"MV/m", 1e6}, {"kV/m", 1e3}, {"V/m", 1.0}}, 2};
   case Dimension::inverse_angle_squared: return {{{"rad^-2", 1.0}}};
+  case Dimension::areal_mass: return {{{"kg/m^2", 1.0}}};
   }
   return {{{"", 1.0}}};
 }

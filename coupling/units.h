@@ -43,6 +43,7 @@ enum class Dimension
   force,                 // N
   electric_field,        // V/m, kV/mm
   inverse_angle_squared, // 1/rad^2 (Gaussian pole shape factor)
+  areal_mass,            // kg/m^2, mg/cm^2 (developer mass per sleeve area, DMA)
 };
 
 // Converts "25 mm" to 0.025 (SI). Throws UnitError naming what was expected and found,

@@ -86,10 +86,40 @@ void DemSystem::begin_step()
 
 void DemSystem::step() { advance(1); }
 
+// The exchange schedule (dem/particle_exchange.h) cuts the steps into runs of the team: the
+// steps up to the one before an exchange step, then the exchange step alone, whose forced
+// list rebuild is where the exchange happens (advance_steps, Pause::rebuild). The cut
+// depends on the step number only, so advance(n) stays bit-identical to n × step().
 void DemSystem::advance(long steps)
 {
   if (!initialized_)
     throw std::logic_error("DemSystem::step()/advance() before initialize()");
+  while (steps > 0)
+  {
+    long run = steps;
+    if (exchange_)
+    {
+      const long every = exchange_->interval_steps();
+      const long next = step_ + 1; // the step the run starts with
+      if (next >= 1 && next % every == 0)
+      {
+        exchange_pending_ = true;
+        force_rebuild_ = true;
+        run = 1;
+      }
+      else
+      {
+        const long first_exchange = next < 1 ? every : (next / every + 1) * every;
+        run = std::min(steps, first_exchange - next);
+      }
+    }
+    advance_steps(run);
+    steps -= run;
+  }
+}
+
+void DemSystem::advance_steps(long steps)
+{
   // A team may be larger now than at initialize() (omp_set_num_threads between calls).
   if (thread_flags_.size() < static_cast<std::size_t>(omp_get_max_threads()))
     thread_flags_.resize(static_cast<std::size_t>(omp_get_max_threads()));
@@ -110,7 +140,13 @@ void DemSystem::advance(long steps)
     case Pause::done:
       return;
     case Pause::rebuild: // the step has begun (kick and drift done); its contacts follow
-      rebuild_neighbour_list();
+      if (exchange_pending_)
+      {
+        exchange_pending_ = false;
+        run_scheduled_exchange(); // rebuilds the list
+      }
+      else
+        rebuild_neighbour_list();
       from = Resume::contacts;
       break;
     case Pause::force_terms: // contacts and team terms done; the others add theirs, then the final kick

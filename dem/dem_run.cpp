@@ -2,6 +2,7 @@
 #include "dem/dem_run.h"
 
 #include "dem/run_summary.h"
+#include "dem/particle_flow.h"
 #include "dem/openmp_waiting.h"
 #include "dem/restart_check.h"
 
@@ -32,6 +33,8 @@ DemRun::DemRun(const Case &c, const RunOptions &options, std::ostream &log)
   force_terms_ = add_case_force_terms(*system_, case_);
   identity_.case_hash = case_hash(case_);
   identity_.inputs = case_inputs(case_);
+  if (case_.flow.inflow() || case_.flow.outflow())
+    system_->set_particle_exchange(std::make_unique<ParticleFlow>(case_, *system_));
 }
 
 std::string DemRun::checkpoint_path() const { return (fs::path(out_dir_) / "checkpoint.bin").string(); }
@@ -107,6 +110,27 @@ void DemRun::log_setup() const
   for (const ForceTermChoice &choice : force_terms_)
     if (!choice.on)
       log_ << "  force term off: " << choice.name << " (" << choice.reason << ")\n";
+  if (const auto *flow = dynamic_cast<const ParticleFlow *>(s.particle_exchange()))
+  {
+    const FlowSettings &f = case_.flow;
+    if (flow->source())
+    {
+      std::snprintf(line, sizeof line,
+                    "  inflow: %.4g kg/m^2 of developer onto the sleeve past %.4g deg, within %.3g mm of it, "
+                    "every %ld steps (%.4g kg/s at full sleeve speed)\n",
+                    f.inflow_areal_mass, f.inflow_angle * 180.0 / M_PI, f.inflow_layer_height * 1e3,
+                    flow->interval_steps(),
+                    f.inflow_areal_mass * case_.sleeve->surface_speed() * s.box().length[2]);
+      log_ << line;
+    }
+    if (flow->sink())
+    {
+      std::snprintf(line, sizeof line, "  outflow: sector %.4g deg wide from %.4g deg; beyond %.4g mm from the axis%s\n",
+                    f.outflow_width * 180.0 / M_PI, f.outflow_angle * 180.0 / M_PI, f.outflow_radius * 1e3,
+                    f.outflow_radius > 0.0 ? "" : " (off)");
+      log_ << line;
+    }
+  }
   if (!measurements_.empty())
   {
     log_ << "  measurements:";
@@ -250,6 +274,9 @@ void DemRun::run()
                       rate * static_cast<double>(s.particles().size()), left / std::max(rate, 1e-30),
                       s.particle_contacts());
         log_ << line;
+        if (s.particle_exchange())
+          log_ << "    particles: " << s.particles().size() << " present, " << s.particles_entered() << " entered, "
+               << s.particles_left() << " left\n";
         log_.flush();
       }
     }
@@ -280,6 +307,9 @@ void DemRun::run()
                 static_cast<double>(s.step_count() - start_step) * static_cast<double>(s.particles().size()) / std::max(wall, 1e-9),
                 s.neighbour_rebuilds());
   log_ << line;
+  if (s.particle_exchange())
+    log_ << "particles: " << s.particles_entered() << " entered, " << s.particles_left() << " left, "
+         << s.particles().size() << " present\n";
   log_ << "outputs: " << out_dir_ << "/{particles.xdmf, snapshots/, time_series.csv, checkpoint.bin, "
        << "checkpoint.previous.bin}\n";
   log_timings(wall);

@@ -56,8 +56,15 @@ void DemSystem::replace_force_term(const std::string &name, std::unique_ptr<Forc
 void DemSystem::setup_derived()
 {
   const std::size_t n = particles_.size();
-  if (n == 0)
+  // Particles the exchange may bring in later (none without one): they count for the stable
+  // time step, and for the skin when the scene starts empty.
+  ParticleState later;
+  if (exchange_)
+    exchange_->smallest_particles(later);
+  if (n == 0 && later.size() == 0)
     throw std::invalid_argument("dem: the scene has no particles (check the populations' count/mass)");
+  if (particles_.next_id < particles_.id_bound())
+    particles_.next_id = particles_.id_bound(); // ids set by hand (tests): never reuse one
   std::vector<std::string> species_materials, species_names;
   std::vector<Material> materials;
   for (const auto &p : case_.populations)
@@ -85,17 +92,21 @@ void DemSystem::setup_derived()
     for (std::size_t f = 0; f < 9; ++f)
       coefficient_fields_[f * types + t] = fields[f];
   }
-  stable_ = stable_time_step(particles_, materials, species_names, table_, walls_.size(),
+  ParticleState all = particles_;
+  for (std::size_t k = 0; k < later.size(); ++k)
+    all.append_from(later, k);
+  stable_ = stable_time_step(all, materials, species_names, table_, walls_.size(),
                              std::max(1.0, 2.0 * walls_.max_surface_speed()));
   dt_ = choose_time_step(case_.dem, stable_);
 
+  const ParticleState &sized = n > 0 ? particles_ : later;
   double mean_d = 0.0, mass = 0.0;
-  for (std::size_t i = 0; i < n; ++i)
+  for (std::size_t i = 0; i < sized.size(); ++i)
   {
-    mean_d += 2.0 * particles_.radius[i];
-    mass += particles_.mass[i];
+    mean_d += 2.0 * sized.radius[i];
+    mass += sized.mass[i];
   }
-  mean_d /= static_cast<double>(n);
+  mean_d /= static_cast<double>(sized.size());
   skin_ = case_.dem.verlet_skin * mean_d;
   energy_floor_ = 0.5 * mass * 1.0; // (1 m/s)²: the runaway guard ignores growth below this
   forces_.resize(n);
@@ -107,6 +118,7 @@ void DemSystem::setup_derived()
 void DemSystem::initialize()
 {
   setup_derived();
+  list_ = NeighbourList{}; // a fresh start: no history from an earlier particle set
   rebuild_neighbour_list();
   // Forces at t = 0, so that the first half kick uses them.
   walls_.prepare(time_, walls_frozen_);
@@ -135,17 +147,81 @@ void DemSystem::permute_particles(const std::vector<std::int32_t> &order)
     t->particles_reordered(order);
 }
 
-void DemSystem::rebuild_neighbour_list()
+void DemSystem::rebuild_neighbour_list(const std::vector<std::int32_t> *origin)
 {
   PhaseTimer timer(times_.neighbour);
   // Pairs are listed out to contact + adhesion range (0 without adhesion) + skin.
   const double reach = table_.particles_adhesive() ? table_.adhesion_range() : 0.0;
-  list_.rebuild(particles_, box_, skin_ + reach, [this](const std::vector<std::int32_t> &order) { permute_particles(order); });
+  list_.rebuild(particles_, box_, skin_ + reach,
+                [this](const std::vector<std::int32_t> &order) { permute_particles(order); }, origin);
   x0_ = particles_.x;
   y0_ = particles_.y;
   z0_ = particles_.z;
   force_rebuild_ = false;
   ++rebuilds_;
+}
+
+void DemSystem::set_particle_exchange(std::unique_ptr<ParticleExchange> exchange)
+{
+  if (exchange && exchange->interval_steps() < 1)
+    throw std::invalid_argument(std::string("dem: particle exchange '") + exchange->name() +
+                                "' must exchange at most once per step");
+  exchange_ = std::move(exchange);
+}
+
+// Leavers out and newcomers in, as one map from the new index to the old (origin_), applied
+// to every per-particle array of the engine and its parts; the list rebuild that follows
+// carries the contact history through the same map.
+void DemSystem::exchange_particles(const std::vector<std::int32_t> &leave, const ParticleState &enter)
+{
+  const std::size_t n = particles_.size();
+  leaving_.assign(n, 0);
+  for (std::int32_t i : leave)
+  {
+    if (i < 0 || U(i) >= n || leaving_[U(i)])
+      throw std::invalid_argument("dem: particle exchange: index " + std::to_string(i) +
+                                  " is not a particle, or named twice");
+    leaving_[U(i)] = 1;
+  }
+  keep_.clear();
+  for (std::size_t i = 0; i < n; ++i)
+    if (!leaving_[i])
+      keep_.push_back(static_cast<std::int32_t>(i));
+  particles_.permute(keep_, scratch_, iscratch_);
+  forces_.permute(keep_, scratch_);
+  permute_array(contact_count_, keep_, iscratch_);
+  wall_slots_.permute(keep_, scratch_, iscratch_);
+  for (std::size_t k = 0; k < enter.size(); ++k)
+  {
+    if (enter.species[k] < 0 || U(enter.species[k]) >= case_.populations.size())
+      throw std::invalid_argument("dem: particle exchange: an entering particle has species " +
+                                  std::to_string(enter.species[k]));
+    particles_.append_from(enter, k);
+  }
+  const std::size_t m = particles_.size();
+  forces_.extend(m);
+  contact_count_.resize(m, 0);
+  wall_slots_.extend(m);
+  origin_ = keep_;
+  origin_.resize(m, -1);
+  entered_ += static_cast<long>(enter.size());
+  left_ += static_cast<long>(leave.size());
+  for (auto &t : terms_)
+    t->particles_changed(origin_);
+  double mass = 0.0;
+  for (double v : particles_.mass)
+    mass += v;
+  energy_floor_ = 0.5 * mass * 1.0;
+  rebuild_neighbour_list(&origin_);
+}
+
+// The exchange of the step in progress (after its drift, before its forces).
+void DemSystem::run_scheduled_exchange()
+{
+  leave_plan_.clear();
+  enter_plan_.resize(0);
+  exchange_->plan(particles_, time_, leave_plan_, enter_plan_);
+  exchange_particles(leave_plan_, enter_plan_);
 }
 
 // Velocity Verlet's half step of the velocities: v += (h/m) F, ω += (h/I) T.
@@ -557,6 +633,14 @@ void DemSystem::write_checkpoint(const std::string &path, const CheckpointIdenti
   out.put_array(z0_);
   out.put(rebuilds_);
   out.put<std::uint8_t>(force_rebuild_); // a rebuild requested for the next step
+  // Particles entering and leaving: the id counter and the engine's counts; the skin and the
+  // energy-guard floor were set at initialize() for a set of particles that may have changed
+  // since, so the restart takes them from here (before it rebuilds the list with the skin).
+  out.put(particles_.next_id);
+  out.put(entered_);
+  out.put(left_);
+  out.put(skin_);
+  out.put(energy_floor_);
   list_.write_history(out);
   wall_slots_.write(out);
   // Each force term's own state, framed by its name so that a restart under a different set
@@ -568,6 +652,11 @@ void DemSystem::write_checkpoint(const std::string &path, const CheckpointIdenti
     out.put_array(std::vector<char>(name.begin(), name.end()));
     term->write_state(out);
   }
+  // The particle exchange's own state, framed by its name ("" = none).
+  const std::string exchange = exchange_ ? exchange_->name() : "";
+  out.put_array(std::vector<char>(exchange.begin(), exchange.end()));
+  if (exchange_)
+    exchange_->write_state(out);
   out.commit();
 }
 
@@ -593,6 +682,9 @@ void DemSystem::read_checkpoint(const std::string &path)
   in.get_array(z0);
   const long rebuilds = in.get<long>();
   const bool rebuild_requested = in.get<std::uint8_t>() != 0;
+  const auto next_id = in.get<std::int32_t>();
+  const long entered = in.get<long>(), left = in.get<long>();
+  const double skin = in.get<double>(), energy_floor = in.get<double>();
   const std::size_t n = particles_.size();
   for (const auto *a : checkpoint_arrays(particles_, forces_))
     if (a->size() != n)
@@ -604,6 +696,11 @@ void DemSystem::read_checkpoint(const std::string &path)
   const ForceBuffers saved_forces = forces_;
   const std::vector<std::int32_t> saved_counts = contact_count_;
   setup_derived();
+  particles_.next_id = next_id;
+  entered_ = entered;
+  left_ = left;
+  skin_ = skin;
+  energy_floor_ = energy_floor;
   // The neighbour list of the run that wrote the file, built again from the positions it was
   // built from. The particles are already in that build's cell order, so the build's stable
   // re-sort leaves them in place (checked: a changed order would continue differently).
@@ -635,6 +732,14 @@ void DemSystem::read_checkpoint(const std::string &path)
               "' where this run has '" + term->name() + "': restart with the case that wrote it");
     term->read_state(in);
   }
+  std::vector<char> exchange_name;
+  in.get_array(exchange_name);
+  const std::string exchange = exchange_ ? exchange_->name() : "";
+  if (std::string(exchange_name.begin(), exchange_name.end()) != exchange)
+    in.fail("was written with particle exchange '" + std::string(exchange_name.begin(), exchange_name.end()) +
+            "' where this run has '" + exchange + "': restart with the case that wrote it");
+  if (exchange_)
+    exchange_->read_state(in);
   forces_ = saved_forces;
   contact_count_ = saved_counts;
   step_ = step;

@@ -19,6 +19,7 @@
 #include "dem/contact_parameters.h"
 #include "dem/force_term.h"
 #include "dem/neighbour_list.h"
+#include "dem/particle_exchange.h"
 #include "dem/particle_state.h"
 #include "dem/stability_guards.h"
 #include "dem/time_step.h"
@@ -68,6 +69,22 @@ public:
   void replace_force_term(const std::string &name, std::unique_ptr<ForceTerm> term);
   const std::vector<std::unique_ptr<ForceTerm>> &force_terms() const { return terms_; }
 
+  // Particles entering and leaving (dem/particle_exchange.h): from now on, during every step
+  // that is a multiple of exchange->interval_steps(), the exchange decides who leaves and
+  // who enters. Set before initialize() (its smallest particles enter the stable time step).
+  void set_particle_exchange(std::unique_ptr<ParticleExchange> exchange);
+  ParticleExchange *particle_exchange() const { return exchange_.get(); }
+  // Removes the particles at indices `leave` (each once, any order) and appends those of
+  // `enter` under new ids, now: every surviving pair and wall contact keeps its history
+  // bit for bit, the leavers' contacts vanish, the newcomers start free, the force terms are
+  // told and the neighbour list is rebuilt (re-sorting the particles). The scheduled
+  // exchange calls it inside a step, before the forces; called between steps, the forces of
+  // the next half kick are those of the old set (the newcomers' are zero).
+  void exchange_particles(const std::vector<std::int32_t> &leave, const ParticleState &enter);
+  // Particles that entered and left through exchange_particles() since the start.
+  long particles_entered() const { return entered_; }
+  long particles_left() const { return left_; }
+
   // One velocity-Verlet step; the same as advance(1).
   void step();
   // `steps` steps, bit-identical to calling step() `steps` times. The threads stay in one
@@ -90,6 +107,7 @@ public:
   const PeriodicBox &box() const { return box_; }
   const NeighbourList &neighbour_list() const { return list_; }
   const ForceBuffers &forces() const { return forces_; }
+  const WallContactSlots &wall_slots() const { return wall_slots_; }
   const std::vector<std::int32_t> &contact_count() const { return contact_count_; }
   const PhaseTimes &phase_times() const { return times_; }
   long neighbour_rebuilds() const { return rebuilds_; }
@@ -131,6 +149,12 @@ private:
   ForceBuffers forces_;
   NeighbourList list_;
   std::vector<std::unique_ptr<ForceTerm>> terms_;
+  std::unique_ptr<ParticleExchange> exchange_;
+  long entered_ = 0, left_ = 0;
+  // exchange_particles()'s scratch (kept: no allocation per exchange beyond growth).
+  std::vector<std::int32_t> keep_, origin_, leave_plan_;
+  std::vector<char> leaving_;
+  ParticleState enter_plan_;
   std::vector<std::int32_t> contact_count_;
   std::vector<double> x0_, y0_, z0_; // positions at the last list build
   WallContactSlots wall_slots_;
@@ -161,7 +185,11 @@ private:
   enum class Pause { done, rebuild, force_terms, energy_guard, alarm };
 
   void setup_derived();
-  void rebuild_neighbour_list();
+  void rebuild_neighbour_list(const std::vector<std::int32_t> *origin = nullptr);
+  // advance() without the exchange schedule (the team's loop; dem_advance.cpp).
+  void advance_steps(long steps);
+  bool exchange_pending_ = false; // exchange at the rebuild of the step in progress
+  void run_scheduled_exchange();
   void permute_particles(const std::vector<std::int32_t> &order);
   bool parallel() const { return particles_.size() > 512; } // below: one thread is faster
   bool list_is_stale(double max_drift2) const { return force_rebuild_ || max_drift2 > 0.25 * skin_ * skin_; }

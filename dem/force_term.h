@@ -38,6 +38,11 @@ public:
   // Particle arrays were re-sorted (new[k] = old[order[k]]): terms that cache per-particle
   // data (e.g. dipole moments) reorder it here.
   virtual void particles_reordered(const std::vector<std::int32_t> & /*order*/) {}
+  // Particles left and entered the scene (dem/particle_exchange.h): origin[k] = the index
+  // that particle k had before, −1 for one that entered; an old index that appears nowhere
+  // left. Terms with per-particle state drop the leavers' and start the newcomers' here.
+  // Called before the particles_reordered() of the list rebuild that follows.
+  virtual void particles_changed(const std::vector<std::int32_t> & /*origin*/) {}
   // Checkpoint: a term whose forces depend on more than the particle state of this step
   // (held forces between refreshes, a far field kept from the last solve, a random stream)
   // writes that state here and reads it back, so that a restarted run continues bit for bit.

@@ -25,42 +25,35 @@ void PeriodicBox::wrap(ParticleState &s) const
   }
 }
 
-void NeighbourList::stash_history(const ParticleState &s)
+// The touching pairs' ξ, CSR by the owner's index at the last build (the list's own arrays
+// still describe that build, whatever happened to the particle arrays since).
+void NeighbourList::stash_history()
 {
-  const std::size_t n = s.size();
+  const std::size_t n = row_start.empty() ? 0 : row_start.size() - 1;
   old_start_.assign(n + 1, 0);
-  if (row_start.size() != n + 1)
-  { // first build (or a changed particle count): nothing to keep
-    old_partner_id_.clear();
-    return;
-  }
   for (std::size_t i = 0; i < n; ++i)
     for (std::int32_t p = row_start[i]; p < row_start[i + 1]; ++p)
-      if (touching[static_cast<std::size_t>(p)])
-        ++old_start_[static_cast<std::size_t>(s.id[i]) + 1];
+      old_start_[i + 1] += touching[static_cast<std::size_t>(p)];
   for (std::size_t k = 0; k < n; ++k)
     old_start_[k + 1] += old_start_[k];
   const std::size_t m = static_cast<std::size_t>(old_start_[n]);
-  old_partner_id_.resize(m);
+  old_partner_.resize(m);
   old_hx_.resize(m);
   old_hy_.resize(m);
   old_hz_.resize(m);
-  counts_.assign(n, 0);
+  std::size_t slot = 0; // rows in order: the pairs of row i fill [old_start_[i], old_start_[i+1])
   for (std::size_t i = 0; i < n; ++i)
-  {
-    const std::size_t a = static_cast<std::size_t>(s.id[i]);
     for (std::int32_t p = row_start[i]; p < row_start[i + 1]; ++p)
     {
       const std::size_t q = static_cast<std::size_t>(p);
       if (!touching[q])
         continue;
-      const std::size_t slot = static_cast<std::size_t>(old_start_[a] + counts_[a]++);
-      old_partner_id_[slot] = s.id[static_cast<std::size_t>(partner[q])];
+      old_partner_[slot] = partner[q];
       old_hx_[slot] = hist_x[q];
       old_hy_[slot] = hist_y[q];
       old_hz_[slot] = hist_z[q];
+      ++slot;
     }
-  }
 }
 
 void NeighbourList::compute_cell_order(const ParticleState &s, const PeriodicBox &box, double skin)
@@ -256,26 +249,33 @@ void NeighbourList::build_pairs(const ParticleState &s, const PeriodicBox &box, 
   }
 }
 
-void NeighbourList::restore_history(const ParticleState &s)
+void NeighbourList::restore_history(const std::vector<std::int32_t> *origin)
 {
-  const std::int32_t N = static_cast<std::int32_t>(s.size());
-  const bool have = !old_partner_id_.empty();
+  const std::int32_t N = static_cast<std::int32_t>(order_.size());
+  const std::int32_t old_n = static_cast<std::int32_t>(old_start_.size()) - 1;
+  // Index at the last build of each particle in the new order (−1: entered since).
+  old_index_.resize(order_.size());
+  for (std::size_t k = 0; k < order_.size(); ++k)
+  {
+    const std::int32_t o = origin ? (*origin)[static_cast<std::size_t>(order_[k])] : order_[k];
+    old_index_[k] = o < old_n ? o : -1; // (first build: nothing to find)
+  }
 #pragma omp parallel for schedule(static) if (N > 512)
   for (std::int32_t i = 0; i < N; ++i)
   {
     const std::size_t iu = static_cast<std::size_t>(i);
-    const std::int32_t a = s.id[iu];
+    const std::int32_t a = old_index_[iu];
     for (std::int32_t p = row_start[iu]; p < row_start[iu + 1]; ++p)
     {
       const std::size_t q = static_cast<std::size_t>(p);
       double hx = 0.0, hy = 0.0, hz = 0.0;
       std::int32_t found = 0;
-      if (have)
+      const std::int32_t b = old_index_[static_cast<std::size_t>(partner[q])];
+      if (a >= 0 && b >= 0)
       {
-        const std::int32_t b = s.id[static_cast<std::size_t>(partner[q])];
         // Same orientation (a, b): ξ as stored; reversed (b, a): ξ_ab = −ξ_ba.
         for (std::int32_t k = old_start_[static_cast<std::size_t>(a)]; k < old_start_[static_cast<std::size_t>(a) + 1] && !found; ++k)
-          if (old_partner_id_[static_cast<std::size_t>(k)] == b)
+          if (old_partner_[static_cast<std::size_t>(k)] == b)
           {
             hx = old_hx_[static_cast<std::size_t>(k)];
             hy = old_hy_[static_cast<std::size_t>(k)];
@@ -283,7 +283,7 @@ void NeighbourList::restore_history(const ParticleState &s)
             found = 1;
           }
         for (std::int32_t k = old_start_[static_cast<std::size_t>(b)]; k < old_start_[static_cast<std::size_t>(b) + 1] && !found; ++k)
-          if (old_partner_id_[static_cast<std::size_t>(k)] == a)
+          if (old_partner_[static_cast<std::size_t>(k)] == a)
           {
             hx = -old_hx_[static_cast<std::size_t>(k)];
             hy = -old_hy_[static_cast<std::size_t>(k)];
@@ -303,7 +303,7 @@ std::size_t NeighbourList::memory_bytes() const
 {
   std::size_t b = 0;
   for (const auto *a : {&row_start, &owner, &partner, &image, &touching, &col_start, &col_pair, &cell_of_, &cell_start_, &order_,
-                        &counts_, &old_start_, &old_partner_id_})
+                        &counts_, &old_start_, &old_partner_, &old_index_})
     b += a->capacity() * sizeof(std::int32_t);
   for (const auto *a : {&hist_x, &hist_y, &hist_z, &force_x, &force_y, &force_z, &torque_j_x, &torque_j_y, &torque_j_z, &old_hx_, &old_hy_, &old_hz_})
     b += a->capacity() * sizeof(double);

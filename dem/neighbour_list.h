@@ -9,8 +9,10 @@
 //   adhesion range here and keeps checking the drift against the skin alone.
 // * Spatial sorting: every build first re-sorts the particles in cell order (a stable counting
 //   sort), so neighbours are close in memory.
-// * Contact history (the Mindlin ξ of each touching pair) is keyed by the particles' stable
-//   ids while the list is rebuilt, so it survives both the rebuild and the re-sorting.
+// * Contact history (the Mindlin ξ of each touching pair) is keyed by the particles' indices
+//   at the last build while the list is rebuilt and mapped through the re-sorting (and
+//   through a change of the particle set: particles that left or entered), so it survives
+//   both; nothing here assumes that particle ids are dense.
 // * Periodic directions use the minimum image; each pair stores which image it uses.
 #pragma once
 
@@ -54,18 +56,26 @@ public:
   // The 27 image shifts, indexed by image code.
   const Vector3 *shifts() const { return shifts_.data(); }
 
-  // Rebuilds the list. Before: keeps the touching pairs' history keyed by id; then re-sorts
-  // all particle arrays in cell order through `permute` (a callback that applies an order
-  // to every per-particle array of the engine); then builds the pairs and restores history.
+  // Rebuilds the list. Before: keeps the touching pairs' history keyed by the particles'
+  // indices at the last build; then re-sorts all particle arrays in cell order through
+  // `permute` (a callback that applies an order to every per-particle array of the engine);
+  // then builds the pairs and restores the history of every pair whose two particles were
+  // both there at the last build.
+  //
+  // `origin` describes a change of the particle set since the last build (particles that
+  // left, particles that entered): origin[k] = the index particle k had at the last build,
+  // −1 for a particle that entered since; a particle whose index appears nowhere left, and
+  // its contacts vanish with it. nullptr = the same particles in the same order.
   template <typename Permute>
-  void rebuild(ParticleState &s, const PeriodicBox &box, double skin, Permute &&permute)
+  void rebuild(ParticleState &s, const PeriodicBox &box, double skin, Permute &&permute,
+               const std::vector<std::int32_t> *origin = nullptr)
   {
-    stash_history(s);
+    stash_history();
     box.wrap(s);
     compute_cell_order(s, box, skin);
     permute(order_);
     build_pairs(s, box, skin);
-    restore_history(s);
+    restore_history(origin);
   }
 
   // Statistics of the last build.
@@ -84,14 +94,15 @@ private:
   std::array<int, 3> n_{1, 1, 1};
   double cell_size_ = 0.0;
   std::vector<std::int32_t> cell_of_, cell_start_, order_, counts_;
-  // Stashed history, CSR keyed by particle id.
-  std::vector<std::int32_t> old_start_, old_partner_id_;
+  // Stashed history, CSR keyed by the particle index at the last build (partners likewise);
+  // old_index_ maps the new order back to it.
+  std::vector<std::int32_t> old_start_, old_partner_, old_index_;
   std::vector<double> old_hx_, old_hy_, old_hz_;
 
-  void stash_history(const ParticleState &s);
+  void stash_history();
   void compute_cell_order(const ParticleState &s, const PeriodicBox &box, double skin);
   void build_pairs(const ParticleState &s, const PeriodicBox &box, double skin);
-  void restore_history(const ParticleState &s);
+  void restore_history(const std::vector<std::int32_t> *origin);
 };
 
 } // namespace magbrush::dem

@@ -30,7 +30,35 @@ void ParticleState::add(const Vector3 &p, double r, double density, int species_
   inv_inertia.push_back(1.0 / (0.4 * m * r * r)); // solid sphere
   charge.push_back(charge_value);
   species.push_back(species_index);
-  id.push_back(static_cast<std::int32_t>(id.size()));
+  id.push_back(next_id++);
+}
+
+void ParticleState::append_from(const ParticleState &o, std::size_t k)
+{
+  x.push_back(o.x[k]);
+  y.push_back(o.y[k]);
+  z.push_back(o.z[k]);
+  vx.push_back(o.vx[k]);
+  vy.push_back(o.vy[k]);
+  vz.push_back(o.vz[k]);
+  wx.push_back(o.wx[k]);
+  wy.push_back(o.wy[k]);
+  wz.push_back(o.wz[k]);
+  radius.push_back(o.radius[k]);
+  mass.push_back(o.mass[k]);
+  inv_mass.push_back(o.inv_mass[k]);
+  inv_inertia.push_back(o.inv_inertia[k]);
+  charge.push_back(o.charge[k]);
+  species.push_back(o.species[k]);
+  id.push_back(next_id++);
+}
+
+std::int32_t ParticleState::id_bound() const
+{
+  std::int32_t m = -1;
+  for (std::int32_t v : id)
+    m = std::max(m, v);
+  return m + 1;
 }
 
 void ParticleState::permute(const std::vector<std::int32_t> &order, std::vector<double> &scratch,
@@ -47,6 +75,12 @@ void ForceBuffers::resize(std::size_t n)
 {
   for (auto *a : {&fx, &fy, &fz, &tx, &ty, &tz})
     a->assign(n, 0.0);
+}
+
+void ForceBuffers::extend(std::size_t n)
+{
+  for (auto *a : {&fx, &fy, &fz, &tx, &ty, &tz})
+    a->resize(n, 0.0);
 }
 
 void ForceBuffers::clear()

@@ -4,7 +4,9 @@
 // arrays without knowing anything about the engine.
 //
 // Index order is NOT stable: the engine periodically re-sorts particles in cell order for
-// cache locality. `id` is the stable name of a particle (0 .. N-1, dense).
+// cache locality. `id` is the stable name of a particle: given once, from the counter
+// `next_id`, and never reused, so that after particles have entered and left a scene the ids
+// are unique but NOT dense (nothing may index an array by id; sort or search by id instead).
 #pragma once
 
 #include "dem/vector3.h"
@@ -28,6 +30,7 @@ struct ParticleState
   std::vector<double> charge;      // [C]
   std::vector<std::int32_t> species; // population index in the case
   std::vector<std::int32_t> id;      // stable particle name
+  std::int32_t next_id = 0;          // the id the next added particle gets
 
   std::size_t size() const { return x.size(); }
   void resize(std::size_t n);
@@ -39,9 +42,17 @@ struct ParticleState
   // Appends one sphere of the given radius and density at rest.
   void add(const Vector3 &p, double r, double density, int species_index, double charge_value);
 
-  // Reorders every array: new[k] = old[order[k]]. `scratch` avoids allocation.
+  // Appends particle k of `other` as it is (kinematics, constants, species, charge) under a
+  // new id from next_id.
+  void append_from(const ParticleState &other, std::size_t k);
+
+  // Reorders every array: new[k] = old[order[k]]. `scratch` avoids allocation. `order` may
+  // be shorter than the arrays: the particles it does not name are dropped.
   void permute(const std::vector<std::int32_t> &order, std::vector<double> &scratch,
                std::vector<std::int32_t> &iscratch);
+
+  // The largest id + 1 (0 when empty): next_id may not be lower than this.
+  std::int32_t id_bound() const;
 };
 
 // Forces and torques [N, N m] accumulated during one step. Force terms ADD to these.
@@ -51,15 +62,18 @@ struct ForceBuffers
   std::vector<double> tx, ty, tz;
 
   void resize(std::size_t n);
+  // Grows to n particles, the new ones at zero (the others keep their values).
+  void extend(std::size_t n);
   void clear();
   void permute(const std::vector<std::int32_t> &order, std::vector<double> &scratch);
 };
 
-// Reorders one array by `order` through `scratch` (new[k] = old[order[k]]).
+// Reorders one array by `order` through `scratch` (new[k] = old[order[k]]); the result has
+// order.size() elements (an order that leaves indices out drops those elements).
 template <typename T>
 void permute_array(std::vector<T> &a, const std::vector<std::int32_t> &order, std::vector<T> &scratch)
 {
-  scratch.resize(a.size());
+  scratch.resize(order.size());
   for (std::size_t k = 0; k < order.size(); ++k)
     scratch[k] = a[static_cast<std::size_t>(order[k])];
   a.swap(scratch);

@@ -89,10 +89,11 @@ void SnapshotWriter::write(const DemSystem &system)
   const ForceBuffers &f = system.forces();
   const std::size_t n = s.size();
   particles_ = n;
-  // Index of each id in the current (sorted) order.
+  // The particles in ascending id (ids are unique, not dense once particles enter and leave).
   std::vector<std::size_t> where(n);
   for (std::size_t i = 0; i < n; ++i)
-    where[static_cast<std::size_t>(s.id[i])] = i;
+    where[i] = i;
+  std::sort(where.begin(), where.end(), [&s](std::size_t a, std::size_t b) { return s.id[a] < s.id[b]; });
   auto vec3 = [&](const std::vector<double> &a, const std::vector<double> &b, const std::vector<double> &c) {
     std::vector<double> out(3 * n);
     for (std::size_t k = 0; k < n; ++k)
@@ -130,6 +131,7 @@ void SnapshotWriter::write(const DemSystem &system)
   }
   file.commit();
   snapshots_.emplace_back(system.time(), name);
+  counts_.push_back(n); // particles may enter and leave: each snapshot has its own count
   write_index();
 }
 
@@ -137,6 +139,7 @@ void SnapshotWriter::resume(double up_to_time)
 {
   // Rebuild the list from the files present, keeping those not later than the restart time.
   snapshots_.clear();
+  counts_.clear();
   const fs::path dir = fs::path(directory_) / "snapshots";
   std::vector<std::string> files;
   for (const auto &e : fs::directory_iterator(dir))
@@ -170,6 +173,7 @@ void SnapshotWriter::resume(double up_to_time)
     {
       snapshots_.emplace_back(t, "snapshots/" + f);
       particles_ = static_cast<std::size_t>(dims[0]);
+      counts_.push_back(particles_);
     }
   }
 }
@@ -179,9 +183,10 @@ void SnapshotWriter::write_index() const
   std::ostringstream x;
   x << "<?xml version=\"1.0\" ?>\n<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n<Xdmf Version=\"3.0\">\n<Domain>\n"
     << "<Grid Name=\"particles\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
-  const std::size_t n = particles_;
-  for (const auto &[t, file] : snapshots_)
+  for (std::size_t k = 0; k < snapshots_.size(); ++k)
   {
+    const auto &[t, file] = snapshots_[k];
+    const std::size_t n = counts_[k];
     char tbuf[32];
     std::snprintf(tbuf, sizeof tbuf, "%.9g", t);
     x << "  <Grid Name=\"t=" << tbuf << "\" GridType=\"Uniform\">\n"

@@ -33,6 +33,7 @@ private:
   std::string directory_;
   std::vector<std::pair<double, std::string>> snapshots_; // (time, file relative to directory)
   std::size_t particles_ = 0;
+  std::vector<std::size_t> counts_; // particles in each snapshot
   void write_index() const;
 };
 

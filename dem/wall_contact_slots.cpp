@@ -10,12 +10,23 @@ std::size_t U(std::int32_t v) { return static_cast<std::size_t>(v); }
 
 void WallContactSlots::reset(std::size_t particles, std::size_t walls)
 {
+  has_walls_ = walls > 0;
   if (walls == 0)
     return;
   const std::size_t k = particles * per_particle;
   wall_.assign(k, -1);
   for (auto *a : doubles())
     a->assign(k, 0.0);
+}
+
+void WallContactSlots::extend(std::size_t particles)
+{
+  if (!has_walls_)
+    return;
+  const std::size_t k = particles * per_particle;
+  wall_.resize(k, -1);
+  for (auto *a : doubles())
+    a->resize(k, 0.0);
 }
 
 void WallContactSlots::release_untouched(std::size_t i, const int *touching, int m)
@@ -55,9 +66,10 @@ std::size_t WallContactSlots::slot_for(std::size_t i, int wall)
 void WallContactSlots::permute(const std::vector<std::int32_t> &order, std::vector<double> &scratch,
                                std::vector<std::int32_t> &iscratch)
 {
-  if (wall_.empty())
+  if (!has_walls_)
     return;
-  std::vector<std::int32_t> slot_order(order.size() * per_particle);
+  std::vector<std::int32_t> &slot_order = slot_order_;
+  slot_order.resize(order.size() * per_particle);
   for (std::size_t k = 0; k < order.size(); ++k)
     for (int s = 0; s < per_particle; ++s)
       slot_order[k * per_particle + U(s)] = order[k] * per_particle + s;
@@ -111,6 +123,7 @@ void WallContactSlots::write(CheckpointWriter &out) const
 void WallContactSlots::read(CheckpointReader &in)
 {
   in.get_array(wall_);
+  has_walls_ = !wall_.empty() || has_walls_;
   for (auto *a : doubles())
     in.get_array(*a);
 }

@@ -51,6 +51,8 @@ public:
   std::size_t slot_for(std::size_t i, int wall);
 
   Vector3 history(std::size_t slot) const { return {hx_[slot], hy_[slot], hz_[slot]}; }
+  // The wall slot `slot` (= particle × per_particle + k) is in contact with (−1: free).
+  int wall(std::size_t slot) const { return wall_.empty() ? -1 : wall_[slot]; }
   void set_history(std::size_t slot, const Vector3 &xi) { hx_[slot] = xi.x, hy_[slot] = xi.y, hz_[slot] = xi.z; }
   void set_load(std::size_t slot, const Vector3 &force_on_wall, const Vector3 &torque_on_wall)
   {
@@ -58,7 +60,11 @@ public:
     tx_[slot] = torque_on_wall.x, ty_[slot] = torque_on_wall.y, tz_[slot] = torque_on_wall.z;
   }
 
-  // The particles were re-sorted (new[k] = old[order[k]]): the slots follow in blocks.
+  // Grows to `particles` particles, the new ones with all slots free (no history).
+  void extend(std::size_t particles);
+
+  // The particles were re-sorted (new[k] = old[order[k]]): the slots follow in blocks. An
+  // order shorter than the particle count drops the slots of the particles it leaves out.
   void permute(const std::vector<std::int32_t> &order, std::vector<double> &scratch,
                std::vector<std::int32_t> &iscratch);
 
@@ -71,7 +77,9 @@ public:
   std::size_t memory_bytes() const;
 
 private:
+  bool has_walls_ = false;
   std::vector<std::int32_t> wall_;
+  std::vector<std::int32_t> slot_order_; // permute()'s scratch
   std::vector<double> hx_, hy_, hz_;           // tangential history ξ
   std::vector<double> fx_, fy_, fz_, tx_, ty_, tz_; // load on the wall
   std::array<std::vector<double> *, 9> doubles() { return {&hx_, &hy_, &hz_, &fx_, &fy_, &fz_, &tx_, &ty_, &tz_}; }

@@ -247,6 +247,11 @@ void InducedDipoles::solve_dipoles(const BeadArrays &beads, MagneticStats &stats
     for (long b = 0; b < static_cast<long>(n); ++b)
       induced_moment(beads.radius[b], beta_[b], Ms_[b], &B0_[3 * b], &p_[3 * b]);
   }
+  const bool fresh = warm_start && !fresh_.empty(); // beads that entered: applied-field dipoles
+  if (fresh)
+    for (std::uint32_t b : fresh_)
+      induced_moment(beads.radius[b], beta_[b], Ms_[b], &B0_[3 * b], &p_[3 * b]);
+  fresh_.clear();
   if (settings_.model == DipoleModel::point_dipole)
   {
     if (far_)
@@ -264,7 +269,7 @@ void InducedDipoles::solve_dipoles(const BeadArrays &beads, MagneticStats &stats
     // The far field is held fixed through the sweeps (only the near field changes from
     // sweep to sweep) and re-evaluated from the latest dipoles far_passes times in all (one
     // more from a cold start, whose first far field comes from the applied-field dipoles).
-    const int passes = settings_.far_passes + (warm_start ? 0 : 1);
+    const int passes = settings_.far_passes + (warm_start && !fresh ? 0 : 1);
     for (int pass = 0; pass < passes; ++pass)
     {
       evaluate_far_field(stats);
@@ -479,6 +484,30 @@ void InducedDipoles::particles_reordered(const std::vector<std::int32_t> &order)
   permute(torque_);
   staleness_.particles_reordered(order);
   near_.forget(); // pair indices refer to the old order
+  correction_.forget_list();
+}
+
+void InducedDipoles::particles_changed(const std::vector<std::int32_t> &origin)
+{
+  const std::size_t old_n = p_.size() / 3;
+  fresh_.clear();
+  if (old_n == 0) // nothing kept: the next compute() starts cold anyway
+    return;
+  const std::vector<double> old(p_);
+  p_.assign(3 * origin.size(), 0.0);
+  for (std::size_t k = 0; k < origin.size(); ++k)
+  {
+    const std::int32_t o = origin[k];
+    if (o >= 0 && static_cast<std::size_t>(o) < old_n)
+      for (int d = 0; d < 3; ++d)
+        p_[3 * k + d] = old[3 * static_cast<std::size_t>(o) + d];
+    else
+      fresh_.push_back(static_cast<std::uint32_t>(k));
+  }
+  force_.clear();
+  torque_.clear();
+  computed_ = false;
+  near_.forget(); // pair indices refer to the old set
   correction_.forget_list();
 }
 

@@ -126,6 +126,12 @@ public:
   // The caller re-sorted its beads (new[k] = old[order[k]]): the kept dipoles, held forces
   // and reference positions follow, and the neighbour list is rebuilt at the next compute.
   void particles_reordered(const std::vector<std::int32_t> &order);
+  // The caller's bead set changed (beads left, beads entered): new[k] = old[origin[k]],
+  // origin[k] = −1 for a bead that entered. The kept beads keep their dipoles as the next
+  // compute()'s initial guess, the new ones start from their applied-field dipole (with the
+  // cold start's extra far-field pass); everything else is rebuilt by that compute(), which
+  // must be the next call.
+  void particles_changed(const std::vector<std::int32_t> &origin);
 
   // Restart (common/state_stream.h): everything a later evaluation or local refresh reads —
   // the held forces, the dipoles (the next solve's start), the fields, the near pairs and
@@ -167,6 +173,7 @@ private:
   // field and gradient, and the held force and torque.
   std::vector<double> beta_, Ms_, B0_, gradB0_, p_, p_next_, B_local_, B_far_, gradB_far_;
   std::vector<double> force_, torque_;
+  std::vector<std::uint32_t> fresh_; // beads that entered since the last compute (particles_changed)
   bool computed_ = false;
   bool zero_field_ = false; // the last compute() found no applied field at any bead
   double skin_ = 0.0;       // Verlet skin of the last compute [m]

@@ -8,6 +8,7 @@
 
 #include <omp.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -167,6 +168,13 @@ void MagneticForceTerm::add_forces(const dem::ParticleState &state, dem::ForceBu
     select_carriers(state);
     must_refresh_ = true;
   }
+  else if (changed_)
+  {
+    admit_newcomers(state);
+    must_refresh_ = true; // a full (warm-started) evaluation of the new set
+  }
+  changed_ = false;
+  newcomers_.clear();
   const std::size_t n = carrier_.size();
   if (n == 0)
     return;
@@ -270,7 +278,7 @@ void MagneticForceTerm::particles_reordered(const std::vector<std::int32_t> &ord
 {
   // The engine re-sorted its arrays (new[k] = old[order[k]]): only the engine index of each
   // compact bead changes. The magnetics keep their own order, lists, dipoles and forces.
-  if (carrier_.empty())
+  if (carrier_.empty() && newcomers_.empty())
     return;
   if (order.size() != state_size_)
   {
@@ -282,6 +290,86 @@ void MagneticForceTerm::particles_reordered(const std::vector<std::int32_t> &ord
     new_index[static_cast<std::size_t>(order[k])] = static_cast<std::uint32_t>(k);
   for (auto &i : carrier_)
     i = new_index[i];
+  for (auto &i : newcomers_)
+    i = new_index[i];
+}
+
+void MagneticForceTerm::particles_changed(const std::vector<std::int32_t> &origin)
+{
+  // Old engine index → new (−1: left). The compact beads whose particle left are dropped;
+  // the others keep their compact order.
+  new_index_.assign(state_size_, -1);
+  for (std::size_t k = 0; k < origin.size(); ++k)
+    if (origin[k] >= 0)
+    {
+      if (static_cast<std::size_t>(origin[k]) >= state_size_)
+      { // the term has not seen this particle set: select afresh at the next step
+        must_refresh_ = true;
+        state_size_ = origin.size();
+        return;
+      }
+      new_index_[static_cast<std::size_t>(origin[k])] = static_cast<std::int32_t>(k);
+    }
+  // Newcomers of an earlier change not yet admitted (two changes between steps) follow too.
+  std::size_t still = 0;
+  for (std::uint32_t i : newcomers_)
+    if (new_index_[i] >= 0)
+      newcomers_[still++] = static_cast<std::uint32_t>(new_index_[i]);
+  newcomers_.resize(still);
+  for (std::size_t k = 0; k < origin.size(); ++k)
+    if (origin[k] < 0)
+      newcomers_.push_back(static_cast<std::uint32_t>(k));
+  // compact_origin_ maps the compact order to the one the dipole solver last saw.
+  if (!changed_)
+  {
+    compact_origin_.resize(carrier_.size());
+    for (std::size_t c = 0; c < carrier_.size(); ++c)
+      compact_origin_[c] = static_cast<std::int32_t>(c);
+  }
+  std::size_t kept = 0;
+  for (std::size_t c = 0; c < carrier_.size(); ++c)
+  {
+    const std::int32_t to = new_index_[carrier_[c]];
+    if (to < 0)
+      continue;
+    carrier_[kept] = static_cast<std::uint32_t>(to);
+    for (auto *v : {&x_, &y_, &z_, &radius_, &mu_r_, &Ms_})
+      (*v)[kept] = (*v)[c];
+    compact_origin_[kept] = compact_origin_[c];
+    ++kept;
+  }
+  carrier_.resize(kept);
+  compact_origin_.resize(kept);
+  for (auto *v : {&x_, &y_, &z_, &radius_, &mu_r_, &Ms_})
+    v->resize(kept);
+  state_size_ = origin.size();
+  changed_ = true;
+}
+
+// The carriers among the particles that entered, in ascending engine index, appended to the
+// compact order; then the dipole solver learns the new set (kept dipoles as the initial guess).
+void MagneticForceTerm::admit_newcomers(const dem::ParticleState &state)
+{
+  std::sort(newcomers_.begin(), newcomers_.end());
+  for (std::uint32_t k : newcomers_)
+  {
+    const std::size_t species = static_cast<std::size_t>(state.species[k]);
+    if (species >= species_.size() || !species_[species].carrier)
+      continue;
+    carrier_.push_back(k);
+    x_.push_back(state.x[k]);
+    y_.push_back(state.y[k]);
+    z_.push_back(state.z[k]);
+    radius_.push_back(state.radius[k]);
+    mu_r_.push_back(species_[species].mu_r);
+    Ms_.push_back(species_[species].saturation_magnetisation);
+    compact_origin_.push_back(-1);
+  }
+  const std::size_t n = carrier_.size();
+  for (auto *v : {&fx_, &fy_, &fz_, &tx_, &ty_, &tz_})
+    v->assign(n, 0.0);
+  dipoles_.particles_changed(compact_origin_);
+  compact_origin_.clear();
 }
 
 // ---------------------------------------------------------------------------------------

@@ -50,6 +50,10 @@ public:
   void write_state(dem::CheckpointWriter &out) const override;
   void read_state(dem::CheckpointReader &in) override;
   bool restored_state() const { return restored_; }
+  // Carriers left or entered: the leavers are dropped from the compact order (the others
+  // keep their place, dipoles and unwrapped positions), the newcomers that are carriers are
+  // appended at the next step, which then solves in full (warm-started).
+  void particles_changed(const std::vector<std::int32_t> &origin) override;
 
   // Statistics of the last full evaluation, and of the last local refresh.
   const MagneticStats &last_stats() const { return stats_; }
@@ -104,6 +108,11 @@ private:
   std::vector<std::uint32_t> carrier_;
   std::vector<double> x_, y_, z_, radius_, mu_r_, Ms_, fx_, fy_, fz_, tx_, ty_, tz_;
   bool must_refresh_ = true;
+  // Engine indices of particles that entered since the last step (particles_changed), kept
+  // through re-sorting; the carriers among them join the compact order at the next step.
+  std::vector<std::uint32_t> newcomers_;
+  bool changed_ = false;
+  std::vector<std::int32_t> compact_origin_, new_index_;
   bool enabled_ = true;
   bool restored_ = false; // read_state() found state for these settings
   // The applied field's ramp factor s(t) when the held forces were evaluated.
@@ -111,6 +120,7 @@ private:
   double last_scale_ = 1.0; // the ramp rescaling of the held forces at the last step
 
   void select_carriers(const dem::ParticleState &state);
+  void admit_newcomers(const dem::ParticleState &state);
   void gather_positions(const dem::ParticleState &state);
   AppliedFieldFunction lookup_at(double t) const;
   void full_refresh(const BeadArrays &beads, double t, double ramp);

@@ -2,8 +2,8 @@
 // bead budget of the periodic slab and the load on the drum. One row per sample in
 // nip_time_series.csv:
 //
-//  * beads: particles in the slab (the engine neither creates nor deletes any: must stay
-//    constant); lost: beads with a non-finite position, inside the sleeve, or farther from the
+//  * beads: particles in the slab (constant unless the case has an inflow or an outflow);
+//    lost: beads with a non-finite position, inside the sleeve, or farther from the
 //    roller axis than the magnetic grid reaches (nothing holds them any more);
 //  * the bead budget of the nip window |θ| ≤ nip.chain_half_angle (sleeve angle): beads in
 //    it, and the running counts of beads that entered it across its upstream edge and left it

@@ -313,6 +313,22 @@ TEST(ModuleDefaults, MeasurementAndOutputSettingsOfADefaultCaseAreTheStructDefau
   EXPECT_SAME(c.compression, compression, average_window);
   EXPECT_SAME(c.compression, compression, map_interval);
 
+  // Particles entering and leaving (inflow, outflow, flow_report): off by default.
+  const FlowSettings flow;
+  EXPECT_SAME_EXACT(c.flow, flow, inflow_population);
+  EXPECT_SAME(c.flow, flow, inflow_areal_mass);
+  EXPECT_SAME(c.flow, flow, inflow_angle);
+  EXPECT_SAME(c.flow, flow, inflow_layer_height);
+  EXPECT_SAME(c.flow, flow, interval);
+  EXPECT_SAME(c.flow, flow, outflow_angle);
+  EXPECT_SAME(c.flow, flow, outflow_width);
+  EXPECT_SAME(c.flow, flow, outflow_radius);
+  EXPECT_SAME(c.flow, flow, sample_interval);
+  EXPECT_SAME(c.flow, flow, flux_angle);
+  EXPECT_SAME(c.flow, flow, density_window);
+  EXPECT_FALSE(c.flow.inflow());
+  EXPECT_FALSE(c.flow.outflow());
+
   const OutputSettings output;
   EXPECT_SAME_EXACT(c.output, output, directory);
   EXPECT_SAME_EXACT(c.output, output, vtu);

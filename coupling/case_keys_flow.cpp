@@ -1,0 +1,52 @@
+// Case keys of module "flow" (the list of modules and why it is explicit: case_keys.h).
+// Particles entering and leaving a roller scene: developer fed onto the sleeve upstream
+// (inflow), removed downstream (outflow), and the flow report (counts and masses in, out and
+// present; the flux through a radial line and the areal mass around it). Read by
+// dem/particle_source, dem/particle_sink, dem/particle_flow and dem/measurements/flow_report.
+#include "coupling/case_keys.h"
+
+namespace magbrush::case_keys {
+
+std::vector<KeySpec> flow_keys()
+{
+  return {
+      section("inflow", "Developer fed onto the sleeve during the run: a layer of the given mass per area created "
+                        "just downstream of an entry angle, moving with the sleeve, so that the mass flux is "
+                        "areal_mass x sleeve speed x slab length (docs/design.md, particles entering and leaving)."),
+      text("inflow.population", "The carrier population fed (\"\" = the first carrier population). Toner populations "
+                                "with a concentration come attached to the carriers in that proportion.")
+          .def(""),
+      quantity("inflow.areal_mass", D::areal_mass,
+               "Developer (carrier + toner) mass per sleeve area carried in (DMA; 0 = no inflow).")
+          .def("0 kg/m^2").non_negative(),
+      quantity("inflow.angle", D::angle, "Entry angle on the sleeve (roller angle, counter-clockwise from +x): new "
+                                         "particles appear in the arc the sleeve surface swept past it since the last exchange.")
+          .def("0 deg").min(-2.0 * pi).max(2.0 * pi),
+      quantity("inflow.layer_height", D::length, "New particles are placed within this distance of the sleeve surface "
+                                                 "(at random, without overlap).")
+          .def("0.5 mm").positive(),
+      quantity("inflow.interval", D::time, "Time between exchanges: insertions and removals happen every interval.")
+          .def("1 us").positive(),
+
+      section("outflow", "Particles removed during the run: those in a sector of the sleeve downstream, and those "
+                         "that left the window around the sleeve."),
+      quantity("outflow.angle", D::angle, "Start of the removal sector (roller angle); it extends from here in the "
+                                          "direction the sleeve turns.")
+          .def("0 deg").min(-2.0 * pi).max(2.0 * pi),
+      quantity("outflow.width", D::angle, "Angular extent of the removal sector (0 = none).")
+          .def("0 deg").non_negative().max(2.0 * pi),
+      quantity("outflow.outer_radius", D::length, "Also remove particles farther than this from the roller axis (0 = none).")
+          .def("0 mm").non_negative(),
+
+      section("flow_report", "The flow report of a scene with inflow or outflow (flow_report.csv): particles and mass "
+                             "in, out and present, the mass flux through a radial line and the areal mass around it."),
+      quantity("flow_report.sample_interval", D::time, "Time between samples.").def("2 us").positive(),
+      quantity("flow_report.flux_angle", D::angle, "The radial line (roller angle) through which the flux is counted.")
+          .def("0 deg").min(-2.0 * pi).max(2.0 * pi),
+      quantity("flow_report.density_window", D::angle, "Angular window centred on the flux line over which the areal "
+                                                        "mass is measured.")
+          .def("10 deg").positive().max(pi),
+  };
+}
+
+} // namespace magbrush::case_keys

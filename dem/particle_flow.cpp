@@ -1,0 +1,56 @@
+// Inflow and outflow as the engine's particle exchange (see particle_flow.h).
+#include "dem/particle_flow.h"
+
+#include "dem/checkpoint_file.h"
+#include "dem/dem_system.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace magbrush::dem {
+
+ParticleFlow::ParticleFlow(const Case &c, const DemSystem &system) : system_(system), interval_(c.flow.interval)
+{
+  if (c.flow.inflow())
+    source_ = std::make_unique<ParticleSource>(c, system.walls(), system.box());
+  if (c.flow.outflow())
+    sink_ = std::make_unique<ParticleSink>(c);
+}
+
+long ParticleFlow::interval_steps() const
+{
+  const double dt = system_.time_step();
+  return dt > 0.0 ? std::max(1L, std::lround(interval_ / dt)) : 1L;
+}
+
+void ParticleFlow::plan(const ParticleState &state, double t, std::vector<std::int32_t> &leave, ParticleState &enter)
+{
+  if (sink_)
+    sink_->select(state, leave);
+  if (source_)
+    source_->create(state, t, enter);
+}
+
+void ParticleFlow::smallest_particles(ParticleState &out) const
+{
+  if (source_)
+    source_->smallest_particles(out);
+}
+
+void ParticleFlow::write_state(CheckpointWriter &out) const
+{
+  if (source_)
+    source_->write_state(out);
+  if (sink_)
+    sink_->write_state(out);
+}
+
+void ParticleFlow::read_state(CheckpointReader &in)
+{
+  if (source_)
+    source_->read_state(in);
+  if (sink_)
+    sink_->read_state(in);
+}
+
+} // namespace magbrush::dem

@@ -1,0 +1,45 @@
+// Particles entering and leaving a roller scene, as the case asks (inflow.*, outflow.*): the
+// engine's ParticleExchange (particle_exchange.h) built from the inflow (particle_source.h)
+// and the outflow (particle_sink.h). Every inflow.interval (rounded to whole steps) the sink
+// first names the particles in its region, then the source creates the developer owed for the
+// arc the sleeve swept since the last exchange. DemRun installs it when the case has an
+// inflow or an outflow; the flow report (dem/measurements/flow_report.h) reads its counts.
+#pragma once
+
+#include "dem/particle_exchange.h"
+#include "dem/particle_sink.h"
+#include "dem/particle_source.h"
+
+#include "coupling/case_model.h"
+
+#include <memory>
+
+namespace magbrush::dem {
+
+class DemSystem;
+
+class ParticleFlow : public ParticleExchange
+{
+public:
+  // The source and sink the case asks for; `system` supplies the walls, the box and (once
+  // initialised) the time step. Throws std::invalid_argument naming a key.
+  ParticleFlow(const Case &c, const DemSystem &system);
+
+  const char *name() const override { return "inflow/outflow"; }
+  long interval_steps() const override;
+  void plan(const ParticleState &state, double t, std::vector<std::int32_t> &leave, ParticleState &enter) override;
+  void smallest_particles(ParticleState &out) const override;
+  void write_state(CheckpointWriter &out) const override;
+  void read_state(CheckpointReader &in) override;
+
+  const ParticleSource *source() const { return source_.get(); }
+  const ParticleSink *sink() const { return sink_.get(); }
+
+private:
+  const DemSystem &system_;
+  double interval_ = 0.0;
+  std::unique_ptr<ParticleSource> source_;
+  std::unique_ptr<ParticleSink> sink_;
+};
+
+} // namespace magbrush::dem

@@ -1,0 +1,273 @@
+// The inflow on the sleeve (see particle_source.h).
+#include "dem/particle_source.h"
+
+#include "dem/checkpoint_file.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+namespace magbrush::dem {
+
+namespace {
+double sphere_mass(double d, double rho) { return rho * M_PI / 6.0 * d * d * d; }
+constexpr int carrier_attempts = 200, toner_attempts = 50;
+} // namespace
+
+ParticleSource::ParticleSource(const Case &c, const DemWalls &walls, const PeriodicBox &box)
+  : walls_(walls), box_(box), rng_(c.dem.seed * 0x9E3779B97F4A7C15ull + 0x5eed)
+{
+  const FlowSettings &f = c.flow;
+  if (!c.sleeve)
+    throw std::invalid_argument("inflow.areal_mass: the inflow feeds the sleeve, and the case has none");
+  if (!box.periodic(2))
+    throw std::invalid_argument("inflow.areal_mass: the inflow needs dem.periodic_length (the slab along the roller axis)");
+  auto feed_of = [&c](std::size_t s) {
+    const Population &p = c.populations[s];
+    Feed fd;
+    fd.species = static_cast<int>(s);
+    fd.density = c.material(p.material).density;
+    fd.d_mean = p.diameter_mean;
+    fd.d_std = std::max(0.0, p.diameter_std);
+    // The normal distribution truncated at ±3σ (and to positive sizes): the smallest size
+    // bounds the stable time step before the particle exists.
+    fd.d_min = std::max(0.05 * fd.d_mean, fd.d_mean - 3.0 * fd.d_std);
+    fd.d_max = fd.d_mean + 3.0 * fd.d_std;
+    fd.charge_to_mass = p.charge_to_mass;
+    fd.concentration = p.concentration;
+    return fd;
+  };
+  int carrier = -1;
+  for (std::size_t s = 0; s < c.populations.size(); ++s)
+  {
+    const Population &p = c.populations[s];
+    if (p.kind == ParticleKind::carrier && carrier < 0 &&
+        (f.inflow_population.empty() || f.inflow_population == p.name))
+      carrier = static_cast<int>(s);
+    if (p.kind == ParticleKind::toner && p.concentration > 0.0)
+      toner_.push_back(feed_of(s));
+  }
+  if (carrier < 0)
+    throw std::invalid_argument(f.inflow_population.empty()
+                                    ? "inflow.population: the case has no carrier population to feed"
+                                    : "inflow.population: no carrier population named '" + f.inflow_population + "'");
+  carrier_ = feed_of(static_cast<std::size_t>(carrier));
+  double tc = 0.0;
+  for (const Feed &t : toner_)
+    tc += t.concentration;
+  R_ = c.sleeve->radius;
+  Lz_ = box.length[2];
+  height_ = f.inflow_layer_height;
+  theta_in_ = f.inflow_angle;
+  omega_ = c.sleeve->omega();
+  spin_up_ = c.sleeve->spin_up_time;
+  areal_mass_ = f.inflow_areal_mass;
+  carrier_share_ = 1.0 / (1.0 + tc);
+  // Random insertion jams near 30-40 % solid; refuse a layer that would need more.
+  const double free_height = height_ - carrier_.d_mean;
+  const double solid = free_height > 0.0 ? carrier_share_ * areal_mass_ / (carrier_.density * free_height) : 1.0;
+  if (solid > 0.3)
+    throw std::invalid_argument("inflow.layer_height: a layer of " + std::to_string(height_ * 1e3) +
+                                " mm cannot hold inflow.areal_mass = " + std::to_string(areal_mass_) +
+                                " kg/m^2 of carriers by random placement (" + std::to_string(100.0 * solid) +
+                                " % solid; at most 30 %): raise inflow.layer_height to at least " +
+                                std::to_string(1e3 * (carrier_share_ * areal_mass_ / (0.3 * carrier_.density) + carrier_.d_mean)) + " mm");
+  owed_toner_.assign(toner_.size(), 0.0);
+  count_.assign(c.populations.size(), 0);
+  mass_.assign(c.populations.size(), 0.0);
+}
+
+double ParticleSource::sleeve_rotation(double t) const
+{
+  if (t <= 0.0)
+    return 0.0;
+  if (spin_up_ > 0.0 && t < spin_up_)
+    return omega_ * t * t / (2.0 * spin_up_);
+  return omega_ * (t - 0.5 * spin_up_);
+}
+
+void ParticleSource::smallest_particles(ParticleState &out) const
+{
+  out.add({0, 0, 0}, 0.5 * carrier_.d_min, carrier_.density, carrier_.species, 0.0);
+  for (const Feed &t : toner_)
+    out.add({0, 0, 0}, 0.5 * t.d_min, t.density, t.species, 0.0);
+}
+
+double ParticleSource::draw_diameter(const Feed &f)
+{
+  if (f.d_std <= 0.0)
+    return f.d_mean;
+  std::normal_distribution<double> normal(f.d_mean, f.d_std);
+  for (;;)
+  {
+    const double d = normal(rng_);
+    if (d >= f.d_min && d <= f.d_max)
+      return d;
+  }
+}
+
+// The particles present within reach of the arc θ0 … θ0 + Δφ (and of the layer).
+void ParticleSource::gather_near(const ParticleState &s, double theta0, double dphi)
+{
+  near_x_.clear();
+  near_r_.clear();
+  double d_big = carrier_.d_max;
+  for (const Feed &t : toner_)
+    d_big = std::max(d_big, carrier_.d_max + 2.0 * t.d_max);
+  const double mid = theta0 + 0.5 * dphi, half = 0.5 * std::abs(dphi) + (height_ + 2.0 * d_big) / R_;
+  const double r_out = R_ + height_ + 2.0 * d_big;
+  for (std::size_t i = 0; i < s.size(); ++i)
+  {
+    const double r = std::hypot(s.x[i], s.y[i]);
+    if (r > r_out)
+      continue;
+    const double a = std::remainder(std::atan2(s.y[i], s.x[i]) - mid, 2.0 * M_PI);
+    if (std::abs(a) > half)
+      continue;
+    near_x_.push_back(s.position(i));
+    near_r_.push_back(s.radius[i]);
+  }
+}
+
+bool ParticleSource::clear_of_everything(const Vector3 &p, double r) const
+{
+  for (std::size_t k = 0; k < near_x_.size(); ++k)
+  {
+    double dz = near_x_[k].z - p.z;
+    dz -= Lz_ * std::round(dz / Lz_);
+    const double dx = near_x_[k].x - p.x, dy = near_x_[k].y - p.y, reach = r + near_r_[k];
+    if (dx * dx + dy * dy + dz * dz < reach * reach)
+      return false;
+  }
+  for (std::size_t w = 0; w < walls_.size(); ++w)
+    if (walls_.distance(w, p, t_last_) < r)
+      return false;
+  return true;
+}
+
+void ParticleSource::append(const Feed &f, const Vector3 &p, double d, double t, ParticleState &enter)
+{
+  const double m = sphere_mass(d, f.density);
+  enter.add(p, 0.5 * d, f.density, f.species, f.charge_to_mass * m);
+  // Rigidly with the sleeve: v = ω ẑ × x, spin ω ẑ.
+  const double w = spin_up_ > 0.0 && t < spin_up_ ? omega_ * t / spin_up_ : omega_;
+  enter.vx.back() = -w * p.y;
+  enter.vy.back() = w * p.x;
+  enter.wz.back() = w;
+  near_x_.push_back(p);
+  near_r_.push_back(0.5 * d);
+  count_[static_cast<std::size_t>(f.species)] += 1;
+  mass_[static_cast<std::size_t>(f.species)] += enter.mass.back();
+}
+
+bool ParticleSource::place_carrier(double d, double theta0, double dphi, double t, ParticleState &enter)
+{
+  const double r = 0.5 * d, a = R_ + r, b = R_ + height_ - r;
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int attempt = 0; attempt < carrier_attempts; ++attempt)
+  {
+    const double rr = std::sqrt(a * a + u(rng_) * (b * b - a * a));
+    const double th = theta0 + dphi * u(rng_);
+    const Vector3 p{rr * std::cos(th), rr * std::sin(th), Lz_ * u(rng_)};
+    if (!clear_of_everything(p, r))
+      continue;
+    append(carrier_, p, d, t, enter);
+    attach_toner(p, r, t, enter);
+    return true;
+  }
+  return false;
+}
+
+void ParticleSource::attach_toner(const Vector3 &c, double rc, double t, ParticleState &enter)
+{
+  const double mc = sphere_mass(2.0 * rc, carrier_.density);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (std::size_t k = 0; k < toner_.size(); ++k)
+  {
+    const Feed &f = toner_[k];
+    owed_toner_[k] += f.concentration * mc;
+    for (;;)
+    {
+      const double d = draw_diameter(f), m = sphere_mass(d, f.density);
+      if (owed_toner_[k] < 0.5 * m)
+        break;
+      bool placed = false;
+      for (int attempt = 0; attempt < toner_attempts && !placed; ++attempt)
+      {
+        // A random point of the carrier's surface; the toner touches it without overlap.
+        const double cz = 2.0 * u(rng_) - 1.0, ph = 2.0 * M_PI * u(rng_), s = std::sqrt(1.0 - cz * cz);
+        const double reach = (rc + 0.5 * d) * (1.0 + 1e-9);
+        Vector3 p{c.x + reach * s * std::cos(ph), c.y + reach * s * std::sin(ph), c.z + reach * cz};
+        p.z -= Lz_ * std::floor(p.z / Lz_);
+        if (!clear_of_everything(p, 0.5 * d))
+          continue;
+        append(f, p, d, t, enter);
+        owed_toner_[k] -= m;
+        placed = true;
+      }
+      if (!placed)
+        break; // owed to the next carrier
+    }
+  }
+}
+
+void ParticleSource::create(const ParticleState &state, double t, ParticleState &enter)
+{
+  const double dphi = sleeve_rotation(t) - sleeve_rotation(t_last_);
+  t_last_ = t;
+  if (dphi == 0.0)
+    return;
+  owed_carrier_ += carrier_share_ * areal_mass_ * R_ * std::abs(dphi) * Lz_;
+  // The arc the new carriers' centres go into: the one swept, but at least two diameters long
+  // (an exchange every few steps sweeps far less than a bead; what does not fit waits).
+  const double span = std::copysign(std::max(std::abs(dphi), 2.0 * carrier_.d_max / R_), dphi);
+  gather_near(state, theta_in_, span);
+  for (;;)
+  {
+    const double d = pending_d_ > 0.0 ? pending_d_ : draw_diameter(carrier_);
+    pending_d_ = d;
+    // Whole particles; what is owed below half a particle waits for the next exchange.
+    if (owed_carrier_ < 0.5 * sphere_mass(d, carrier_.density))
+      break;
+    if (!place_carrier(d, theta_in_, span, t, enter))
+      break;
+    owed_carrier_ -= sphere_mass(d, carrier_.density);
+    pending_d_ = 0.0;
+  }
+  const double mean_mass = sphere_mass(carrier_.d_mean, carrier_.density);
+  if (owed_carrier_ > 50.0 * mean_mass)
+    throw std::runtime_error("inflow: the developer owed (" + std::to_string(owed_carrier_ / mean_mass) +
+                             " carriers) does not fit into the entry arc: the particles there do not move on "
+                             "with the sleeve, or inflow.layer_height is too thin for inflow.areal_mass");
+}
+
+void ParticleSource::write_state(CheckpointWriter &out) const
+{
+  std::ostringstream text;
+  text << rng_;
+  const std::string s = text.str();
+  out.put_array(std::vector<char>(s.begin(), s.end()));
+  out.put(t_last_);
+  out.put(owed_carrier_);
+  out.put(pending_d_);
+  out.put_array(owed_toner_);
+  out.put_array(count_);
+  out.put_array(mass_);
+}
+
+void ParticleSource::read_state(CheckpointReader &in)
+{
+  std::vector<char> s;
+  in.get_array(s);
+  std::istringstream(std::string(s.begin(), s.end())) >> rng_;
+  t_last_ = in.get<double>();
+  owed_carrier_ = in.get<double>();
+  pending_d_ = in.get<double>();
+  in.get_array(owed_toner_);
+  in.get_array(count_);
+  in.get_array(mass_);
+}
+
+} // namespace magbrush::dem

@@ -1,0 +1,99 @@
+// The inflow: developer fed onto the sleeve during the run, the way the sleeve carries it out
+// of the sump past the doctor blade (case keys inflow.*, coupling/case_keys_flow.cpp).
+//
+// A layer of developer mass per sleeve area Γ (DMA) rides on the sleeve surface, which moves
+// at v = ω R. Over a time τ the surface carries the arc R Δφ past the entry angle θ_in, with
+// Δφ = ∫ω dt (the sleeve's spin-up ramp included), so the source owes the mass
+//
+//     Δm = Γ R Δφ L_z        (mass flux Γ v L_z, L_z the periodic slab length)
+//
+// and places it in that arc, θ_in … θ_in + Δφ (in the sense of rotation; at least two bead
+// diameters long, since an exchange every few steps sweeps far less than a bead), within
+// inflow.layer_height of the surface: carriers of the fed population, drawn from its size
+// distribution, at random (uniform in area), without overlap with the particles present, the
+// walls or each other. The previous exchange's particles have moved on by Δφ with the sleeve,
+// so the arc is free. Each new particle moves rigidly with the sleeve (v = ω ẑ × x, ω ẑ).
+// Toner populations that give a concentration TC come attached: each carrier brings toner of
+// mass TC × its own mass, touching its surface at random points (a toner that does not fit
+// is owed to the next carrier). The carriers' share of Γ is Γ / (1 + ΣTC).
+//
+// What is owed and not placed (a drawn diameter that did not fit, mass below one particle)
+// stays owed: over a run the mass created follows Γ R φ(t) L_z to within one particle. The
+// random stream, the mass owed and the counts are written into checkpoints.
+#pragma once
+
+#include "dem/neighbour_list.h"
+#include "dem/particle_state.h"
+#include "dem/wall_contacts.h"
+
+#include "coupling/case_model.h"
+
+#include <random>
+#include <vector>
+
+namespace magbrush::dem {
+
+class CheckpointWriter;
+class CheckpointReader;
+
+class ParticleSource
+{
+public:
+  // Throws std::invalid_argument naming the key when the case cannot feed (no sleeve, no
+  // slab, no carrier population, a layer too thin for the particles).
+  ParticleSource(const Case &c, const DemWalls &walls, const PeriodicBox &box);
+
+  // Appends to `enter` the particles owed for the arc the sleeve swept since the last call
+  // (the first call counts from t = 0); `state` is the scene now (for the overlap test).
+  void create(const ParticleState &state, double t, ParticleState &enter);
+
+  // One particle per fed population at its smallest diameter (for the stable time step).
+  void smallest_particles(ParticleState &out) const;
+
+  // Created so far, per population index: number and mass [kg].
+  const std::vector<long> &created_count() const { return count_; }
+  const std::vector<double> &created_mass() const { return mass_; }
+  // The sleeve's rotation angle since t = 0 [rad] (signed), and the mass owed for it:
+  // Γ R |φ(t)| L_z [kg].
+  double sleeve_rotation(double t) const;
+  double mass_due(double t) const { return areal_mass_ * R_ * std::abs(sleeve_rotation(t)) * Lz_; }
+
+  void write_state(CheckpointWriter &out) const;
+  void read_state(CheckpointReader &in);
+
+private:
+  struct Feed
+  {
+    int species = 0;
+    double density = 0.0, d_mean = 0.0, d_std = 0.0, d_min = 0.0, d_max = 0.0, charge_to_mass = 0.0;
+    double concentration = 0.0; // toner: mass per carrier mass
+  };
+  Feed carrier_;
+  std::vector<Feed> toner_;
+  const DemWalls &walls_;
+  PeriodicBox box_;
+  double R_ = 0.0, Lz_ = 0.0, height_ = 0.0, theta_in_ = 0.0, omega_ = 0.0, spin_up_ = 0.0;
+  double areal_mass_ = 0.0, carrier_share_ = 1.0;
+
+  // State (checkpointed).
+  std::mt19937_64 rng_;
+  double t_last_ = 0.0;
+  double owed_carrier_ = 0.0;
+  std::vector<double> owed_toner_;
+  double pending_d_ = 0.0; // a carrier diameter drawn and not yet placed (0: none)
+  std::vector<long> count_;
+  std::vector<double> mass_;
+
+  // Scratch: the particles near the arc (positions, radii), this exchange's included.
+  std::vector<Vector3> near_x_;
+  std::vector<double> near_r_;
+
+  double draw_diameter(const Feed &f);
+  bool clear_of_everything(const Vector3 &p, double r) const;
+  void gather_near(const ParticleState &state, double theta0, double dphi);
+  bool place_carrier(double d, double theta0, double dphi, double t, ParticleState &enter);
+  void attach_toner(const Vector3 &centre, double rc, double t, ParticleState &enter);
+  void append(const Feed &f, const Vector3 &p, double d, double t, ParticleState &enter);
+};
+
+} // namespace magbrush::dem

@@ -281,7 +281,7 @@ struct StatisticsSettings
 struct OutputSettings
 {
   std::string directory = "results";
-  bool vtu = true;
+  bool vtu = false;
   bool xdmf = true;
 };
 

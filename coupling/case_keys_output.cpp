@@ -10,8 +10,8 @@ std::vector<KeySpec> output_keys()
   return {
       section("output", "Results."),
       text("output.directory", "Results directory.").def("results"),
-      boolean("output.vtu", "Write VTU particle snapshots.").def("true"),
-      boolean("output.xdmf", "Write HDF5/XDMF particle snapshots.").def("true"),
+      boolean("output.vtu", "Also write VTK XML particle snapshots (snapshots/*.vtu, index particles.pvd).").def("false"),
+      boolean("output.xdmf", "Write HDF5 particle snapshots with their XDMF index (particles.xdmf).").def("true"),
   };
 }
 

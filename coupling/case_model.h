@@ -306,7 +306,7 @@ struct FlowSettings
 struct OutputSettings
 {
   std::string directory = "results";
-  bool vtu = true;
+  bool vtu = false;
   bool xdmf = true;
 };
 

@@ -3,6 +3,7 @@
 
 #include "dem/run_summary.h"
 #include "dem/particle_flow.h"
+#include "dem/snapshot_outputs.h"
 #include "dem/openmp_waiting.h"
 #include "dem/restart_check.h"
 
@@ -180,7 +181,7 @@ void DemRun::write_measurements() const
 void DemRun::run()
 {
   DemSystem &s = *system_;
-  SnapshotWriter snapshots(out_dir_);
+  SnapshotOutputs snapshots(out_dir_, case_.output);
   const std::string csv = (fs::path(out_dir_) / "time_series.csv").string();
   const bool restart = !options_.restart_file.empty();
   if (restart)

@@ -18,6 +18,7 @@
 #include <fstream>
 #include <regex>
 #include <thread>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -272,4 +273,35 @@ TEST_F(DemCli, KilledRunLeavesGoodCheckpointsByDefault)
   EXPECT_EQ(resumed.code, 0) << resumed.output;
   EXPECT_NE(resumed.output.find("restarted from"), std::string::npos) << resumed.output;
   EXPECT_NE(resumed.output.find("done:"), std::string::npos) << resumed.output;
+
+TEST_F(DemCli, WritesVtuSnapshotsWhenAskedAndNoXdmfWhenNot)
+{
+  const std::string out = (dir / "vtu").string();
+  const CliResult r = run_dem(case_file + " --set output.vtu=true --set output.xdmf=false --set dem.duration=40us --output " + out);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_FALSE(fs::exists(fs::path(out) / "particles.xdmf"));
+  std::ifstream pvd(fs::path(out) / "particles.pvd");
+  const std::string index((std::istreambuf_iterator<char>(pvd)), std::istreambuf_iterator<char>());
+  std::size_t sets = 0;
+  for (std::size_t p = index.find("<DataSet"); p != std::string::npos; p = index.find("<DataSet", p + 1))
+    ++sets;
+  EXPECT_EQ(sets, 3u) << index; // t = 0, 20, 40 µs
+  const auto file = fs::path(out) / "snapshots" / "particles_00000000.vtu";
+  ASSERT_TRUE(fs::exists(file));
+  std::ifstream vtu(file);
+  const std::string text((std::istreambuf_iterator<char>(vtu)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("NumberOfPoints=\"250\""), std::string::npos);
+  // The position array holds 250 lines of three numbers, all above the stage (z > 0).
+  const auto begin = text.find('\n', text.find("Name=\"position\"")) + 1;
+  std::istringstream positions(text.substr(begin, text.find("</DataArray>", begin) - begin));
+  double x, y, z;
+  std::size_t points = 0;
+  while (positions >> x >> y >> z)
+  {
+    ++points;
+    EXPECT_GT(z, 0.0);
+  }
+  EXPECT_EQ(points, 250u);
+  for (const char *array : {"\"velocity\"", "\"charge\"", "\"id\"", "\"contact_count\""})
+    EXPECT_NE(text.find(array), std::string::npos) << array;
 }

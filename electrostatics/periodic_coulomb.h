@@ -69,6 +69,8 @@ public:
   // The held far field (3 per charge, [V/m]) and far potential, for checkpoints.
   std::vector<double> &held_far_field() { return far_E_; }
   std::vector<double> &held_far_potential() { return far_phi_; }
+  const std::vector<double> &held_far_field() const { return far_E_; }
+  const std::vector<double> &held_far_potential() const { return far_phi_; }
   std::size_t charges() const { return n_; }
   std::size_t near_entries() const { return row_source_.size(); }
   const magnetics::CellMultipoleField &far_field() const { return *far_; }

@@ -139,8 +139,8 @@ struct Electric
   // (docs/electrostatics.md, "Coulomb and the conductors' images"; DEM only).
   bool coulomb = true;           // on when some population is charged
   int coulomb_order = 4;         // Taylor order of the Coulomb far field
-  double coulomb_cell = 100e-6;  // fine cell size of the far field [m] (near pairs: ±2 cells)
-  double coulomb_refresh = 0.0;  // far-field refresh interval [s] (0 = every step)
+  double coulomb_cell = 25e-6;   // fine cell size of the far field [m] (near pairs: ±2 cells)
+  double coulomb_refresh = 2e-6; // far-field refresh interval [s] (0 = every step)
   bool conductor_images = true;  // false: Kweon's assumption, Φ unchanged by the toner
   int pair_image_terms = 2;      // explicit drum images per charge acting on the others (0 = none)
 };

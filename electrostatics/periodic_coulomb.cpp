@@ -2,6 +2,8 @@
 
 #include "electrostatics/coulomb_constants.h"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -34,7 +36,8 @@ PeriodicCoulomb::PeriodicCoulomb(const CoulombSettings &settings, const std::arr
   if (!(settings.cell_size > 0.0))
     throw std::invalid_argument("Coulomb: the far-field cell size must be positive; found " +
                                 std::to_string(settings.cell_size) + " m.");
-  far_ = std::make_unique<magnetics::CellMultipoleField>(settings.order, box, 2, magnetics::SourceKind::charges);
+  far_ = std::make_unique<magnetics::CellMultipoleField>(settings.order, box, settings.near_reach,
+                                                         magnetics::SourceKind::charges);
   far_->set_single_precision(settings.single_precision);
 }
 
@@ -103,7 +106,8 @@ void PeriodicCoulomb::build_rows(std::vector<char> &own_image_near)
     row_begin_[i + 1] += row_begin_[i];
   row_source_.resize(row_begin_[n]);
   row_shift_.resize(3 * row_begin_[n]);
-  std::vector<std::uint32_t> fill(row_begin_.begin(), row_begin_.end() - 1);
+  std::vector<std::uint32_t> &fill = row_fill_;
+  fill.assign(row_begin_.begin(), row_begin_.end() - 1);
   auto put = [&](std::uint32_t target, std::uint32_t source, const double *shift) {
     if (own_image(target, source, shift))
     {
@@ -159,9 +163,12 @@ void PeriodicCoulomb::rebuild(std::size_t n, const double *x, const double *y, c
   for (auto *v : {&sx_, &sy_, &sz_, &sq_})
     v->resize(total);
   place_sources(x, y, z, q, floor);
+  const double t0 = omp_get_wtime();
+  far_->set_near_targets(n);
   far_->build(total, sx_.data(), sy_.data(), sz_.data(), settings_.cell_size);
-  std::vector<char> own_image_near;
-  build_rows(own_image_near);
+  const double t1 = omp_get_wtime();
+  build_rows(own_image_near_);
+  const double t2 = omp_get_wtime();
   scratch_E_.resize(3 * total);
   scratch_phi_.resize(total);
   far_->evaluate(magnetics::FarFieldSources{sq_.data(), nullptr},
@@ -172,7 +179,8 @@ void PeriodicCoulomb::rebuild(std::size_t n, const double *x, const double *y, c
     far_E_[i] = coulomb_constant * scratch_E_[i];
   for (std::size_t i = 0; i < n; ++i)
     far_phi_[i] = coulomb_constant * scratch_phi_[i];
-  remove_own_far_images(own_image_near);
+  remove_own_far_images(own_image_near_);
+  times_ = {t1 - t0, t2 - t1, omp_get_wtime() - t2};
 }
 
 void PeriodicCoulomb::field(const double *x, const double *y, const double *z, const double *q, const double *floor,

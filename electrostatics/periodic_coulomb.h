@@ -38,8 +38,9 @@ namespace magbrush::electrostatics {
 struct CoulombSettings
 {
   int order = 4;            // Taylor order of the cell multipoles (error vs cost: docs/electrostatics.md)
-  double cell_size = 100e-6; // fine cell size [m]; the near field reaches ±2 cells
+  double cell_size = 25e-6; // fine cell size [m]; the near field reaches ±2 cells
   bool single_precision = true; // M2L in single precision (magnetics/cell_multipole_field.h)
+  int near_reach = 2;        // the near field: fine cells within ±near_reach (1 or 2)
 };
 
 class PeriodicCoulomb
@@ -72,6 +73,12 @@ public:
   const std::vector<double> &held_far_field() const { return far_E_; }
   const std::vector<double> &held_far_potential() const { return far_phi_; }
   std::size_t charges() const { return n_; }
+  // Wall time of the last rebuild's phases [s]: cells and near pair list, near rows, far field.
+  struct Times
+  {
+    double cells = 0.0, rows = 0.0, far = 0.0;
+  };
+  const Times &last_rebuild_times() const { return times_; }
   std::size_t near_entries() const { return row_source_.size(); }
   const magnetics::CellMultipoleField &far_field() const { return *far_; }
 
@@ -89,8 +96,11 @@ private:
   // Near rows of the real charges: sources and shifts (r = x_s + shift − x_i).
   std::vector<std::uint32_t> row_begin_, row_source_;
   std::vector<double> row_shift_;
+  std::vector<std::uint32_t> row_fill_;
+  std::vector<char> own_image_near_; // per image: is it its owner's near pair (not in the far field)
   // Held far field of the real charges (kernel sum × 1/(4πε0)), own images removed.
   std::vector<double> far_E_, far_phi_, scratch_phi_, scratch_E_;
+  Times times_;
 
   void place_sources(const double *x, const double *y, const double *z, const double *q, const double *floor);
   void build_rows(std::vector<char> &own_image_near);

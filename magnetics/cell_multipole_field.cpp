@@ -724,7 +724,7 @@ void CellMultipoleField::build_near_pairs(const double *const coord[3])
           for (std::uint32_t k = bead_begin_[c]; k < bead_begin_[c + 1]; ++k)
           {
             const std::uint32_t j = bead_order_[k];
-            if (j < i || (j == i && (zero_shift || !positive_shift)))
+            if (j < i || (j == i && (zero_shift || !positive_shift)) || (i >= near_targets_ && j >= near_targets_))
               continue;
             emit(j, shift);
           }

@@ -78,6 +78,10 @@ public:
   // Sorts the beads into fine cells of target size `cell_size` [m] (periodic axes get k·2^m
   // cells exactly, k = 1 or 3), builds the levels, interaction lists and the near pair list.
   void build(std::size_t n, const double *x, const double *y, const double *z, double cell_size);
+  // Only beads below `targets` need their near pairs (charges: the images of the pair images
+  // are sources only); pairs of two beads ≥ targets are not listed. Before build(); default
+  // all beads.
+  void set_near_targets(std::size_t targets) { near_targets_ = targets; }
 
   // The beads moved (by less than a fraction of a cell since build()): keep the cells, the
   // lists and the near pairs (a bead stays in the cell it was sorted into, as in a Verlet
@@ -136,6 +140,7 @@ private:
   std::vector<std::uint32_t> bead_begin_;  // per fine cell, into bead_order_
   std::vector<std::uint32_t> bead_cell_;   // fine cell of every bead
   std::vector<MagneticNeighbourList::Pair> near_pairs_;
+  std::size_t near_targets_ = static_cast<std::size_t>(-1);
 
   // Translation matrices A[γ][β] = D_(β+γ)(−Δ h_ℓ) for the 7³ offsets of every lower
   // level, and the lattice-summed ones of the upper levels per (level, offset, the level's

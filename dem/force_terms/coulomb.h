@@ -33,7 +33,7 @@ namespace magbrush::electrostatics {
 struct CoulombTermSettings
 {
   CoulombSettings far;
-  double refresh = 0.0;       // far-field refresh interval [s] (0 = every step)
+  double refresh = 2e-6;      // far-field refresh interval [s] (0 = every step)
   double max_move_cells = 0.25; // rebuild when a charge moved this × the cell size
   std::optional<GroundedSurface> image_surface; // pair images in this surface
   int image_terms = 2;

@@ -67,6 +67,18 @@ bool same_bits(const std::vector<double> &a, const std::vector<double> &b)
 
 } // namespace
 
+TEST(CoulombTerm, SettingsOfADefaultCaseAreTheStructDefaults)
+{
+  // The electric keys' defaults (coupling/case_keys_electric.cpp, checked against the Electric
+  // struct in test_module_defaults) reach the term as its own defaults; no drum: no images.
+  const CoulombTermSettings from_case = CoulombTermSettings::from_case(Case{}), built;
+  EXPECT_EQ(from_case.far.order, built.far.order);
+  EXPECT_EQ(from_case.far.cell_size, built.far.cell_size);
+  EXPECT_EQ(from_case.refresh, built.refresh);
+  EXPECT_EQ(from_case.image_terms, built.image_terms);
+  EXPECT_FALSE(from_case.image_surface.has_value());
+}
+
 TEST(CoulombTerm, NeutralPeriodicSystemHasNoNetForce)
 {
   // Every pair and image acts twice with opposite signs: the net force is zero up to the far

@@ -36,6 +36,10 @@ PeriodicCoulomb::PeriodicCoulomb(const CoulombSettings &settings, const std::arr
   if (!(settings.cell_size > 0.0))
     throw std::invalid_argument("Coulomb: the far-field cell size must be positive; found " +
                                 std::to_string(settings.cell_size) + " m.");
+  if (box[0] > 0.0 && box[1] > 0.0 && box[2] > 0.0)
+    throw std::invalid_argument("Coulomb: a box periodic along x, y and z is not supported (its charge sums need "
+                                "Ewald summation with a stated boundary condition); leave one axis open, or set "
+                                "electric.coulomb: false.");
   far_ = std::make_unique<magnetics::CellMultipoleField>(settings.order, box, settings.near_reach,
                                                          magnetics::SourceKind::charges);
   far_->set_single_precision(settings.single_precision);

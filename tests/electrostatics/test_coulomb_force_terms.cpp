@@ -110,17 +110,28 @@ TEST(CoulombTerm, ForcesHaveTheSameBitsOnOneAndTwoThreads)
 {
   const std::array<double, 3> box = {0.0, 0.0, 1e-3};
   const auto s = brush(3000, 300, 1e-3, 0.4e-3, 1e-3, 8);
-  dem::ForceBuffers f[2];
-  for (int threads : {1, 2})
+  // With and without pair images in a drum plane at y = 0, and the self images.
+  GroundedSurface drum;
+  drum.layer = LayeredImages(3.0, 20e-6);
+  for (bool images : {false, true})
   {
-    omp_set_num_threads(threads);
-    CoulombTerm term(settings(4, 0.08e-3, 0.0), box);
-    f[threads - 1] = forces_of(term, s, 0.0);
+    dem::ForceBuffers f[2];
+    for (int threads : {1, 2})
+    {
+      omp_set_num_threads(threads);
+      CoulombTermSettings set = settings(4, 25e-6, 0.0);
+      if (images)
+        set.image_surface = drum;
+      CoulombTerm term(set, box);
+      f[threads - 1] = forces_of(term, s, 0.0);
+      ConductorImages self({drum});
+      self.add_forces(s, f[threads - 1], 0.0);
+    }
+    omp_set_num_threads(2);
+    EXPECT_TRUE(same_bits(f[0].fx, f[1].fx));
+    EXPECT_TRUE(same_bits(f[0].fy, f[1].fy));
+    EXPECT_TRUE(same_bits(f[0].fz, f[1].fz));
   }
-  omp_set_num_threads(2);
-  EXPECT_TRUE(same_bits(f[0].fx, f[1].fx));
-  EXPECT_TRUE(same_bits(f[0].fy, f[1].fy));
-  EXPECT_TRUE(same_bits(f[0].fz, f[1].fz));
 }
 
 TEST(CoulombTerm, HeldFarFieldRestartsBitForBit)

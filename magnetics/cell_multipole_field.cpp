@@ -547,7 +547,7 @@ const std::vector<double> &CellMultipoleField::lattice_matrix(int level, const s
       }
   }
   else if (charges)
-    windowed_sheet_sum(level, offset, axes, open, S);
+    windowed_sheet_sum(level, offset, axes, S);
   else
   {
     // Two periodic axes: the lattice sum of the order-2 tensor converges only like 1/R
@@ -598,7 +598,7 @@ const std::vector<double> &CellMultipoleField::lattice_matrix(int level, const s
 }
 
 void CellMultipoleField::windowed_sheet_sum(int level, const std::array<long, 3> &offset, const int axes[2],
-                                            int open, std::vector<double> &S)
+                                            std::vector<double> &S)
 {
   // Charges, two periodic axes: the sums of orders 0 and 1 (the potential and field of a
   // charged sheet) converge badly or not at all, and the hard disc + analytic continuum of the
@@ -695,7 +695,6 @@ void CellMultipoleField::windowed_sheet_sum(int level, const std::array<long, 3>
     const double u = gauss[0][i]; // ρ = ρ_M/u, dρ = ρ_M/u² du
     ring(rho_max / u, rho_max / (u * u) * gauss[1][i]);
   }
-  (void)open;
 }
 
 void CellMultipoleField::build_near_pairs(const double *const coord[3])

@@ -176,7 +176,7 @@ private:
   bool near(int level, const std::array<long, 3> &D) const;
   const std::vector<double> &lattice_matrix(int level, const std::array<long, 3> &offset);
   // Charges with two periodic axes: the lattice sum by a smooth window and its continuum.
-  void windowed_sheet_sum(int level, const std::array<long, 3> &offset, const int axes[2], int open,
+  void windowed_sheet_sum(int level, const std::array<long, 3> &offset, const int axes[2],
                           std::vector<double> &S);
   // The passes of an evaluation: P2M (add_sources(s, bead, M) adds a bead's moments at
   // offset s), M2M + M2L + L2L, and L2P (at_bead(u, bead, L) reads the cell's expansion).

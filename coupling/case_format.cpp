@@ -215,6 +215,12 @@ std::vector<ResolvedEntry> resolved_entries(const Case &c)
   }
   e.q("electric.image.period", "electric.image.period", im.period);
   e.q("electric.image.duty", "electric.image.duty", im.duty);
+  e.b("electric.coulomb", "electric.coulomb", c.electric.coulomb);
+  e.i("electric.coulomb_order", "electric.coulomb_order", c.electric.coulomb_order);
+  e.q("electric.coulomb_cell", "electric.coulomb_cell", c.electric.coulomb_cell);
+  e.q("electric.coulomb_refresh", "electric.coulomb_refresh", c.electric.coulomb_refresh);
+  e.b("electric.conductor_images", "electric.conductor_images", c.electric.conductor_images);
+  e.i("electric.pair_image_terms", "electric.pair_image_terms", c.electric.pair_image_terms);
 
   const auto &f = c.applied_field;
   e.s("applied_field.kind", "applied_field.kind",

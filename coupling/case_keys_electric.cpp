@@ -25,6 +25,25 @@ std::vector<KeySpec> electric_keys()
       quantity("electric.image.period", D::length, "Strip period along the drum surface (0 = uniform dark).")
           .def("0 mm").non_negative().affects(A::electric),
       number("electric.image.duty", "Exposed fraction of one period.").def("0.5").min(0.0).max(1.0).affects(A::electric),
+      // Coulomb and the conductors' images (DEM only: dem/force_terms/coulomb, conductor_images).
+      boolean("electric.coulomb",
+              "Coulomb forces between the charged particles, without a cutoff, over the periodic images of the slab (on when some population is charged).")
+          .def("true"),
+      integer("electric.coulomb_order",
+              "Taylor order of the Coulomb far field (force error against cost: docs/electrostatics.md).")
+          .def("4").non_negative().max(6),
+      quantity("electric.coulomb_cell", D::length,
+               "Fine cell size of the Coulomb far field; pairs within two cells are summed exactly (25 um: ~30 exact partners per charge in a toner-laden nip, docs/electrostatics.md).")
+          .def("25 um").positive(),
+      quantity("electric.coulomb_refresh", D::time,
+               "Interval between evaluations of the Coulomb far field, held in between (0 = every step); the near pairs are exact at every step (2 us: ~1e-3 RMS force error at 0.1 m/s relative motion, docs/electrostatics.md).")
+          .def("2 us").non_negative(),
+      boolean("electric.conductor_images",
+              "The charges' images in the grounded drum substrate (through the photoconductor layer) and in the sleeve. false = Kweon's assumption that the field is unchanged by the toner (no screening by the conductors).")
+          .def("true"),
+      integer("electric.pair_image_terms",
+              "Drum images per charge that act on the OTHER charges (explicit terms of the layered image series, the rest lumped keeping charge and dipole moment; 0 = the self force only).")
+          .def("2").non_negative().max(20),
   };
 }
 

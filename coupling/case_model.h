@@ -148,6 +148,14 @@ struct Electric
   bool enabled = false;
   double bias = 0.0;             // sleeve potential against the grounded drum substrate [V]
   LatentImage image;
+  // Coulomb between the particles' charges and their images in the drum and the sleeve
+  // (docs/electrostatics.md, "Coulomb and the conductors' images"; DEM only).
+  bool coulomb = true;           // on when some population is charged
+  int coulomb_order = 4;         // Taylor order of the Coulomb far field
+  double coulomb_cell = 25e-6;   // fine cell size of the far field [m] (near pairs: ±2 cells)
+  double coulomb_refresh = 2e-6; // far-field refresh interval [s] (0 = every step)
+  bool conductor_images = true;  // false: Kweon's assumption, Φ unchanged by the toner
+  int pair_image_terms = 2;      // explicit drum images per charge acting on the others (0 = none)
 };
 
 // Applied magnetic field: from the roller (field solver grid) or uniform (the compression test).

@@ -949,6 +949,12 @@ private:
     }
     li.period = q(image, "period");
     li.duty = q(image, "duty");
+    c.electric.coulomb = flag(s, "coulomb");
+    c.electric.coulomb_order = static_cast<int>(integer(s, "coulomb_order"));
+    c.electric.coulomb_cell = q(s, "coulomb_cell");
+    c.electric.coulomb_refresh = q(s, "coulomb_refresh");
+    c.electric.conductor_images = flag(s, "conductor_images");
+    c.electric.pair_image_terms = static_cast<int>(integer(s, "pair_image_terms"));
   }
 
   void build_applied_field(Case &c, const Scope &s)

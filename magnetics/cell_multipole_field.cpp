@@ -44,12 +44,6 @@ CellMultipoleField::CellMultipoleField(int order, const std::array<double, 3> &b
       "cell multipole: a box periodic along all three axes has a shape-dependent dipole sum "
       "(it needs Ewald summation with a stated boundary condition), which is not implemented; "
       "found three periodic axes. Leave one axis open or use magnetic_far_field: none.");
-  if (kind == SourceKind::charges && periodic_axes_ > 0)
-    throw std::invalid_argument(
-      "cell multipole: periodic images of charges are not implemented (the lattice sums of the "
-      "monopole and dipole tensors do not converge without a neutralising background and "
-      "Ewald-type summation); found " + std::to_string(periodic_axes_) +
-      " periodic axes for a charge expansion. Use open axes.");
 }
 
 std::uint64_t CellMultipoleField::key_of(const std::array<long, 3> &I) const
@@ -503,6 +497,7 @@ const std::vector<double> &CellMultipoleField::lattice_matrix(int level, const s
     for (std::size_t a = 0; a < nd; ++a)
       S[a] += D[a];
   };
+  const bool charges = taylor_.source_kind() == SourceKind::charges;
   int axes[3], na = 0, open = -1;
   for (int d = 0; d < 3; ++d)
     if (box_[d] > 0.0)
@@ -515,7 +510,8 @@ const std::vector<double> &CellMultipoleField::lattice_matrix(int level, const s
   {
     // ±M images explicitly, the rest as the integral over the continuous line of images
     // (Euler–Maclaurin with midpoint ends: the next term is ~f''/24, negligible at M = 40);
-    // every tensor used is of order ≥ 2, so the tail decays at least like 1/M².
+    // every dipole tensor is of order ≥ 2, so the tail decays at least like 1/M² (charges
+    // add the orders 0 and 1: the field's tail is integrable, the potential's regularised).
     const int ax = axes[0];
     const long step = t.cells[ax];
     const double period = box_[ax];
@@ -541,10 +537,17 @@ const std::vector<double> &CellMultipoleField::lattice_matrix(int level, const s
         R[ax] += side * z;
         taylor_.derivatives(R, D.data());
         const double w = weight[q] * Z0 / (node[q] * node[q]) / period;
+        // Charges: the potential of a line of images diverges like ln; the regularised tail
+        // ∫ (1/|R| − 1/z) drops the same infinite constant for every offset, so Φ is defined
+        // up to (that constant) × (the total charge) and the field is exact.
+        if (charges)
+          D[0] -= 1.0 / z;
         for (std::size_t a = 0; a < nd; ++a)
           S[a] += w * D[a];
       }
   }
+  else if (charges)
+    windowed_sheet_sum(level, offset, axes, S);
   else
   {
     // Two periodic axes: the lattice sum of the order-2 tensor converges only like 1/R
@@ -594,6 +597,106 @@ const std::vector<double> &CellMultipoleField::lattice_matrix(int level, const s
   return lattice_.emplace(key, std::move(matrix)).first->second;
 }
 
+void CellMultipoleField::windowed_sheet_sum(int level, const std::array<long, 3> &offset, const int axes[2],
+                                            std::vector<double> &S)
+{
+  // Charges, two periodic axes: the sums of orders 0 and 1 (the potential and field of a
+  // charged sheet) converge badly or not at all, and the hard disc + analytic continuum of the
+  // dipoles leaves ~1e-3 of the sheet field from the disc's ragged rim (its lattice-point
+  // count). Here the images are weighted by a smooth window w(ρ/ρ_M) (1 inside half the
+  // radius, falling to 0 at ρ_M = two_axis_image_radius periods, C∞) and the rest, (1 − w),
+  // is the continuum integral of density 1/A: by Poisson summation the lattice sum of the
+  // smooth (1 − w) D_α differs from its integral only by its Fourier transform at the
+  // reciprocal lattice vectors, which a smooth window makes negligible. The integral runs in
+  // polar coordinates about the offset's own image (radial Gauss–Legendre over the window's
+  // ramp and over the tail ρ = ρ_M/t, the periodic angle by the trapezoidal rule). The
+  // potential's integral diverges: its integrand is regularised by −1/ρ, which drops the same
+  // infinite constant for every offset.
+  const Level &t = levels_[level];
+  const std::size_t nd = taylor_.derivative_size();
+  std::vector<double> D(nd);
+  const double P1 = box_[axes[0]], P2 = box_[axes[1]], A = P1 * P2;
+  const double rho_max = two_axis_image_radius * std::min(P1, P2), rho_in = 0.5 * rho_max;
+  auto window = [&](double rho) {
+    if (rho <= rho_in)
+      return 1.0;
+    if (rho >= rho_max)
+      return 0.0;
+    const double u = (rho - rho_in) / (rho_max - rho_in);
+    const double a = std::exp(-1.0 / u), b = std::exp(-1.0 / (1.0 - u));
+    return b / (a + b);
+  };
+  const double R0[3] = {-offset[0] * t.size[0], -offset[1] * t.size[1], -offset[2] * t.size[2]};
+  const long M1 = static_cast<long>(std::ceil(rho_max / P1)), M2 = static_cast<long>(std::ceil(rho_max / P2));
+  for (long m1 = -M1; m1 <= M1; ++m1)
+    for (long m2 = -M2; m2 <= M2; ++m2)
+    {
+      const double w = window(std::hypot(m1 * P1, m2 * P2));
+      if (w == 0.0)
+        continue;
+      std::array<long, 3> Delta = offset;
+      Delta[axes[0]] += m1 * t.cells[axes[0]];
+      Delta[axes[1]] += m2 * t.cells[axes[1]];
+      if (level < column_level_ && near(level, Delta))
+        continue;
+      const double R[3] = {-Delta[0] * t.size[0], -Delta[1] * t.size[1], -Delta[2] * t.size[2]};
+      taylor_.derivatives(R, D.data());
+      for (std::size_t a = 0; a < nd; ++a)
+        S[a] += w * D[a];
+    }
+  // Gauss–Legendre nodes on [0, 1] (24 points), by Newton iteration on P_24.
+  constexpr int ng = 24, nangle = 32;
+  static const std::array<std::array<double, ng>, 2> gauss = [] {
+    std::array<std::array<double, ng>, 2> g{};
+    for (int i = 0; i < ng; ++i)
+    {
+      double x = std::cos(pi * (i + 0.75) / (ng + 0.5)), dp = 0.0;
+      for (int it = 0; it < 100; ++it)
+      {
+        double p0 = 1.0, p1 = x;
+        for (int k = 2; k <= ng; ++k)
+        {
+          const double p2 = ((2.0 * k - 1.0) * x * p1 - (k - 1.0) * p0) / k;
+          p0 = p1;
+          p1 = p2;
+        }
+        dp = ng * (x * p1 - p0) / (x * x - 1.0);
+        const double dx = p1 / dp;
+        x -= dx;
+        if (std::abs(dx) < 1e-16)
+          break;
+      }
+      g[0][i] = 0.5 * (1.0 - x);
+      g[1][i] = 1.0 / ((1.0 - x * x) * dp * dp); // weight on [0, 1]: 2/((1−x²)P'²)/2
+    }
+    return g;
+  }();
+  auto ring = [&](double rho, double weight) {
+    // weight × ∫ dθ (1 − w) D_α(R0 + ρ e_θ) ρ / A, trapezoidal in θ.
+    const double f = weight * (1.0 - window(rho)) * rho / A * (2.0 * pi / nangle);
+    if (f == 0.0)
+      return;
+    for (int k = 0; k < nangle; ++k)
+    {
+      const double th = 2.0 * pi * (k + 0.5) / nangle;
+      double R[3] = {R0[0], R0[1], R0[2]};
+      R[axes[0]] += rho * std::cos(th);
+      R[axes[1]] += rho * std::sin(th);
+      taylor_.derivatives(R, D.data());
+      D[0] -= 1.0 / rho;
+      for (std::size_t a = 0; a < nd; ++a)
+        S[a] += f * D[a];
+    }
+  };
+  for (int i = 0; i < ng; ++i)
+    ring(rho_in + (rho_max - rho_in) * gauss[0][i], (rho_max - rho_in) * gauss[1][i]);
+  for (int i = 0; i < ng; ++i)
+  {
+    const double u = gauss[0][i]; // ρ = ρ_M/u, dρ = ρ_M/u² du
+    ring(rho_max / u, rho_max / (u * u) * gauss[1][i]);
+  }
+}
+
 void CellMultipoleField::build_near_pairs(const double *const coord[3])
 {
   const Level &fine = levels_[0];
@@ -620,7 +723,7 @@ void CellMultipoleField::build_near_pairs(const double *const coord[3])
           for (std::uint32_t k = bead_begin_[c]; k < bead_begin_[c + 1]; ++k)
           {
             const std::uint32_t j = bead_order_[k];
-            if (j < i || (j == i && (zero_shift || !positive_shift)))
+            if (j < i || (j == i && (zero_shift || !positive_shift)) || (i >= near_targets_ && j >= near_targets_))
               continue;
             emit(j, shift);
           }

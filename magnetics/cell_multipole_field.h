@@ -1,9 +1,14 @@
 // The far field of point sources without a cutoff: a cell multipole method (a uniform
 // octree of occupied cells, Cartesian Taylor expansions, periodic images to convergence).
 // The sources are the induced magnetic dipoles (SourceKind::dipoles, the field B and its
-// gradient) or charges, optionally with dipoles (SourceKind::charges, open boxes: the
-// potential Φ = Σ q/r, the field E = −∇Φ = Σ q r/r³ and its gradient, without the physical
-// prefactor 1/(4πε0)); cartesian_taylor.h has the expansions of both.
+// gradient) or charges, optionally with dipoles (SourceKind::charges: the potential
+// Φ = Σ q/r, the field E = −∇Φ = Σ q r/r³ and its gradient, without the physical prefactor
+// 1/(4πε0)); cartesian_taylor.h has the expansions of both. Periodic charges need no
+// neutralising background: with one periodic axis the field of a row of charges converges
+// (its potential diverges like a line charge's: it is regularised by dropping the same
+// constant for every source, so Φ is exact up to a constant times the total charge); with two
+// periodic axes a net charge per cell is a charged sheet in free space (field 2πσ on either
+// side, potential −2πσ|h| far away, no constant dropped beyond the lattice regularisation).
 //
 // The beads are sorted into cubic-ish fine cells of size h (a few diameters). Pairs of beads
 // in ADJACENT fine cells (|ΔI|∞ ≤ near_reach, periodic images included) are the near field:
@@ -66,14 +71,17 @@ public:
   // near_reach: the near field is the fine cells within ±near_reach (1: 27 cells, the
   // classical FMM; 2: 125 cells, which moves the nearest — strongest, for a 1/r³ kernel —
   // far interactions from a separation ratio of 0.87 to 0.58: far more accurate per order);
-  // kind: dipoles (the magnetics) or charges (open boxes only: periodic charges need a
-  // neutralising background and an Ewald-type lattice sum, not implemented).
+  // kind: dipoles (the magnetics) or charges (open, or periodic along one or two axes).
   CellMultipoleField(int order, const std::array<double, 3> &box, int near_reach = 2,
                      SourceKind kind = SourceKind::dipoles);
 
   // Sorts the beads into fine cells of target size `cell_size` [m] (periodic axes get k·2^m
   // cells exactly, k = 1 or 3), builds the levels, interaction lists and the near pair list.
   void build(std::size_t n, const double *x, const double *y, const double *z, double cell_size);
+  // Only beads below `targets` need their near pairs (charges: the images of the pair images
+  // are sources only); pairs of two beads ≥ targets are not listed. Before build(); default
+  // all beads.
+  void set_near_targets(std::size_t targets) { near_targets_ = targets; }
 
   // The beads moved (by less than a fraction of a cell since build()): keep the cells, the
   // lists and the near pairs (a bead stays in the cell it was sorted into, as in a Verlet
@@ -132,6 +140,7 @@ private:
   std::vector<std::uint32_t> bead_begin_;  // per fine cell, into bead_order_
   std::vector<std::uint32_t> bead_cell_;   // fine cell of every bead
   std::vector<MagneticNeighbourList::Pair> near_pairs_;
+  std::size_t near_targets_ = static_cast<std::size_t>(-1);
 
   // Translation matrices A[γ][β] = D_(β+γ)(−Δ h_ℓ) for the 7³ offsets of every lower
   // level, and the lattice-summed ones of the upper levels per (level, offset, the level's
@@ -166,6 +175,9 @@ private:
   void build_near_pairs(const double *const coord[3]);
   bool near(int level, const std::array<long, 3> &D) const;
   const std::vector<double> &lattice_matrix(int level, const std::array<long, 3> &offset);
+  // Charges with two periodic axes: the lattice sum by a smooth window and its continuum.
+  void windowed_sheet_sum(int level, const std::array<long, 3> &offset, const int axes[2],
+                          std::vector<double> &S);
   // The passes of an evaluation: P2M (add_sources(s, bead, M) adds a bead's moments at
   // offset s), M2M + M2L + L2L, and L2P (at_bead(u, bead, L) reads the cell's expansion).
   template <class AddSources> void form_multipoles(const AddSources &add_sources);

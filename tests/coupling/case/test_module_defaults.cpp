@@ -203,6 +203,12 @@ TEST(ModuleDefaults, FieldSolverSettingsOfADefaultCaseAreTheStructDefaults)
   EXPECT_SAME(c.electric.image, electric.image, light_value);
   EXPECT_SAME(c.electric.image, electric.image, period);
   EXPECT_SAME(c.electric.image, electric.image, duty);
+  EXPECT_SAME_EXACT(c.electric, electric, coulomb);
+  EXPECT_SAME_EXACT(c.electric, electric, coulomb_order);
+  EXPECT_SAME(c.electric, electric, coulomb_cell);
+  EXPECT_SAME(c.electric, electric, coulomb_refresh);
+  EXPECT_SAME_EXACT(c.electric, electric, conductor_images);
+  EXPECT_SAME_EXACT(c.electric, electric, pair_image_terms);
 }
 
 // The geometry: roller, poles, sleeve, drum, blades, plane walls.

@@ -1,0 +1,218 @@
+#include "dem/force_terms/coulomb.h"
+
+#include "dem/checkpoint_file.h"
+#include "dem/dem_system.h"
+#include "dem/force_terms/force_term_registry.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace magbrush::electrostatics {
+
+CoulombTermSettings CoulombTermSettings::from_case(const Case &c)
+{
+  CoulombTermSettings s;
+  s.far.order = c.electric.coulomb_order;
+  s.far.cell_size = c.electric.coulomb_cell;
+  s.refresh = c.electric.coulomb_refresh;
+  s.image_terms = c.electric.pair_image_terms;
+  // Pair images in the drum (where the developed layer sits) when the scene has a drum and
+  // the conductors' images are on; the sleeve's images act on each charge itself only
+  // (conductor_images.h).
+  if (c.drum.present && c.sleeve && c.electric.conductor_images && c.electric.pair_image_terms > 0)
+  {
+    GroundedSurface drum;
+    drum.shape = GroundedSurface::Shape::cylinder;
+    const Vec2 centre = c.drum.center(c.sleeve->radius);
+    drum.centre_x = centre[0];
+    drum.centre_y = centre[1];
+    drum.radius = c.drum.radius;
+    drum.layer = LayeredImages(c.drum.pc_eps_r, c.drum.pc_thickness);
+    s.image_surface = drum;
+  }
+  return s;
+}
+
+CoulombTerm::CoulombTerm(const CoulombTermSettings &settings, const std::array<double, 3> &box)
+  : settings_(settings), box_(box), coulomb_(settings.far, box)
+{
+  if (settings.image_surface)
+    coulomb_.set_image_surface(*settings.image_surface, settings.image_terms);
+}
+
+void CoulombTerm::select(const dem::ParticleState &state)
+{
+  index_.clear();
+  q_.clear();
+  radius_.clear();
+  for (std::size_t k = 0; k < state.size(); ++k)
+    if (state.charge[k] != 0.0)
+    {
+      index_.push_back(static_cast<std::uint32_t>(k));
+      q_.push_back(state.charge[k]);
+      radius_.push_back(state.radius[k]);
+    }
+  const std::size_t n = index_.size();
+  for (auto *v : {&x_, &y_, &z_})
+    v->resize(n);
+  for (std::size_t k = 0; k < n; ++k)
+  {
+    x_[k] = state.x[index_[k]];
+    y_[k] = state.y[index_[k]];
+    z_[k] = state.z[index_[k]];
+  }
+  E_.assign(3 * n, 0.0);
+  state_size_ = state.size();
+  must_select_ = false;
+  must_rebuild_ = true;
+}
+
+void CoulombTerm::gather(const dem::ParticleState &state)
+{
+  // Unwrapped along periodic axes: of the engine position's images, the one nearest to the
+  // previous position (a particle moves far less than half a period per step). A changed
+  // charge invalidates the held far field.
+  const std::size_t n = index_.size();
+  const std::vector<double> *engine[3] = {&state.x, &state.y, &state.z};
+  std::vector<double> *mine[3] = {&x_, &y_, &z_};
+  for (int d = 0; d < 3; ++d)
+  {
+    const double L = box_[d];
+    const double *from = engine[d]->data();
+    double *to = mine[d]->data();
+    for (std::size_t k = 0; k < n; ++k)
+    {
+      const double raw = from[index_[k]];
+      const double jump = to[k] - raw;
+      to[k] = (L > 0.0 && std::abs(jump) > 0.5 * L) ? raw + L * std::round(jump / L) : raw;
+    }
+  }
+  for (std::size_t k = 0; k < n; ++k)
+    if (state.charge[index_[k]] != q_[k])
+    {
+      q_[k] = state.charge[index_[k]];
+      must_rebuild_ = true;
+    }
+}
+
+bool CoulombTerm::moved_too_far() const
+{
+  const double limit = settings_.max_move_cells * settings_.far.cell_size, limit2 = limit * limit;
+  for (std::size_t k = 0; k < index_.size(); ++k)
+  {
+    const double dx = x_[k] - bx_[k], dy = y_[k] - by_[k], dz = z_[k] - bz_[k];
+    if (dx * dx + dy * dy + dz * dz > limit2)
+      return true;
+  }
+  return false;
+}
+
+void CoulombTerm::rebuild(double t)
+{
+  bx_ = x_;
+  by_ = y_;
+  bz_ = z_;
+  coulomb_.rebuild(index_.size(), bx_.data(), by_.data(), bz_.data(), q_.data(), radius_.data());
+  built_at_ = t;
+  must_rebuild_ = false;
+  ++evaluations_;
+}
+
+void CoulombTerm::add_forces(const dem::ParticleState &state, dem::ForceBuffers &forces, double t)
+{
+  if (must_select_ || state.size() != state_size_)
+    select(state);
+  const std::size_t n = index_.size();
+  if (n == 0)
+    return;
+  gather(state);
+  if (must_rebuild_ || t - built_at_ >= settings_.refresh || moved_too_far())
+    rebuild(t);
+  coulomb_.field(x_.data(), y_.data(), z_.data(), q_.data(), radius_.data(), E_.data(), nullptr);
+  for (std::size_t k = 0; k < n; ++k)
+  {
+    const std::size_t i = index_[k];
+    forces.fx[i] += q_[k] * E_[3 * k];
+    forces.fy[i] += q_[k] * E_[3 * k + 1];
+    forces.fz[i] += q_[k] * E_[3 * k + 2];
+  }
+}
+
+void CoulombTerm::particles_reordered(const std::vector<std::int32_t> &order)
+{
+  if (index_.empty())
+    return;
+  if (order.size() != state_size_)
+  {
+    must_select_ = true;
+    return;
+  }
+  std::vector<std::uint32_t> new_index(order.size());
+  for (std::size_t k = 0; k < order.size(); ++k)
+    new_index[static_cast<std::size_t>(order[k])] = static_cast<std::uint32_t>(k);
+  for (auto &i : index_)
+    i = new_index[i];
+}
+
+void CoulombTerm::write_state(dem::CheckpointWriter &out) const
+{
+  out.put<std::uint64_t>(state_size_);
+  out.put<std::uint8_t>(must_select_ || must_rebuild_ ? 1 : 0);
+  out.put_array(index_);
+  for (const auto *v : {&q_, &radius_, &x_, &y_, &z_, &bx_, &by_, &bz_})
+    out.put_array(*v);
+  out.put<double>(built_at_);
+  out.put<std::int64_t>(evaluations_);
+  out.put_array(coulomb_.held_far_field());
+  out.put_array(coulomb_.held_far_potential());
+}
+
+void CoulombTerm::read_state(dem::CheckpointReader &in)
+{
+  state_size_ = static_cast<std::size_t>(in.get<std::uint64_t>());
+  const bool stale = in.get<std::uint8_t>() != 0;
+  in.get_array(index_);
+  for (auto *v : {&q_, &radius_, &x_, &y_, &z_, &bx_, &by_, &bz_})
+    in.get_array(*v);
+  built_at_ = in.get<double>();
+  evaluations_ = static_cast<long>(in.get<std::int64_t>());
+  std::vector<double> far_E, far_phi;
+  in.get_array(far_E);
+  in.get_array(far_phi);
+  E_.assign(3 * index_.size(), 0.0);
+  must_select_ = false;
+  must_rebuild_ = stale;
+  if (!stale && !index_.empty())
+  {
+    // The cells and near rows of the last rebuild (deterministic from the stored positions),
+    // then the held far field as it was.
+    coulomb_.rebuild(index_.size(), bx_.data(), by_.data(), bz_.data(), q_.data(), radius_.data());
+    if (far_E.size() != coulomb_.held_far_field().size() || far_phi.size() != coulomb_.held_far_potential().size())
+      throw std::runtime_error("checkpoint: the Coulomb term's held far field has " + std::to_string(far_E.size() / 3) +
+                               " charges, its particles " + std::to_string(index_.size()) + ".");
+    coulomb_.held_far_field() = far_E;
+    coulomb_.held_far_potential() = far_phi;
+  }
+}
+
+namespace {
+// On when some population is charged, unless switched off.
+std::string coulomb_not_needed_because(const Case &c)
+{
+  if (!c.electric.coulomb)
+    return "electric.coulomb is false";
+  for (const auto &p : c.populations)
+    if (p.charge_to_mass != 0.0)
+      return "";
+  return "no population is charged";
+}
+
+const bool registered = dem::register_force_term(
+    {"Coulomb", dem::force_term_order::coulomb, coulomb_not_needed_because,
+     [](const Case &c, const dem::DemSystem &system) -> std::unique_ptr<dem::ForceTerm> {
+       return std::make_unique<CoulombTerm>(CoulombTermSettings::from_case(c), system.box().length);
+     }});
+} // namespace
+
+} // namespace magbrush::electrostatics

@@ -1,0 +1,213 @@
+#include "electrostatics/periodic_coulomb.h"
+
+#include "electrostatics/coulomb_constants.h"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace magbrush::electrostatics {
+
+namespace {
+constexpr long parallel_threshold = 512;
+
+// Adds the kernel field q r/|r|³ and potential q/|r| at r = (target − source).
+inline void add_coulomb(double rx, double ry, double rz, double q, double &ex, double &ey, double &ez, double &phi)
+{
+  const double r2 = rx * rx + ry * ry + rz * rz;
+  const double ir = 1.0 / std::sqrt(r2);
+  const double qir3 = q * ir * ir * ir;
+  ex += qir3 * rx;
+  ey += qir3 * ry;
+  ez += qir3 * rz;
+  phi += q * ir;
+}
+} // namespace
+
+PeriodicCoulomb::PeriodicCoulomb(const CoulombSettings &settings, const std::array<double, 3> &box)
+  : settings_(settings), box_(box)
+{
+  if (settings.order < 0 || settings.order > 8)
+    throw std::invalid_argument("Coulomb: the far-field order must be within 0 … 8; found " +
+                                std::to_string(settings.order) + ".");
+  if (!(settings.cell_size > 0.0))
+    throw std::invalid_argument("Coulomb: the far-field cell size must be positive; found " +
+                                std::to_string(settings.cell_size) + " m.");
+  if (box[0] > 0.0 && box[1] > 0.0 && box[2] > 0.0)
+    throw std::invalid_argument("Coulomb: a box periodic along x, y and z is not supported (its charge sums need "
+                                "Ewald summation with a stated boundary condition); leave one axis open, or set "
+                                "electric.coulomb: false.");
+  far_ = std::make_unique<magnetics::CellMultipoleField>(settings.order, box, settings.near_reach,
+                                                         magnetics::SourceKind::charges);
+  far_->set_single_precision(settings.single_precision);
+}
+
+void PeriodicCoulomb::set_image_surface(const GroundedSurface &surface, int terms)
+{
+  surface_ = surface;
+  image_terms_ = terms;
+  images_per_charge_ = surface.layer.pair_image_count(terms);
+}
+
+void PeriodicCoulomb::place_sources(const double *x, const double *y, const double *z, const double *q,
+                                    const double *floor)
+{
+  const std::size_t n = n_, m = static_cast<std::size_t>(images_per_charge_);
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    sx_[i] = x[i];
+    sy_[i] = y[i];
+    sz_[i] = z[i];
+    sq_[i] = q[i];
+  }
+  if (m == 0)
+    return;
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    double normal[3];
+    double h = surface_.height(x[i], y[i], z[i], normal);
+    if (floor)
+      h = std::max(h, floor[i]);
+    h = std::max(h, 0.0);
+    const double foot[3] = {x[i] - h * normal[0], y[i] - h * normal[1], z[i] - h * normal[2]};
+    surface_.layer.pair_images(h, image_terms_, image_charge_, image_depth_);
+    for (std::size_t k = 0; k < m; ++k)
+    {
+      const std::size_t s = n + i * m + k;
+      sx_[s] = foot[0] - image_depth_[k] * normal[0];
+      sy_[s] = foot[1] - image_depth_[k] * normal[1];
+      sz_[s] = foot[2] - image_depth_[k] * normal[2];
+      sq_[s] = q[i] * image_charge_[k];
+    }
+  }
+}
+
+void PeriodicCoulomb::build_rows(std::vector<char> &own_image_near)
+{
+  // Each real target's row lists the sources of its near pairs with the shift that puts the
+  // source's image next to it, in the order of the pair list (fixed): a charge's own images
+  // at zero shift are left out (the self force is the conductor-image term's).
+  const std::size_t n = n_, m = static_cast<std::size_t>(images_per_charge_);
+  const auto &pairs = far_->near_pairs();
+  auto owner = [&](std::uint32_t s) { return s < n ? s : static_cast<std::uint32_t>((s - n) / m); };
+  auto own_image = [&](std::uint32_t target, std::uint32_t source, const double *shift) {
+    return source >= n && owner(source) == target && shift[0] == 0.0 && shift[1] == 0.0 && shift[2] == 0.0;
+  };
+  own_image_near.assign(n * m, 0);
+  row_begin_.assign(n + 1, 0);
+  for (const auto &p : pairs)
+  {
+    const double minus[3] = {-p.shift[0], -p.shift[1], -p.shift[2]};
+    if (p.i < n && !own_image(p.i, p.j, p.shift))
+      ++row_begin_[p.i + 1];
+    if (p.j < n && !own_image(p.j, p.i, minus))
+      ++row_begin_[p.j + 1];
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    row_begin_[i + 1] += row_begin_[i];
+  row_source_.resize(row_begin_[n]);
+  row_shift_.resize(3 * row_begin_[n]);
+  std::vector<std::uint32_t> &fill = row_fill_;
+  fill.assign(row_begin_.begin(), row_begin_.end() - 1);
+  auto put = [&](std::uint32_t target, std::uint32_t source, const double *shift) {
+    if (own_image(target, source, shift))
+    {
+      own_image_near[source - n] = 1;
+      return;
+    }
+    const std::uint32_t k = fill[target]++;
+    row_source_[k] = source;
+    for (int d = 0; d < 3; ++d)
+      row_shift_[3 * k + d] = shift[d];
+  };
+  for (const auto &p : pairs)
+  {
+    const double minus[3] = {-p.shift[0], -p.shift[1], -p.shift[2]};
+    if (p.i < n)
+      put(p.i, p.j, p.shift);
+    if (p.j < n)
+      put(p.j, p.i, minus);
+  }
+}
+
+void PeriodicCoulomb::remove_own_far_images(const std::vector<char> &own_image_near)
+{
+  // The far field contains a charge's own images (zero shift) that are not near pairs:
+  // subtract their exact field (the expansion's error on them stays, as for any far pair).
+  const std::size_t n = n_, m = static_cast<std::size_t>(images_per_charge_);
+  if (m == 0)
+    return;
+#pragma omp parallel for schedule(static) if (static_cast<long>(n) >= parallel_threshold)
+  for (long il = 0; il < static_cast<long>(n); ++il)
+  {
+    const std::size_t i = static_cast<std::size_t>(il);
+    double ex = 0.0, ey = 0.0, ez = 0.0, phi = 0.0;
+    for (std::size_t k = 0; k < m; ++k)
+    {
+      const std::size_t s = n + i * m + k;
+      if (own_image_near[i * m + k])
+        continue;
+      add_coulomb(sx_[i] - sx_[s], sy_[i] - sy_[s], sz_[i] - sz_[s], sq_[s], ex, ey, ez, phi);
+    }
+    far_E_[3 * i] -= coulomb_constant * ex;
+    far_E_[3 * i + 1] -= coulomb_constant * ey;
+    far_E_[3 * i + 2] -= coulomb_constant * ez;
+    far_phi_[i] -= coulomb_constant * phi;
+  }
+}
+
+void PeriodicCoulomb::rebuild(std::size_t n, const double *x, const double *y, const double *z, const double *q,
+                              const double *floor)
+{
+  n_ = n;
+  const std::size_t total = n * (1 + static_cast<std::size_t>(images_per_charge_));
+  for (auto *v : {&sx_, &sy_, &sz_, &sq_})
+    v->resize(total);
+  place_sources(x, y, z, q, floor);
+  const double t0 = omp_get_wtime();
+  far_->set_near_targets(n);
+  far_->build(total, sx_.data(), sy_.data(), sz_.data(), settings_.cell_size);
+  const double t1 = omp_get_wtime();
+  build_rows(own_image_near_);
+  const double t2 = omp_get_wtime();
+  scratch_E_.resize(3 * total);
+  scratch_phi_.resize(total);
+  far_->evaluate(magnetics::FarFieldSources{sq_.data(), nullptr},
+                 magnetics::FarFieldTargets{scratch_phi_.data(), scratch_E_.data(), nullptr});
+  far_E_.resize(3 * n);
+  far_phi_.resize(n);
+  for (std::size_t i = 0; i < 3 * n; ++i)
+    far_E_[i] = coulomb_constant * scratch_E_[i];
+  for (std::size_t i = 0; i < n; ++i)
+    far_phi_[i] = coulomb_constant * scratch_phi_[i];
+  remove_own_far_images(own_image_near_);
+  times_ = {t1 - t0, t2 - t1, omp_get_wtime() - t2};
+}
+
+void PeriodicCoulomb::field(const double *x, const double *y, const double *z, const double *q, const double *floor,
+                            double *E, double *phi)
+{
+  place_sources(x, y, z, q, floor);
+  const long n = static_cast<long>(n_);
+#pragma omp parallel for schedule(static) if (n >= parallel_threshold)
+  for (long i = 0; i < n; ++i)
+  {
+    double ex = 0.0, ey = 0.0, ez = 0.0, p = 0.0;
+    for (std::uint32_t k = row_begin_[i]; k < row_begin_[i + 1]; ++k)
+    {
+      const std::uint32_t s = row_source_[k];
+      add_coulomb(sx_[i] - sx_[s] - row_shift_[3 * k], sy_[i] - sy_[s] - row_shift_[3 * k + 1],
+                  sz_[i] - sz_[s] - row_shift_[3 * k + 2], sq_[s], ex, ey, ez, p);
+    }
+    E[3 * i] = far_E_[3 * i] + coulomb_constant * ex;
+    E[3 * i + 1] = far_E_[3 * i + 1] + coulomb_constant * ey;
+    E[3 * i + 2] = far_E_[3 * i + 2] + coulomb_constant * ez;
+    if (phi)
+      phi[i] = far_phi_[i] + coulomb_constant * p;
+  }
+}
+
+} // namespace magbrush::electrostatics

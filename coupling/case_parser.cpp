@@ -989,6 +989,7 @@ private:
     f.grid_angular_spacing = q(s, "grid_angular_spacing");
     f.grid_outer_radius = q(s, "grid_outer_radius");
     f.grid_electric_spacing = q(s, "grid_electric_spacing");
+    f.electric_phase_samples = static_cast<int>(integer(s, "electric_phase_samples"));
     f.probe_radius = q(s, "probe_radius");
     f.output_dir = str(s, "output_dir");
   }

@@ -1,0 +1,131 @@
+// The nip potential at any phase of the latent image: construction, phase weights, the drum's
+// surface travel (see nip_potential_field.h).
+#include "coupling/nip_potential_field.h"
+
+#include "coupling/case_hash.h"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace magbrush {
+
+namespace {
+constexpr double pi = 3.14159265358979323846;
+}
+
+NipPotentialField::NipPotentialField(const NipPotentialGrid &grid, PhaseInterpolation interpolation)
+  : x_min_(grid.bias.x_min), x_max_(grid.bias.x_max), y_min_(grid.bias.y_min),
+    y_max_(grid.bias.y_max), dx_(0.0), dy_(0.0), n_x_(grid.bias.n_x), n_y_(grid.bias.n_y),
+    K_(grid.phase_samples()), period_(grid.image_period), interpolation_(interpolation)
+{
+  validate(grid, "NipPotentialField");
+  dx_ = grid.bias.dx();
+  dy_ = grid.bias.dy();
+  bias_ = spline::bicubic_hermite_data(grid.bias.phi, n_x_, n_y_, /*periodic*/ false);
+  // Interleave the samples per node, so that one lookup reads one contiguous block per corner.
+  const size_t n = grid.bias.phi.size();
+  image_.assign(n * static_cast<size_t>(K_) * 4, 0.0);
+  for (int k = 0; k < K_; ++k)
+  {
+    const std::vector<double> data =
+      spline::bicubic_hermite_data(grid.image[static_cast<size_t>(k)], n_x_, n_y_, false);
+    for (size_t node = 0; node < n; ++node)
+      for (int c = 0; c < 4; ++c)
+        image_[(node * static_cast<size_t>(K_) + static_cast<size_t>(k)) * 4 + c] = data[node * 4 + c];
+  }
+}
+
+NipPotentialField NipPotentialField::for_case(const Case &c, const std::string &grid_path,
+                                              PhaseInterpolation interpolation)
+{
+  const ElectricGridFile file = read_electric_grid(grid_path);
+  check_provenance(file.info, field_inputs(c, FieldKind::electric));
+  return NipPotentialField(file.grid, interpolation);
+}
+
+double NipPotentialField::surface_travel(const Drum &drum, double t)
+{
+  // Θ(t) = ∫ ω: the drum wall's speed ramps linearly from rest over spin_up_time
+  // (dem/wall_contacts.cpp cylinder_omega), and the drum rests while the particles settle (t < 0).
+  if (t <= 0.0)
+    return 0.0;
+  const double omega = drum.omega(), T = drum.spin_up_time;
+  const double angle = T > 0.0 && t < T ? 0.5 * omega * t * t / T
+                                        : omega * (T > 0.0 ? t - 0.5 * T : t);
+  return drum.radius * angle;
+}
+
+NipPotentialField::PhaseWeights NipPotentialField::make_phase_weights() const
+{
+  PhaseWeights w;
+  w.index.assign(static_cast<size_t>(K_), 0);
+  w.weight.assign(static_cast<size_t>(K_), 0.0);
+  return w;
+}
+
+void NipPotentialField::phase_weights(double u, PhaseWeights &w) const
+{
+  if (w.index.size() < static_cast<size_t>(K_) || w.weight.size() < static_cast<size_t>(K_))
+    throw std::invalid_argument("NipPotentialField::phase_weights: buffers for " +
+                                std::to_string(w.index.size()) + " samples, the field has " +
+                                std::to_string(K_) + " (use make_phase_weights)");
+  if (period_ <= 0.0 || K_ == 1)
+  {
+    w.count = 1;
+    w.index[0] = 0;
+    w.weight[0] = 1.0;
+    return;
+  }
+  // The phase in units of the sample spacing, in [0, K).
+  double f = u / period_;
+  f = (f - std::floor(f)) * K_;
+  if (f >= K_)
+    f = 0.0;
+  const int k0 = static_cast<int>(f);
+  const double frac = f - k0;
+  if (frac == 0.0)
+  {
+    w.count = 1;
+    w.index[0] = k0;
+    w.weight[0] = 1.0;
+    return;
+  }
+  if (interpolation_ == PhaseInterpolation::linear)
+  {
+    w.count = 2;
+    w.index[0] = k0;
+    w.weight[0] = 1.0 - frac;
+    w.index[1] = (k0 + 1) % K_;
+    w.weight[1] = frac;
+    return;
+  }
+  // Trigonometric: the periodic interpolant through K equispaced samples, as weights
+  // w_k(Δ) = (1/K) [1 + 2 Σ_{m<K/2} cos mΔ (+ cos (K/2)Δ for even K)], Δ = 2π (f − k)/K:
+  // sin(KΔ/2) / (K sin(Δ/2)) for odd K, sin(KΔ/2) cot(Δ/2) / K for even K (the Nyquist
+  // harmonic as a cosine, so the weights are real and sum to one).
+  // sin(KΔ/2) = sin(π (f − k)) = (−1)^k sin(π f).
+  const double s_f = std::sin(pi * f);
+  for (int k = 0; k < K_; ++k)
+  {
+    const double half = pi * (f - k) / K_;
+    const double sign = (k % 2 == 0) ? 1.0 : -1.0;
+    const double ratio = sign * s_f / (K_ * std::sin(half));
+    w.index[static_cast<size_t>(k)] = k;
+    w.weight[static_cast<size_t>(k)] = K_ % 2 == 0 ? ratio * std::cos(half) : ratio;
+  }
+  w.count = K_;
+}
+
+double NipPotentialField::potential(const Vec3 &x, const PhaseWeights &w) const
+{
+  double out[6];
+  return patch(x, w, out) ? out[0] : std::numeric_limits<double>::quiet_NaN();
+}
+
+const char *NipPotentialField::interpolation_name() const
+{
+  return interpolation_ == PhaseInterpolation::linear ? "linear" : "trigonometric";
+}
+
+} // namespace magbrush

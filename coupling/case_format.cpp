@@ -230,6 +230,7 @@ std::vector<ResolvedEntry> resolved_entries(const Case &c)
   e.q("field.grid_angular_spacing", "field.grid_angular_spacing", fs.grid_angular_spacing);
   e.q("field.grid_outer_radius", "field.grid_outer_radius", fs.grid_outer_radius);
   e.q("field.grid_electric_spacing", "field.grid_electric_spacing", fs.grid_electric_spacing);
+  e.i("field.electric_phase_samples", "field.electric_phase_samples", fs.electric_phase_samples);
   e.q("field.probe_radius", "field.probe_radius", fs.probe_radius);
   e.s("field.output_dir", "field.output_dir", fs.output_dir);
 

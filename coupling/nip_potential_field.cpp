@@ -82,12 +82,14 @@ void NipPotentialField::phase_weights(double u, PhaseWeights &w) const
   f = (f - std::floor(f)) * K_;
   if (f >= K_)
     f = 0.0;
-  const int k0 = static_cast<int>(f);
-  const double frac = f - k0;
-  if (frac == 0.0)
+  int k0 = static_cast<int>(f);
+  double frac = f - k0;
+  // Within round-off of a sample (1e-9 of the sample spacing): that sample alone, so that the
+  // stored phases are reproduced exactly.
+  if (frac < 1e-9 || frac > 1.0 - 1e-9)
   {
     w.count = 1;
-    w.index[0] = k0;
+    w.index[0] = frac < 0.5 ? k0 : (k0 + 1) % K_;
     w.weight[0] = 1.0;
     return;
   }

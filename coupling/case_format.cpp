@@ -203,6 +203,7 @@ std::vector<ResolvedEntry> resolved_entries(const Case &c)
   }
   e.q("electric.image.period", "electric.image.period", im.period);
   e.q("electric.image.duty", "electric.image.duty", im.duty);
+  e.q("electric.image.edge_width", "electric.image.edge_width", im.edge_width);
 
   const auto &f = c.applied_field;
   e.s("applied_field.kind", "applied_field.kind",

@@ -25,6 +25,8 @@ std::vector<KeySpec> electric_keys()
       quantity("electric.image.period", D::length, "Strip period along the drum surface (0 = uniform dark).")
           .def("0 mm").non_negative().affects(A::electric),
       number("electric.image.duty", "Exposed fraction of one period.").def("0.5").min(0.0).max(1.0).affects(A::electric),
+      quantity("electric.image.edge_width", D::length, "Width of the smooth (raised-cosine) transition at each strip edge, at most the narrower strip (0 = sharp edges).")
+          .def("0 um").non_negative().affects(A::electric),
   };
 }
 

@@ -128,6 +128,7 @@ struct LatentImage
   double light_value = 0.0;      // C/m² or V, in the exposed (image) areas
   double period = 0.0;           // strip period along the drum surface [m] (0 = uniform dark)
   double duty = 0.5;             // exposed fraction of one period
+  double edge_width = 0.0;       // width of the raised-cosine transition at each strip edge [m] (0 = sharp)
 };
 
 struct Electric

@@ -933,6 +933,12 @@ private:
     }
     li.period = q(image, "period");
     li.duty = q(image, "duty");
+    li.edge_width = q(image, "edge_width");
+    if (li.period > 0.0 && li.edge_width > std::min(li.duty, 1.0 - li.duty) * li.period)
+      error_at_path(image.display, "edge_width " + std::to_string(li.edge_width * 1e6) +
+                                     " um is wider than the narrower strip (min(duty, 1 - duty) x period = " +
+                                     std::to_string(std::min(li.duty, 1.0 - li.duty) * li.period * 1e6) +
+                                     " um): the edges of one strip would overlap");
   }
 
   void build_applied_field(Case &c, const Scope &s)

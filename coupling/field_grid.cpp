@@ -170,6 +170,11 @@ void validate(const NipPotentialGrid &g, const std::string &what)
                          num(g.image_period) + " m");
   if (g.image.empty())
     throw FieldGridError(what + ": the image needs at least one phase sample, found none");
+  if (!(std::isfinite(g.drum_radius) && g.drum_radius >= 0.0 && std::isfinite(g.drum_center[0]) &&
+        std::isfinite(g.drum_center[1])))
+    throw FieldGridError(what + ": the drum centre and radius must be finite (radius ≥ 0), found (" +
+                         num(g.drum_center[0]) + ", " + num(g.drum_center[1]) + ") m, " +
+                         num(g.drum_radius) + " m");
   if (g.image_period == 0.0 && g.image.size() != 1)
     throw FieldGridError(what + ": a uniform image (period 0) has exactly one phase sample, found " +
                          std::to_string(g.image.size()));
@@ -559,6 +564,8 @@ void write_electric_grid(const std::string &path, const NipPotentialGrid &nip,
     w.int_attribute(group, "n_y", grid.n_y);
     w.double_attribute(group, "image_period", {nip.image_period});
     w.int_attribute(group, "phase_samples", nip.phase_samples());
+    w.double_attribute(group, "drum_center", {nip.drum_center[0], nip.drum_center[1]});
+    w.double_attribute(group, "drum_radius", {nip.drum_radius});
     w.dataset(group, "x", linspace(grid.x_min, grid.x_max, grid.n_x, true),
               {static_cast<hsize_t>(grid.n_x)}, "m");
     w.dataset(group, "y", linspace(grid.y_min, grid.y_max, grid.n_y, true),
@@ -902,6 +909,11 @@ ElectricGridFile read_electric_grid(const std::string &path)
                linspace(g.y_min, g.y_max, g.n_y, true), "/cartesian/y", g.dy());
   g.phi = r.dataset(group, "cartesian", "phi_bias", {nx, ny}, "V");
   out.grid.image_period = r.scalar_attribute(group, "image_period");
+  const std::vector<double> centre = r.double_attribute(group, "drum_center");
+  if (centre.size() != 2)
+    r.fail("attribute /cartesian/drum_center must hold 2 values, found " + std::to_string(centre.size()));
+  out.grid.drum_center = {centre[0], centre[1]};
+  out.grid.drum_radius = r.scalar_attribute(group, "drum_radius");
   const int K = r.int_attribute(group, "phase_samples");
   if (K < 1)
     r.fail("attribute /cartesian/phase_samples must be ≥ 1, found " + std::to_string(K));

@@ -22,6 +22,7 @@
 #include "coupling/case_hash.h"
 #include "coupling/case_model.h"
 
+#include <array>
 #include <functional>
 #include <limits>
 #include <stdexcept>
@@ -97,11 +98,14 @@ struct CartesianGrid
 // carried along the drum surface by the arc length u (its surface value at arc length s from the
 // nip point is the value the case gives at s − u; field_solver/nip_electrostatics.h
 // latent_image_value). Φ_image is periodic in u with the image period P and stored at the K
-// phases u_k = k P / K, k = 0 .. K − 1; a uniform image (P = 0) has one sample.
+// phases u_k = k P / K, k = 0 .. K − 1; a uniform image (P = 0) has one sample. The drum's
+// centre and radius let a reader carry a sample along the surface (nip_potential_field.h).
 struct NipPotentialGrid
 {
   CartesianGrid bias;                     // the window, and Φ_bias [V] on it
   double image_period = 0.0;              // P [m] along the drum surface; 0: the image is uniform
+  std::array<double, 2> drum_center{{0.0, 0.0}}; // [m], in the window's frame
+  double drum_radius = 0.0;               // the drum (photoconductor) surface radius [m]
   std::vector<std::vector<double>> image; // K arrays laid out like bias.phi [V]
 
   int phase_samples() const { return static_cast<int>(image.size()); }

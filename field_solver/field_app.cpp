@@ -299,6 +299,8 @@ bool compute_electric_field(const Case &c, const FieldRunOptions &options, MPI_C
   const bool moving = image.period > 0.0 && image.kind != LatentImage::Kind::none;
   const int K = moving ? c.field.electric_phase_samples : 1;
   grid.image_period = moving ? image.period : 0.0;
+  grid.drum_center = layout.drum_center;
+  grid.drum_radius = c.drum.radius;
   SolveReport report;
   double solve_seconds = 0.0, sample_seconds = 0.0;
   const auto solve_and_sample = [&](double bias, const LatentImage &img, double shift) {

@@ -22,9 +22,21 @@ double latent_image_value(const LatentImage &image, double s)
 {
   if (image.period <= 0.0)
     return image.dark_value;
-  const double u = s / image.period + 0.5 * image.duty;
-  const double frac = u - std::floor(u);
-  return frac < image.duty ? image.light_value : image.dark_value;
+  // s' ∈ [−P/2, P/2): the place within the period; e: the distance inside the exposed strip
+  // from its nearer edge (negative outside it).
+  if (image.duty >= 1.0)
+    return image.light_value;
+  if (image.duty <= 0.0)
+    return image.dark_value;
+  const double P = image.period;
+  const double v = s / P + 0.5;
+  const double s_local = (v - std::floor(v) - 0.5) * P;
+  const double e = 0.5 * image.duty * P - std::abs(s_local);
+  const double w = image.edge_width;
+  if (w <= 0.0)
+    return e > 0.0 ? image.light_value : image.dark_value;
+  const double S = e >= 0.5 * w ? 1.0 : e <= -0.5 * w ? 0.0 : 0.5 * (1.0 + std::sin(pi * e / w));
+  return image.dark_value + (image.light_value - image.dark_value) * S;
 }
 
 NipElectrostatics::NipElectrostatics(MPI_Comm communicator_in, const NipLayout &layout,
@@ -194,7 +206,32 @@ std::vector<double> NipElectrostatics::air_potential(const std::vector<Vec2> &po
   const std::vector<double> v_air = potential(air);
   for (std::size_t i = 0; i < air_index.size(); ++i)
     values[air_index[i]] = v_air[i];
-  const std::vector<double> v_anchor = solver->values_at(anchor);
+  // The curved mapping approximates the circles by polynomials: an anchor a hair outside the
+  // exact circle can still lie outside the mesh. Such anchors move further into the air (at
+  // most 1 % of the gap), the others stay.
+  std::vector<double> v_anchor;
+  for (double lift = hair;; lift *= 10.0)
+  {
+    std::vector<bool> found;
+    v_anchor = solver->values_at(anchor, &found);
+    bool all = true;
+    for (std::size_t i = 0; i < anchor.size(); ++i)
+      if (!found[i])
+      {
+        all = false;
+        const Vec2 &x = points[anchor_index[i]];
+        const bool sleeve = std::hypot(x[0], x[1]) < nip.sleeve_radius;
+        const double cx = sleeve ? 0.0 : nip.drum_center[0], cy = sleeve ? 0.0 : nip.drum_center[1];
+        const double r = std::hypot(anchor[i][0] - cx, anchor[i][1] - cy);
+        const double scale = (r + 9.0 * lift) / r;
+        anchor[i] = Point<2>(cx + (anchor[i][0] - cx) * scale, cy + (anchor[i][1] - cy) * scale);
+      }
+    if (all)
+      break;
+    if (lift > 1e-2 * gap)
+      throw std::runtime_error("nip field: the surface points of the smooth extension lie "
+                               "outside the mesh even 1 % of the gap into the air");
+  }
   const auto g_anchor = solver->gradients_at(anchor);
   for (std::size_t i = 0; i < anchor_index.size(); ++i)
   {

@@ -33,7 +33,8 @@ struct NipDiscretisation
 // The latent image along the drum surface as a function of the arc length s from the nip
 // point (the drum surface point nearest the sleeve), s increasing counter-clockwise about the
 // drum centre: exposed ("light") where frac(s/period + duty/2) < duty — an exposed strip
-// centred on the nip — dark elsewhere; uniformly dark when period = 0. This is the image at
+// centred on the nip — dark elsewhere; uniformly dark when period = 0. With an edge width w
+// the value changes from dark to light along a raised cosine over w centred on each edge. This is the image at
 // phase 0 (t ≤ 0 in the DEM); once the drum has turned, the value at s is the one this gives
 // at s − u, u the arc length the surface travelled (coupling/nip_potential_field.h).
 double latent_image_value(const LatentImage &image, double s);

@@ -25,6 +25,10 @@ NipPotentialGrid nip_grid(int n_x, int n_y, double width, double gap,
   NipPotentialGrid g;
   g.bias = sample_cartesian_grid(-0.5 * width, 0.5 * width, n_x, 0.0, gap, n_y, bias);
   g.image_period = period;
+  // A planar surface y = 0 moving toward +x: the bottom of a huge drum centred above it
+  // (counter-clockwise there is +x).
+  g.drum_center = {0.0, 1e3};
+  g.drum_radius = 1e3;
   for (int k = 0; k < K; ++k)
   {
     const double u = k * period / K;

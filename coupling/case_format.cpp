@@ -221,6 +221,7 @@ std::vector<ResolvedEntry> resolved_entries(const Case &c)
   e.q("electric.coulomb_refresh", "electric.coulomb_refresh", c.electric.coulomb_refresh);
   e.b("electric.conductor_images", "electric.conductor_images", c.electric.conductor_images);
   e.i("electric.pair_image_terms", "electric.pair_image_terms", c.electric.pair_image_terms);
+  e.q("electric.image.edge_width", "electric.image.edge_width", im.edge_width);
 
   const auto &f = c.applied_field;
   e.s("applied_field.kind", "applied_field.kind",
@@ -248,6 +249,7 @@ std::vector<ResolvedEntry> resolved_entries(const Case &c)
   e.q("field.grid_angular_spacing", "field.grid_angular_spacing", fs.grid_angular_spacing);
   e.q("field.grid_outer_radius", "field.grid_outer_radius", fs.grid_outer_radius);
   e.q("field.grid_electric_spacing", "field.grid_electric_spacing", fs.grid_electric_spacing);
+  e.i("field.electric_phase_samples", "field.electric_phase_samples", fs.electric_phase_samples);
   e.q("field.probe_radius", "field.probe_radius", fs.probe_radius);
   e.s("field.output_dir", "field.output_dir", fs.output_dir);
 

@@ -44,6 +44,8 @@ std::vector<KeySpec> electric_keys()
       integer("electric.pair_image_terms",
               "Drum images per charge that act on the OTHER charges (explicit terms of the layered image series, the rest lumped keeping charge and dipole moment; 0 = the self force only).")
           .def("2").non_negative().max(20),
+      quantity("electric.image.edge_width", D::length, "Width of the smooth (raised-cosine) transition at each strip edge, at most the narrower strip (0 = sharp edges).")
+          .def("0 um").non_negative().affects(A::electric),
   };
 }
 

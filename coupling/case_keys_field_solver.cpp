@@ -19,6 +19,8 @@ std::vector<KeySpec> field_solver_keys()
       quantity("field.grid_angular_spacing", D::angle, "Polar magnetic grid angular spacing.").def("0.25 deg").positive().affects(A::magnetic),
       quantity("field.grid_outer_radius", D::length, "Polar grid outer radius (0 = sleeve + 3 mm).").def("0 mm").non_negative().affects(A::magnetic),
       quantity("field.grid_electric_spacing", D::length, "Cartesian nip grid spacing.").def("10 um").positive().affects(A::electric),
+      integer("field.electric_phase_samples", "Phases of the moving latent image stored per image period (the DEM interpolates between them; docs/electrostatics.md).")
+          .def("16").min(1).max(1024).affects(A::electric),
       quantity("field.probe_radius", D::length, "Radius of the exported sleeve flux profile (0 = sleeve radius).")
           .def("0 mm").non_negative().affects(A::magnetic),
       text("field.output_dir", "Directory of the stored field files.").def("fields"),

@@ -141,6 +141,7 @@ struct LatentImage
   double light_value = 0.0;      // C/m² or V, in the exposed (image) areas
   double period = 0.0;           // strip period along the drum surface [m] (0 = uniform dark)
   double duty = 0.5;             // exposed fraction of one period
+  double edge_width = 0.0;       // width of the raised-cosine transition at each strip edge [m] (0 = sharp)
 };
 
 struct Electric
@@ -194,6 +195,7 @@ struct FieldSettings
   double grid_angular_spacing = 0.25 * 3.14159265358979323846 / 180.0; // Δθ [rad]
   double grid_outer_radius = 0.0;       // polar grid outer radius [m] (0 = sleeve + 3 mm)
   double grid_electric_spacing = 10e-6; // Cartesian nip grid spacing [m]
+  int electric_phase_samples = 16;      // latent-image phases stored per image period
   double probe_radius = 0.0;            // sleeve-profile probe radius [m] (0 = sleeve radius)
   std::string output_dir = "fields";
 };

@@ -955,6 +955,12 @@ private:
     c.electric.coulomb_refresh = q(s, "coulomb_refresh");
     c.electric.conductor_images = flag(s, "conductor_images");
     c.electric.pair_image_terms = static_cast<int>(integer(s, "pair_image_terms"));
+    li.edge_width = q(image, "edge_width");
+    if (li.period > 0.0 && li.edge_width > std::min(li.duty, 1.0 - li.duty) * li.period)
+      error_at_path(image.display, "edge_width " + std::to_string(li.edge_width * 1e6) +
+                                     " um is wider than the narrower strip (min(duty, 1 - duty) x period = " +
+                                     std::to_string(std::min(li.duty, 1.0 - li.duty) * li.period * 1e6) +
+                                     " um): the edges of one strip would overlap");
   }
 
   void build_applied_field(Case &c, const Scope &s)
@@ -1027,6 +1033,7 @@ private:
     f.grid_angular_spacing = q(s, "grid_angular_spacing");
     f.grid_outer_radius = q(s, "grid_outer_radius");
     f.grid_electric_spacing = q(s, "grid_electric_spacing");
+    f.electric_phase_samples = static_cast<int>(integer(s, "electric_phase_samples"));
     f.probe_radius = q(s, "probe_radius");
     f.output_dir = str(s, "output_dir");
   }

@@ -155,6 +155,39 @@ void validate(const CartesianGrid &g, const std::string &what)
   require_finite(g.phi, what, "/cartesian/phi", g.n_y);
 }
 
+CartesianGrid NipPotentialGrid::image_grid(int k) const
+{
+  CartesianGrid g = bias;
+  g.phi = image.at(static_cast<size_t>(k));
+  return g;
+}
+
+void validate(const NipPotentialGrid &g, const std::string &what)
+{
+  validate(g.bias, what + " (bias solution)");
+  if (!(std::isfinite(g.image_period) && g.image_period >= 0.0))
+    throw FieldGridError(what + ": the image period must be finite and ≥ 0, found " +
+                         num(g.image_period) + " m");
+  if (g.image.empty())
+    throw FieldGridError(what + ": the image needs at least one phase sample, found none");
+  if (!(std::isfinite(g.drum_radius) && g.drum_radius >= 0.0 && std::isfinite(g.drum_center[0]) &&
+        std::isfinite(g.drum_center[1])))
+    throw FieldGridError(what + ": the drum centre and radius must be finite (radius ≥ 0), found (" +
+                         num(g.drum_center[0]) + ", " + num(g.drum_center[1]) + ") m, " +
+                         num(g.drum_radius) + " m");
+  if (g.image_period == 0.0 && g.image.size() != 1)
+    throw FieldGridError(what + ": a uniform image (period 0) has exactly one phase sample, found " +
+                         std::to_string(g.image.size()));
+  for (size_t k = 0; k < g.image.size(); ++k)
+  {
+    if (g.image[k].size() != g.bias.phi.size())
+      throw FieldGridError(what + ": image phase sample " + std::to_string(k) + " has " +
+                           std::to_string(g.image[k].size()) + " values but n_x × n_y = " +
+                           std::to_string(g.bias.phi.size()));
+    require_finite(g.image[k], what, "/cartesian/phi_image[" + std::to_string(k) + "]", g.bias.n_y);
+  }
+}
+
 // ---------------------------------------------------------------------------------------
 // Spline node data
 
@@ -530,10 +563,11 @@ void write_magnetic_grid(const std::string &path, const PolarGrid &grid,
   });
 }
 
-void write_electric_grid(const std::string &path, const CartesianGrid &grid,
+void write_electric_grid(const std::string &path, const NipPotentialGrid &nip,
                          const GridProvenance &provenance)
 {
-  validate(grid, "file " + path);
+  validate(nip, "file " + path);
+  const CartesianGrid &grid = nip.bias;
   write_atomically(path, [&](const Writer &w, hid_t file) {
     write_provenance(w, file, "electric", provenance, {grid.dx(), grid.dy()});
     Handle group(H5Gcreate2(file, "cartesian", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
@@ -545,15 +579,30 @@ void write_electric_grid(const std::string &path, const CartesianGrid &grid,
     w.double_attribute(group, "y_max", {grid.y_max});
     w.int_attribute(group, "n_x", grid.n_x);
     w.int_attribute(group, "n_y", grid.n_y);
+    w.double_attribute(group, "image_period", {nip.image_period});
+    w.int_attribute(group, "phase_samples", nip.phase_samples());
+    w.double_attribute(group, "drum_center", {nip.drum_center[0], nip.drum_center[1]});
+    w.double_attribute(group, "drum_radius", {nip.drum_radius});
     w.dataset(group, "x", linspace(grid.x_min, grid.x_max, grid.n_x, true),
               {static_cast<hsize_t>(grid.n_x)}, "m");
     w.dataset(group, "y", linspace(grid.y_min, grid.y_max, grid.n_y, true),
               {static_cast<hsize_t>(grid.n_y)}, "m");
     const std::vector<hsize_t> shape = {static_cast<hsize_t>(grid.n_x),
                                         static_cast<hsize_t>(grid.n_y)};
-    w.dataset(group, "phi", grid.phi, shape, "V");
-    // For inspection only; the reader ignores them: E = −∇Φ at the nodes.
-    const CartesianFieldInterpolator interp(grid);
+    w.dataset(group, "phi_bias", grid.phi, shape, "V");
+    std::vector<double> images;
+    images.reserve(grid.phi.size() * nip.image.size());
+    for (const auto &sample : nip.image)
+      images.insert(images.end(), sample.begin(), sample.end());
+    w.dataset(group, "phi_image", images,
+              {static_cast<hsize_t>(nip.phase_samples()), shape[0], shape[1]}, "V");
+    // For inspection only; the reader ignores them: Φ and E = −∇Φ at the nodes at phase 0
+    // (the image as the case gives it, bias on).
+    CartesianGrid total = grid;
+    for (size_t k = 0; k < total.phi.size(); ++k)
+      total.phi[k] += nip.image[0][k];
+    w.dataset(group, "phi", total.phi, shape, "V");
+    const CartesianFieldInterpolator interp(total);
     std::vector<double> E_x(grid.phi.size()), E_y(grid.phi.size());
     for (int i = 0; i < grid.n_x; ++i)
       for (int j = 0; j < grid.n_y; ++j)
@@ -775,7 +824,8 @@ GridFileInfo read_info(const Reader &r, hid_t file)
   if (info.format_version != field_grid_format_version)
     r.fail("format_version is " + std::to_string(info.format_version) + " but this magbrush (" +
            MAGBRUSH_VERSION + ") reads version " + std::to_string(field_grid_format_version) +
-           "; regenerate the field with this version (`magbrush field CASE`)");
+           " (checksummed datasets; the electric field as bias solution plus the image's phase samples); "
+           "regenerate the field with this version (`magbrush field CASE`)");
   info.kind = r.string_attribute(file, "kind");
   if (info.kind != "magnetic" && info.kind != "electric")
     r.fail("kind is '" + info.kind + "' but 'magnetic' or 'electric' was expected");
@@ -866,7 +916,7 @@ ElectricGridFile read_electric_grid(const std::string &path)
   require_kind(r, out.info, "electric");
 
   Handle group = r.open_group(file, "cartesian");
-  CartesianGrid &g = out.grid;
+  CartesianGrid &g = out.grid.bias;
   g.x_min = r.scalar_attribute(group, "x_min");
   g.x_max = r.scalar_attribute(group, "x_max");
   g.y_min = r.scalar_attribute(group, "y_min");
@@ -884,8 +934,23 @@ ElectricGridFile read_electric_grid(const std::string &path)
                linspace(g.x_min, g.x_max, g.n_x, true), "/cartesian/x", g.dx());
   r.check_axis(r.dataset(group, "cartesian", "y", {ny}, "m"),
                linspace(g.y_min, g.y_max, g.n_y, true), "/cartesian/y", g.dy());
-  g.phi = r.dataset(group, "cartesian", "phi", {nx, ny}, "V");
-  validate(g, "file " + path);
+  g.phi = r.dataset(group, "cartesian", "phi_bias", {nx, ny}, "V");
+  out.grid.image_period = r.scalar_attribute(group, "image_period");
+  const std::vector<double> centre = r.double_attribute(group, "drum_center");
+  if (centre.size() != 2)
+    r.fail("attribute /cartesian/drum_center must hold 2 values, found " + std::to_string(centre.size()));
+  out.grid.drum_center = {centre[0], centre[1]};
+  out.grid.drum_radius = r.scalar_attribute(group, "drum_radius");
+  const int K = r.int_attribute(group, "phase_samples");
+  if (K < 1)
+    r.fail("attribute /cartesian/phase_samples must be ≥ 1, found " + std::to_string(K));
+  const std::vector<double> images =
+    r.dataset(group, "cartesian", "phi_image", {static_cast<hsize_t>(K), nx, ny}, "V");
+  const size_t n = g.phi.size();
+  for (int k = 0; k < K; ++k)
+    out.grid.image.emplace_back(images.begin() + static_cast<std::ptrdiff_t>(k * n),
+                                images.begin() + static_cast<std::ptrdiff_t>((k + 1) * n));
+  validate(out.grid, "file " + path);
   return out;
 }
 

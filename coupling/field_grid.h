@@ -6,8 +6,9 @@
 //    r_min ≤ r ≤ r_max around the roller axis, θ periodic on [0, 2π)). B = curl(A_z ẑ) is
 //    taken from a C2 spline of A_z (polar_field_interpolator.h), so B is exactly
 //    divergence-free and its gradient is continuous.
-//  * Electric: the potential Φ [V] of the nip on a Cartesian window; E = −∇Φ
-//    (cartesian_field_interpolator.h).
+//  * Electric: the potential Φ [V] of the nip on a Cartesian window, as the bias solution
+//    plus the latent image's solution at K phases of its travel with the drum surface
+//    (NipPotentialGrid); E = −∇Φ (nip_potential_field.h).
 //
 // The file layout is documented in docs/field_grid_format.md. Files are written atomically
 // (a temporary file, then a rename), and the reader checks everything it relies on (format name and
@@ -21,6 +22,7 @@
 #include "coupling/case_hash.h"
 #include "coupling/case_model.h"
 
+#include <array>
 #include <functional>
 #include <limits>
 #include <stdexcept>
@@ -88,6 +90,30 @@ struct CartesianGrid
   size_t memory_bytes() const { return phi.size() * sizeof(double); }
 };
 
+// The nip potential the DEM needs (the electric grid, format version 2). The problem is linear
+// and the latent image moves with the drum surface while the sleeve and the drum stay where they
+// are, so at any moment
+//   Φ(x, y; u) = Φ_bias(x, y) + Φ_image(x, y; u),
+// Φ_bias: the sleeve at its bias, no image; Φ_image(·; u): the sleeve grounded and the image
+// carried along the drum surface by the arc length u (its surface value at arc length s from the
+// nip point is the value the case gives at s − u; field_solver/nip_electrostatics.h
+// latent_image_value). Φ_image is periodic in u with the image period P and stored at the K
+// phases u_k = k P / K, k = 0 .. K − 1; a uniform image (P = 0) has one sample. The drum's
+// centre and radius let a reader carry a sample along the surface (nip_potential_field.h).
+struct NipPotentialGrid
+{
+  CartesianGrid bias;                     // the window, and Φ_bias [V] on it
+  double image_period = 0.0;              // P [m] along the drum surface; 0: the image is uniform
+  std::array<double, 2> drum_center{{0.0, 0.0}}; // [m], in the window's frame
+  double drum_radius = 0.0;               // the drum (photoconductor) surface radius [m]
+  std::vector<std::vector<double>> image; // K arrays laid out like bias.phi [V]
+
+  int phase_samples() const { return static_cast<int>(image.size()); }
+  // Sample k as a grid of its own (the window of `bias`).
+  CartesianGrid image_grid(int k) const;
+  size_t memory_bytes() const { return bias.memory_bytes() * (1 + image.size()); }
+};
+
 // Sample a field given as a function of (x, y) [m] at the grid nodes. The field solver passes
 // its finite-element solution (evaluated in a batch and wrapped in a lookup) or, in tests,
 // an exact solution.
@@ -111,6 +137,7 @@ PolarGridLayout polar_grid_layout(const Case &c);
 // non-finite values). The writer and the reader both call these.
 void validate(const PolarGrid &g, const std::string &what);
 void validate(const CartesianGrid &g, const std::string &what);
+void validate(const NipPotentialGrid &g, const std::string &what);
 
 // ---------------------------------------------------------------------------------------
 // The C2 interpolant of the node values, shared by both interpolators.
@@ -220,23 +247,25 @@ struct MagneticGridFile
 struct ElectricGridFile
 {
   GridFileInfo info;
-  CartesianGrid grid;
+  NipPotentialGrid grid;
 };
 
 // ---------------------------------------------------------------------------------------
 // File format
 
 inline constexpr const char *field_grid_format_name = "magbrush-field-grid";
-// Version 2: every dataset carries HDF5's Fletcher-32 checksum, the metadata the 1.8 object
-// headers' checksums; a version 1 file is refused ("regenerate").
-inline constexpr int field_grid_format_version = 2;
+// Version 3: every dataset carries HDF5's Fletcher-32 checksum, the metadata the 1.8 object
+// headers' checksums, and the electric field is stored as the bias solution plus the image's
+// phase samples (NipPotentialGrid). Files of an older version are refused ("regenerate"); the
+// field stage regenerates them by itself.
+inline constexpr int field_grid_format_version = 3;
 
 // Write atomically: a temporary file next to `path` first (common/atomic_file.h), renamed onto
 // `path` only when complete. On failure (unwritable directory, invalid grid, ...) throws
 // FieldGridError and leaves no file behind; an existing `path` is untouched.
 void write_magnetic_grid(const std::string &path, const PolarGrid &grid,
                          const GridProvenance &provenance);
-void write_electric_grid(const std::string &path, const CartesianGrid &grid,
+void write_electric_grid(const std::string &path, const NipPotentialGrid &grid,
                          const GridProvenance &provenance);
 
 // Read and check everything (see docs/field_grid_format.md); throws FieldGridError.

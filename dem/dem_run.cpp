@@ -139,8 +139,6 @@ void DemRun::log_setup() const
       log_ << " " << m->name() << (&m == &measurements_.back() ? "" : ",");
     log_ << "\n";
   }
-  if (case_.electric.enabled)
-    log_ << "  note: electrostatic terms (Coulomb, qE) are not part of this engine build yet\n";
   log_.flush();
 }
 

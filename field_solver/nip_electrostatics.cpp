@@ -22,20 +22,33 @@ double latent_image_value(const LatentImage &image, double s)
 {
   if (image.period <= 0.0)
     return image.dark_value;
-  const double u = s / image.period + 0.5 * image.duty;
-  const double frac = u - std::floor(u);
-  return frac < image.duty ? image.light_value : image.dark_value;
+  // s' ∈ [−P/2, P/2): the place within the period; e: the distance inside the exposed strip
+  // from its nearer edge (negative outside it).
+  if (image.duty >= 1.0)
+    return image.light_value;
+  if (image.duty <= 0.0)
+    return image.dark_value;
+  const double P = image.period;
+  const double v = s / P + 0.5;
+  const double s_local = (v - std::floor(v) - 0.5) * P;
+  const double e = 0.5 * image.duty * P - std::abs(s_local);
+  const double w = image.edge_width;
+  if (w <= 0.0)
+    return e > 0.0 ? image.light_value : image.dark_value;
+  const double S = e >= 0.5 * w ? 1.0 : e <= -0.5 * w ? 0.0 : 0.5 * (1.0 + std::sin(pi * e / w));
+  return image.dark_value + (image.light_value - image.dark_value) * S;
 }
 
 NipElectrostatics::NipElectrostatics(MPI_Comm communicator_in, const NipLayout &layout,
                                      double layer_eps_r_in, double bias_in,
                                      const LatentImage &image_in,
-                                     const NipDiscretisation &disc)
+                                     const NipDiscretisation &disc, double image_shift_in)
   : communicator(communicator_in)
   , nip(layout)
   , layer_eps_r(layer_eps_r_in)
   , bias(bias_in)
   , image(image_in)
+  , image_shift(image_shift_in)
   , discretisation(disc)
   , triangulation(communicator, dealii::Triangulation<2>::none, false,
                   dealii::parallel::shared::Triangulation<2>::partition_metis)
@@ -56,6 +69,11 @@ double NipElectrostatics::arc_length_from_nip(const Point<2> &x) const
   return nip.drum_radius * wrap(phi - (nip.drum_angle + pi));
 }
 
+double NipElectrostatics::image_at(const Point<2> &x) const
+{
+  return latent_image_value(image, arc_length_from_nip(x) - image_shift);
+}
+
 PotentialProblemDescription NipElectrostatics::describe() const
 {
   PotentialProblemDescription d;
@@ -69,16 +87,12 @@ PotentialProblemDescription NipElectrostatics::describe() const
   const double V = bias;
   d.dirichlet[nip_boundary::sleeve] = [V](const Point<2> &) { return V; };
   if (image.kind == LatentImage::Kind::surface_potential)
-    d.dirichlet[nip_boundary::drum] = [this](const Point<2> &x) {
-      return latent_image_value(image, arc_length_from_nip(x));
-    };
+    d.dirichlet[nip_boundary::drum] = [this](const Point<2> &x) { return image_at(x); };
   else
     d.dirichlet[nip_boundary::drum] = [](const Point<2> &) { return 0.0; };
   if (image.kind == LatentImage::Kind::surface_charge)
     d.surface_charges.push_back({nip_region::photoconductor, nip_region::air,
-                                 [this](const Point<2> &x) {
-                                   return latent_image_value(image, arc_length_from_nip(x));
-                                 }});
+                                 [this](const Point<2> &x) { return image_at(x); }});
   return d;
 }
 
@@ -113,8 +127,7 @@ std::vector<double> NipElectrostatics::potential(const std::vector<Vec2> &points
       values[k] = bias;
     else if (rd < substrate)
       values[k] = image.kind == LatentImage::Kind::surface_potential
-                    ? latent_image_value(image, arc_length_from_nip(
-                                                  Point<2>(points[k][0], points[k][1])))
+                    ? image_at(Point<2>(points[k][0], points[k][1]))
                     : 0.0;
     else
     {
@@ -143,12 +156,88 @@ std::vector<double> NipElectrostatics::potential(const std::vector<Vec2> &points
       values[index[i]] = bias;
     else if (dd < band)
       values[index[i]] = image.kind == LatentImage::Kind::surface_potential
-                           ? latent_image_value(image, arc_length_from_nip(Point<2>(x[0], x[1])))
+                           ? image_at(Point<2>(x[0], x[1]))
                            : 0.0;
     else
       throw std::runtime_error("nip field: the point (" + std::to_string(x[0]) + ", " +
                                std::to_string(x[1]) + ") m lies outside the solved region; "
                                "the electric grid window must stay near the nip");
+  }
+  return values;
+}
+
+std::vector<double> NipElectrostatics::air_potential(const std::vector<Vec2> &points) const
+{
+  // Every point below a surface is mapped to its nearest surface point (radially: both
+  // surfaces are circles), moved a hair into the air so that it lies in an air cell of the
+  // curved mapping; Φ and ∇Φ there give the Taylor extension.
+  const double gap = nip.bipolar.center_left + nip.bipolar.center_right - nip.sleeve_radius -
+                     nip.drum_radius;
+  const double hair = 1e-6 * gap;
+  std::vector<double> values(points.size(), 0.0);
+  std::vector<Vec2> air;
+  std::vector<Point<2>> anchor;
+  std::vector<std::size_t> air_index, anchor_index;
+  for (std::size_t k = 0; k < points.size(); ++k)
+  {
+    const Vec2 &x = points[k];
+    const double rs = std::hypot(x[0], x[1]);
+    const double dx = x[0] - nip.drum_center[0], dy = x[1] - nip.drum_center[1];
+    const double rd = std::hypot(dx, dy);
+    if (rs < nip.sleeve_radius)
+    {
+      const double ux = rs > 0.0 ? x[0] / rs : 1.0, uy = rs > 0.0 ? x[1] / rs : 0.0;
+      anchor.emplace_back((nip.sleeve_radius + hair) * ux, (nip.sleeve_radius + hair) * uy);
+      anchor_index.push_back(k);
+    }
+    else if (rd < nip.drum_radius)
+    {
+      const double ux = rd > 0.0 ? dx / rd : 1.0, uy = rd > 0.0 ? dy / rd : 0.0;
+      anchor.emplace_back(nip.drum_center[0] + (nip.drum_radius + hair) * ux,
+                          nip.drum_center[1] + (nip.drum_radius + hair) * uy);
+      anchor_index.push_back(k);
+    }
+    else
+    {
+      air.push_back(x);
+      air_index.push_back(k);
+    }
+  }
+  const std::vector<double> v_air = potential(air);
+  for (std::size_t i = 0; i < air_index.size(); ++i)
+    values[air_index[i]] = v_air[i];
+  // The curved mapping approximates the circles by polynomials: an anchor a hair outside the
+  // exact circle can still lie outside the mesh. Such anchors move further into the air (at
+  // most 1 % of the gap), the others stay.
+  std::vector<double> v_anchor;
+  for (double lift = hair;; lift *= 10.0)
+  {
+    std::vector<bool> found;
+    v_anchor = solver->values_at(anchor, &found);
+    bool all = true;
+    for (std::size_t i = 0; i < anchor.size(); ++i)
+      if (!found[i])
+      {
+        all = false;
+        const Vec2 &x = points[anchor_index[i]];
+        const bool sleeve = std::hypot(x[0], x[1]) < nip.sleeve_radius;
+        const double cx = sleeve ? 0.0 : nip.drum_center[0], cy = sleeve ? 0.0 : nip.drum_center[1];
+        const double r = std::hypot(anchor[i][0] - cx, anchor[i][1] - cy);
+        const double scale = (r + 9.0 * lift) / r;
+        anchor[i] = Point<2>(cx + (anchor[i][0] - cx) * scale, cy + (anchor[i][1] - cy) * scale);
+      }
+    if (all)
+      break;
+    if (lift > 1e-2 * gap)
+      throw std::runtime_error("nip field: the surface points of the smooth extension lie "
+                               "outside the mesh even 1 % of the gap into the air");
+  }
+  const auto g_anchor = solver->gradients_at(anchor);
+  for (std::size_t i = 0; i < anchor_index.size(); ++i)
+  {
+    const Vec2 &x = points[anchor_index[i]];
+    values[anchor_index[i]] = v_anchor[i] + g_anchor[i][0] * (x[0] - anchor[i][0]) +
+                              g_anchor[i][1] * (x[1] - anchor[i][1]);
   }
   return values;
 }

@@ -31,16 +31,23 @@ struct NipDiscretisation
 };
 
 // The latent image along the drum surface as a function of the arc length s from the nip
-// point (the drum surface point nearest the sleeve): exposed ("light") where
-// frac(s/period + duty/2) < duty — an exposed strip centred on the nip — dark elsewhere;
-// uniformly dark when period = 0.
+// point (the drum surface point nearest the sleeve), s increasing counter-clockwise about the
+// drum centre: exposed ("light") where frac(s/period + duty/2) < duty — an exposed strip
+// centred on the nip — dark elsewhere; uniformly dark when period = 0. With an edge width w
+// the value changes from dark to light along a raised cosine over w centred on each edge. This is the image at
+// phase 0 (t ≤ 0 in the DEM); once the drum has turned, the value at s is the one this gives
+// at s − u, u the arc length the surface travelled (coupling/nip_potential_field.h).
 double latent_image_value(const LatentImage &image, double s);
 
 class NipElectrostatics
 {
 public:
+  // `image_shift` u [m]: the image carried along the drum surface by u (the surface value at s
+  // is latent_image_value(image, s − u)). The field is linear in (bias, image values): the
+  // field stage solves the bias alone and the image alone at its phase samples.
   NipElectrostatics(MPI_Comm communicator, const NipLayout &layout, double layer_eps_r,
-                    double bias, const LatentImage &image, const NipDiscretisation &disc);
+                    double bias, const LatentImage &image, const NipDiscretisation &disc,
+                    double image_shift = 0.0);
   ~NipElectrostatics();
 
   void run();
@@ -49,6 +56,16 @@ public:
   // substrate 0 V (conductors); all others must be in the meshed region.
   std::vector<double> potential(const std::vector<Vec2> &points) const;
   std::vector<Vec2> electric_field(const std::vector<Vec2> &points) const; // meshed region only
+
+  // Φ of the air, continued smoothly below the surfaces that bound it (collective): in the air
+  // the solution; at a point inside the sleeve, or below the drum surface (the photoconductor
+  // included), the first-order Taylor extension of the air solution from the nearest surface
+  // point x_s along the surface normal, Φ(x_s) + ∇Φ(x_s)·(x − x_s), with Φ and ∇Φ taken on the
+  // air side. The extension is C1 across the surface (value and both derivatives match), so a
+  // spline through grid nodes on both sides interpolates the air field up to the surface
+  // without the kink that the conductor's constant value (potential()) puts there. The values
+  // below the surfaces are not the potential there: nothing charged is ever inside a solid.
+  std::vector<double> air_potential(const std::vector<Vec2> &points) const;
 
   // Arc length from the nip point along the drum surface of the point x [m].
   double arc_length_from_nip(const Point<2> &x) const;
@@ -59,11 +76,13 @@ public:
 
 private:
   PotentialProblemDescription describe() const;
+  double image_at(const Point<2> &x) const; // the surface value at x (charge or potential)
 
   MPI_Comm communicator;
   NipLayout nip;
   double layer_eps_r, bias;
   LatentImage image;
+  double image_shift;
   NipDiscretisation discretisation;
   dealii::parallel::shared::Triangulation<2> triangulation;
   std::unique_ptr<PotentialProblem> solver;

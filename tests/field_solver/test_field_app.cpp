@@ -1,11 +1,13 @@
 // The production field stage end to end (bin/magbrush-field on a paper case, coarse mesh):
 // the first run stores both fields; an unchanged case is "up to date" and rewrites nothing;
 // moving a pole regenerates only the magnetic field; changing the bias only the electric one.
+#include "coupling/cartesian_field_interpolator.h"
 #include "coupling/field_grid.h"
 
 #include <gtest/gtest.h>
 #include "tests/test_temp_dir.h"
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -54,8 +56,14 @@ TEST(FieldApp, StoresFieldsAndReusesThemUntilTheirInputsChange)
   EXPECT_FALSE(m.info.provenance.case_hash.empty());
   EXPECT_LT(m.info.provenance.error_estimate, 0.05);
   const auto e = magbrush::read_electric_grid(electric);
-  // the sleeve at the bias: the window's corner nearest the roller axis is inside the sleeve
-  EXPECT_DOUBLE_EQ(e.grid.at(0, e.grid.n_y / 2), -650.0);
+  // The bias solution is the bias on the sleeve surface (10 mm radius, the drum on +x), the
+  // image is stored at field.electric_phase_samples phases of its 2 mm period.
+  const magbrush::CartesianFieldInterpolator bias(e.grid.bias);
+  EXPECT_NEAR(bias.potential({10e-3, 0.0, 0.0}), -650.0, 0.5);
+  EXPECT_NEAR(bias.potential({10e-3 * std::cos(0.1), 10e-3 * std::sin(0.1), 0.0}), -650.0, 0.5);
+  EXPECT_EQ(e.grid.phase_samples(), 16);
+  EXPECT_DOUBLE_EQ(e.grid.image_period, 2e-3);
+  EXPECT_DOUBLE_EQ(e.grid.drum_radius, 15e-3);
 
   const auto m_time = fs::last_write_time(magnetic), e_time = fs::last_write_time(electric);
   const std::string again = run_field("", rc);

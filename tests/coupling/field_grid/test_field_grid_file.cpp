@@ -40,6 +40,22 @@ CartesianGrid some_cartesian_grid()
                                [](double x, double y) { return 1e6 * x * y - 600.0 + std::exp(x * 1e3); });
 }
 
+// A nip potential: the bias grid plus K image phases (distinct values in every sample).
+NipPotentialGrid some_nip_grid(const CartesianGrid &bias, int K = 3, double period = 250e-6)
+{
+  NipPotentialGrid g;
+  g.bias = bias;
+  g.image_period = K == 1 ? 0.0 : period;
+  for (int k = 0; k < K; ++k)
+  {
+    std::vector<double> v(bias.phi.size());
+    for (size_t n = 0; n < v.size(); ++n)
+      v[n] = 37.0 * std::sin(0.7 * n + 1.3 * k + 0.2);
+    g.image.push_back(v);
+  }
+  return g;
+}
+
 GridProvenance some_provenance()
 {
   GridProvenance p;
@@ -175,16 +191,22 @@ TEST(FieldGridFile, ElectricRoundTripIsBitExactAndUnknownErrorIsNaN)
   GridProvenance p = some_provenance();
   p.error_estimate = std::nan("");
   p.mesh_sizes.clear();
-  write_electric_grid(path, g, p);
+  const NipPotentialGrid nip = some_nip_grid(g);
+  write_electric_grid(path, nip, p);
   const ElectricGridFile in = read_electric_grid(path);
   EXPECT_EQ(in.info.kind, "electric");
-  EXPECT_EQ(in.grid.x_min, g.x_min);
-  EXPECT_EQ(in.grid.x_max, g.x_max);
-  EXPECT_EQ(in.grid.y_min, g.y_min);
-  EXPECT_EQ(in.grid.y_max, g.y_max);
-  EXPECT_EQ(in.grid.n_x, g.n_x);
-  EXPECT_EQ(in.grid.n_y, g.n_y);
-  EXPECT_EQ(std::memcmp(in.grid.phi.data(), g.phi.data(), g.phi.size() * sizeof(double)), 0);
+  EXPECT_EQ(in.info.format_version, field_grid_format_version);
+  EXPECT_EQ(in.grid.bias.x_min, g.x_min);
+  EXPECT_EQ(in.grid.bias.x_max, g.x_max);
+  EXPECT_EQ(in.grid.bias.y_min, g.y_min);
+  EXPECT_EQ(in.grid.bias.y_max, g.y_max);
+  EXPECT_EQ(in.grid.bias.n_x, g.n_x);
+  EXPECT_EQ(in.grid.bias.n_y, g.n_y);
+  EXPECT_EQ(std::memcmp(in.grid.bias.phi.data(), g.phi.data(), g.phi.size() * sizeof(double)), 0);
+  EXPECT_EQ(in.grid.image_period, nip.image_period);
+  ASSERT_EQ(in.grid.phase_samples(), 3);
+  for (int k = 0; k < 3; ++k)
+    EXPECT_EQ(in.grid.image[k], nip.image[k]) << "phase sample " << k;
   EXPECT_TRUE(std::isnan(in.info.provenance.error_estimate));
   EXPECT_TRUE(in.info.provenance.mesh_sizes.empty());
   EXPECT_EQ(in.info.grid_spacing, (std::vector<double>{g.dx(), g.dy()}));
@@ -215,6 +237,26 @@ TEST(FieldGridFile, ReaderRejectsWrongFormatVersionAndKind)
   const std::string kind = error_of([&] { read_electric_grid(path); });
   EXPECT_TRUE(contains(kind, "kind is 'magnetic' but a 'electric' field grid was expected")) << kind;
   EXPECT_TRUE(contains(kind, path.string())) << kind;
+
+  // Older versions (no checksums; version 1 also one Φ without the image's phases) are
+  // refused, magnetic or electric, with the advice to regenerate.
+  for (int old_version : {1, 2})
+  {
+    write_magnetic_grid(path, some_polar_grid(), some_provenance());
+    {
+      H5File f(path);
+      set_int_attribute(f.id, "format_version", old_version);
+    }
+    const std::string old_magnetic = error_of([&] { read_magnetic_grid(path); });
+    EXPECT_TRUE(contains(old_magnetic, "regenerate")) << old_magnetic;
+    write_electric_grid(path, some_nip_grid(some_cartesian_grid()), some_provenance());
+    {
+      H5File f(path);
+      set_int_attribute(f.id, "format_version", old_version);
+    }
+    const std::string old_electric = error_of([&] { read_electric_grid(path); });
+    EXPECT_TRUE(contains(old_electric, "format_version is " + std::to_string(old_version))) << old_electric;
+  }
 }
 
 TEST(FieldGridFile, ReaderRejectsMissingDatasetAndAttribute)
@@ -294,18 +336,18 @@ TEST(FieldGridFile, ReaderRejectsNonFiniteValuesAndNonMonotoneAxes)
 {
   const fs::path path = scratch_dir() / "f.h5";
   const CartesianGrid g = some_cartesian_grid();
-  write_electric_grid(path, g, some_provenance());
+  write_electric_grid(path, some_nip_grid(g), some_provenance());
   {
     H5File f(path);
     std::vector<double> phi = g.phi;
     phi[7] = std::nan("");
-    replace_dataset(f.id, "/cartesian/phi", phi,
+    replace_dataset(f.id, "/cartesian/phi_bias", phi,
                     {static_cast<hsize_t>(g.n_x), static_cast<hsize_t>(g.n_y)}, "V");
   }
   const std::string m = error_of([&] { read_electric_grid(path); });
   EXPECT_TRUE(contains(m, "/cartesian/phi has a non-finite value (nan) at node [1][2]")) << m;
 
-  write_electric_grid(path, g, some_provenance());
+  write_electric_grid(path, some_nip_grid(g), some_provenance());
   {
     H5File f(path);
     std::vector<double> x(g.n_x);
@@ -474,7 +516,15 @@ TEST(FieldGridFile, WriterRejectsMalformedGrids)
   EXPECT_TRUE(contains(error_of([&] { write_magnetic_grid(path, g, {}); }), "0 < r_min < r_max"));
   CartesianGrid c = some_cartesian_grid();
   c.n_y = 3;
-  EXPECT_TRUE(contains(error_of([&] { write_electric_grid(path, c, {}); }), "n_y ≥ 4"));
+  EXPECT_TRUE(contains(error_of([&] { write_electric_grid(path, some_nip_grid(c), {}); }), "n_y ≥ 4"));
+  NipPotentialGrid nip = some_nip_grid(some_cartesian_grid());
+  nip.image[1].pop_back();
+  EXPECT_TRUE(contains(error_of([&] { write_electric_grid(path, nip, {}); }),
+                       "image phase sample 1 has 29 values but n_x × n_y = 30"));
+  nip = some_nip_grid(some_cartesian_grid());
+  nip.image_period = 0.0;
+  EXPECT_TRUE(contains(error_of([&] { write_electric_grid(path, nip, {}); }),
+                       "a uniform image (period 0) has exactly one phase sample, found 3"));
   EXPECT_FALSE(fs::exists(path));
 }
 
@@ -546,7 +596,10 @@ TEST(FieldGridFile, InspectionDatasetsHoldTheFieldAtTheNodes)
   // Φ = x y + x²: a quadratic, reproduced exactly by the not-a-knot spline; E = −(y + 2x, x).
   const CartesianGrid c = sample_cartesian_grid(-1e-3, 1e-3, 9, 0.0, 5e-4, 6,
                                                 [](double x, double y) { return 1e6 * (x * y + x * x); });
-  write_electric_grid(dir / "e.h5", c, {});
+  NipPotentialGrid nip = some_nip_grid(c, 1);
+  for (auto &v : nip.image[0])
+    v = 0.0;
+  write_electric_grid(dir / "e.h5", nip, {});
   std::string ux, uy;
   const auto E_x = read_dataset(dir / "e.h5", "/cartesian/E_x", ux);
   const auto E_y = read_dataset(dir / "e.h5", "/cartesian/E_y", uy);

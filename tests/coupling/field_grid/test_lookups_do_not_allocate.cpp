@@ -2,6 +2,7 @@
 // from many threads): counted by replacing the global operator new in this test program.
 #include "coupling/applied_magnetic_field.h"
 #include "coupling/cartesian_field_interpolator.h"
+#include "coupling/nip_potential_field.h"
 #include "tests/coupling/field_grid/exact_multipole.h"
 #include "coupling/polar_field_interpolator.h"
 
@@ -34,6 +35,22 @@ TEST(FieldLookups, DoNotAllocate)
       12.5e-3, 16e-3, 36, 720, [&](double x, double y) { return exact.A(x, y); }));
   const CartesianFieldInterpolator electric(
       sample_cartesian_grid(-1e-3, 1e-3, 21, 0.0, 4e-4, 9, [](double x, double y) { return x * y; }));
+  // The nip field at a moving image phase: weights filled per step, lookups per particle.
+  NipPotentialGrid nip;
+  nip.bias = sample_cartesian_grid(-1e-3, 1e-3, 21, 0.0, 4e-4, 9, [](double x, double y) { return x * y; });
+  nip.image_period = 0.5e-3;
+  nip.drum_center = {0.0, 15e-3};
+  nip.drum_radius = 15e-3;
+  for (int k = 0; k < 4; ++k)
+    nip.image.push_back(sample_cartesian_grid(-1e-3, 1e-3, 21, 0.0, 4e-4, 9, [k](double x, double y) {
+                          return std::cos(1e4 * x + k) * (1.0 - 1e3 * y);
+                        }).phi);
+  std::vector<NipPotentialField> nip_fields;
+  for (const auto phase : {NipPotentialField::PhaseInterpolation::linear,
+                           NipPotentialField::PhaseInterpolation::trigonometric,
+                           NipPotentialField::PhaseInterpolation::co_moving})
+    nip_fields.emplace_back(nip, phase);
+  auto weights = nip_fields[0].make_phase_weights();
   const auto roller = AppliedMagneticField::roller(polar, 1e-3);
   const auto uniform = AppliedMagneticField::uniform({0, 0, 1}, 0.13, 1e-3);
   const auto points = magbrush::testing::sample_annulus(12.5e-3, 20e-3, 1000); // grid and tail
@@ -53,6 +70,12 @@ TEST(FieldLookups, DoNotAllocate)
     sum += B[2];
     electric.evaluate({p[0] * 0.1, p[1] * 0.01, 0.0}, E);
     sum += E[0];
+    for (const auto &f : nip_fields)
+    {
+      f.phase_weights(p[0] * 0.03, weights);
+      f.evaluate({p[0] * 0.1, p[1] * 0.01, 0.0}, weights, E);
+      sum += E[1];
+    }
   }
   EXPECT_EQ(allocations.load() - before, 0);
   EXPECT_TRUE(std::isfinite(sum));

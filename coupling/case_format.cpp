@@ -259,6 +259,7 @@ std::vector<ResolvedEntry> resolved_entries(const Case &c)
   e.q("dem.duration", "dem.duration", d.duration);
   e.q("dem.output_interval", "dem.output_interval", d.output_interval);
   e.q("dem.checkpoint_interval", "dem.checkpoint_interval", d.checkpoint_interval);
+  e.q("dem.checkpoint_wall_interval", "dem.checkpoint_wall_interval", d.checkpoint_wall_interval);
   e.q("dem.periodic_length", "dem.periodic_length", d.periodic_length);
   e.q("dem.periodic_length_x", "dem.periodic_length_x", d.periodic_length_x);
   e.q("dem.periodic_length_y", "dem.periodic_length_y", d.periodic_length_y);
@@ -284,6 +285,18 @@ std::vector<ResolvedEntry> resolved_entries(const Case &c)
   e.q("dem.adhesion_range_fraction", "dem.adhesion_range_fraction", d.adhesion_range_fraction);
   e.q("dem.toner_stiffness_factor", "dem.toner_stiffness_factor", d.toner_stiffness_factor);
 
+  const FlowSettings &flow = c.flow;
+  e.s("inflow.population", "inflow.population", flow.inflow_population);
+  e.q("inflow.areal_mass", "inflow.areal_mass", flow.inflow_areal_mass);
+  e.q("inflow.angle", "inflow.angle", flow.inflow_angle);
+  e.q("inflow.layer_height", "inflow.layer_height", flow.inflow_layer_height);
+  e.q("inflow.interval", "inflow.interval", flow.interval);
+  e.q("outflow.angle", "outflow.angle", flow.outflow_angle);
+  e.q("outflow.width", "outflow.width", flow.outflow_width);
+  e.q("outflow.outer_radius", "outflow.outer_radius", flow.outflow_radius);
+  e.q("flow_report.sample_interval", "flow_report.sample_interval", flow.sample_interval);
+  e.q("flow_report.flux_angle", "flow_report.flux_angle", flow.flux_angle);
+  e.q("flow_report.density_window", "flow_report.density_window", flow.density_window);
   e.q("development.measure_from", "development.measure_from", c.development.measure_from);
   e.q("development.measure_to", "development.measure_to", c.development.measure_to);
   e.q("development.sample_interval", "development.sample_interval", c.development.sample_interval);

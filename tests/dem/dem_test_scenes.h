@@ -5,7 +5,12 @@
 
 #include "coupling/case_model.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <memory>
+#include <random>
+#include <vector>
 #include <string>
 
 namespace magbrush::dem::testing {
@@ -78,6 +83,68 @@ inline HertzImpact hertz_impact(double m_star, double R_star, double E_star, dou
   const double integral = 0.4 * std::tgamma(0.4) * std::tgamma(0.5) / std::tgamma(0.9);
   h.duration = 2.0 * integral * h.delta_max / v;
   return h;
+}
+
+// Frictional, rolling-resistant, damped spheres (100 µm ± 10 %) inserted in a layer `height`
+// thick over a rigid stage, in a periodic x–y box of side `side`, under gravity: with random
+// initial velocities (give_random_velocities) every code path — contacts, wall contacts,
+// list rebuilds, re-sorting — is exercised within a few hundred steps.
+inline Case falling_spheres_case(long count, double side, double height, unsigned long seed)
+{
+  Material m = elastic_material("carrier", 1e8, 0.35, 2200);
+  m.friction = 0.45;
+  m.polygon_angles = 12;
+  m.damping = 0.6;
+  Case c = single_species_case(m);
+  c.populations[0].diameter_mean = 100e-6;
+  c.populations[0].diameter_std = 10e-6;
+  c.populations[0].count = count;
+  c.populations[0].insert_box = std::array<Vec3, 2>{Vec3{0, 0, 0}, Vec3{side, side, height}};
+  c.dem.periodic_length_x = c.dem.periodic_length_y = side;
+  c.dem.gravity = {0, 0, -9.81};
+  c.dem.seed = seed;
+  add_rigid_plane(c, {0, 0, 0}, {0, 0, 1}, 0.3, 0.35);
+  c.materials.back().youngs_modulus = 5e10;
+  return c;
+}
+
+// Random velocities in [−1, 1]³ m/s from a seeded stream.
+inline void give_random_velocities(ParticleState &p, unsigned long seed)
+{
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (std::size_t i = 0; i < p.size(); ++i)
+  {
+    p.vx[i] = u(rng);
+    p.vy[i] = u(rng);
+    p.vz[i] = u(rng);
+  }
+}
+
+// The id and every dynamic quantity of each particle, in ascending id: id, x, y, z, v, ω,
+// force, torque (state_values_per_particle numbers each, the force at state_force_offset).
+constexpr std::size_t state_values_per_particle = 16;
+constexpr std::size_t state_force_offset = 10;
+inline std::vector<double> state_by_id(const DemSystem &s)
+{
+  const auto &p = s.particles();
+  const auto &f = s.forces();
+  std::vector<std::size_t> order(p.size());
+  for (std::size_t i = 0; i < p.size(); ++i)
+    order[i] = i;
+  std::sort(order.begin(), order.end(), [&p](std::size_t a, std::size_t b) { return p.id[a] < p.id[b]; });
+  std::vector<double> out;
+  out.reserve(p.size() * state_values_per_particle);
+  for (std::size_t i : order)
+    for (double v : {static_cast<double>(p.id[i]), p.x[i], p.y[i], p.z[i], p.vx[i], p.vy[i], p.vz[i], p.wx[i], p.wy[i],
+                     p.wz[i], f.fx[i], f.fy[i], f.fz[i], f.tx[i], f.ty[i], f.tz[i]})
+      out.push_back(v);
+  return out;
+}
+
+inline bool bit_identical(const std::vector<double> &a, const std::vector<double> &b)
+{
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
 }
 
 } // namespace magbrush::dem::testing

@@ -234,18 +234,6 @@ std::unique_ptr<DemSystem> make_adhesive_packing(const Case &c)
   return sys;
 }
 
-std::vector<double> state_by_id(const DemSystem &sys)
-{
-  const auto &p = sys.particles();
-  std::vector<double> out(p.size() * 6);
-  for (std::size_t i = 0; i < p.size(); ++i)
-  {
-    const double v[6] = {p.x[i], p.y[i], p.z[i], sys.forces().fx[i], sys.forces().fy[i], sys.forces().fz[i]};
-    std::memcpy(&out[static_cast<std::size_t>(p.id[i]) * 6], v, sizeof v);
-  }
-  return out;
-}
-
 std::vector<double> run_by_id(const Case &c, int threads, int steps, long &contacts)
 {
   omp_set_num_threads(threads);
@@ -286,7 +274,7 @@ TEST(Adhesion, OneAndTwoThreadsGiveIdenticalBits)
   const auto a = run_by_id(c, 1, 1500, contacts[0]);
   const auto b = run_by_id(c, 2, 1500, contacts[1]);
   omp_set_num_threads(2);
-  std::printf("adhesive packing: %zu particles, %ld contacts after 1500 steps\n", a.size() / 6, contacts[0]);
+  std::printf("adhesive packing: %zu particles, %ld contacts after 1500 steps\n", a.size() / state_values_per_particle, contacts[0]);
   EXPECT_GT(contacts[0], 20);
   ASSERT_EQ(a.size(), b.size());
   EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(double)), 0);

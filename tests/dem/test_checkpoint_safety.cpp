@@ -29,23 +29,12 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// 300 frictional spheres falling onto a stage in a periodic box, with random velocities:
-// contacts, wall contacts, list rebuilds and re-sorting within a few hundred steps.
+// 300 falling spheres (dem_test_scenes.h): contacts, wall contacts, list rebuilds and
+// re-sorting within a few hundred steps.
 Case falling_case()
 {
-  Material m = elastic_material("carrier", 1e8, 0.35, 2200);
-  m.friction = 0.45;
-  m.damping = 0.6;
-  Case c = single_species_case(m);
-  c.populations[0].diameter_mean = 100e-6;
-  c.populations[0].diameter_std = 10e-6;
-  c.populations[0].count = 300;
-  c.populations[0].insert_box = std::array<Vec3, 2>{Vec3{0, 0, 0}, Vec3{1.5e-3, 1.5e-3, 0.4e-3}};
-  c.dem.periodic_length_x = c.dem.periodic_length_y = 1.5e-3;
-  c.dem.gravity = {0, 0, -9.81};
-  c.dem.seed = 5;
-  add_rigid_plane(c, {0, 0, 0}, {0, 0, 1}, 0.3, 0.35);
-  c.materials.back().youngs_modulus = 5e10;
+  Case c = falling_spheres_case(300, 1.5e-3, 0.4e-3, 5);
+  c.materials[0].polygon_angles = Material{}.polygon_angles; // smooth spheres: no rolling resistance
   return c;
 }
 
@@ -54,31 +43,9 @@ std::unique_ptr<DemSystem> make_falling(const Case &c)
   auto sys = std::make_unique<DemSystem>(c);
   sys->add_force_term(std::make_unique<Gravity>(c.dem.gravity));
   sys->insert_particles();
-  std::mt19937_64 rng(11);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  auto &p = sys->particles();
-  for (std::size_t i = 0; i < p.size(); ++i)
-  {
-    p.vx[i] = u(rng);
-    p.vy[i] = u(rng);
-    p.vz[i] = u(rng);
-  }
+  give_random_velocities(sys->particles(), 11);
   sys->initialize();
   return sys;
-}
-
-std::vector<double> state_by_id(const DemSystem &s)
-{
-  const auto &p = s.particles();
-  const auto &f = s.forces();
-  std::vector<double> out(p.size() * 15);
-  for (std::size_t i = 0; i < p.size(); ++i)
-  {
-    const double v[15] = {p.x[i], p.y[i], p.z[i], p.vx[i], p.vy[i], p.vz[i], p.wx[i], p.wy[i],
-                          p.wz[i], f.fx[i], f.fy[i], f.fz[i], f.tx[i], f.ty[i], f.tz[i]};
-    std::memcpy(&out[static_cast<std::size_t>(p.id[i]) * 15], v, sizeof v);
-  }
-  return out;
 }
 
 std::string read_bytes(const fs::path &p)

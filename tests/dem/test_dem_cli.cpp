@@ -273,6 +273,7 @@ TEST_F(DemCli, KilledRunLeavesGoodCheckpointsByDefault)
   EXPECT_EQ(resumed.code, 0) << resumed.output;
   EXPECT_NE(resumed.output.find("restarted from"), std::string::npos) << resumed.output;
   EXPECT_NE(resumed.output.find("done:"), std::string::npos) << resumed.output;
+}
 
 TEST_F(DemCli, WritesVtuSnapshotsWhenAskedAndNoXdmfWhenNot)
 {

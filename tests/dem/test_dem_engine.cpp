@@ -28,66 +28,19 @@ using namespace magbrush::dem::testing;
 
 namespace {
 
-// ~1500 frictional, rolling-resistant, damped spheres (100 µm ± 10 %) in a periodic x–y box
-// on a stage, falling under gravity with random initial velocities: every code path
-// (contacts, walls, rebuilds, sorting) is exercised within a few hundred steps.
-Case packing_case()
-{
-  Material m = elastic_material("carrier", 1e8, 0.35, 2200);
-  m.friction = 0.45;
-  m.polygon_angles = 12;
-  m.damping = 0.6;
-  Case c = single_species_case(m);
-  c.populations[0].diameter_mean = 100e-6;
-  c.populations[0].diameter_std = 10e-6;
-  c.populations[0].count = 1500;
-  c.populations[0].insert_box = std::array<Vec3, 2>{Vec3{0, 0, 0}, Vec3{3e-3, 3e-3, 0.3e-3}};
-  c.dem.periodic_length_x = c.dem.periodic_length_y = 3e-3;
-  c.dem.gravity = {0, 0, -9.81};
-  c.dem.seed = 42;
-  add_rigid_plane(c, {0, 0, 0}, {0, 0, 1}, 0.3, 0.35);
-  c.materials.back().youngs_modulus = 5e10;
-  return c;
-}
+// ~1500 falling spheres (dem_test_scenes.h): every code path within a few hundred steps.
+Case packing_case() { return falling_spheres_case(1500, 3e-3, 0.3e-3, 42); }
 
 std::unique_ptr<DemSystem> make_packing(const Case &c)
 {
   auto sys = std::make_unique<DemSystem>(c);
   sys->add_force_term(std::make_unique<Gravity>(c.dem.gravity));
   sys->insert_particles();
-  std::mt19937_64 rng(3);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  auto &p = sys->particles();
-  for (std::size_t i = 0; i < p.size(); ++i)
-  {
-    p.vx[i] = u(rng);
-    p.vy[i] = u(rng);
-    p.vz[i] = u(rng);
-  }
+  give_random_velocities(sys->particles(), 3);
   sys->initialize();
   return sys;
 }
 
-// Every dynamic array, in id order, as raw bytes.
-std::vector<double> state_by_id(const DemSystem &s)
-{
-  const auto &p = s.particles();
-  const auto &f = s.forces();
-  std::vector<double> out(p.size() * 15);
-  for (std::size_t i = 0; i < p.size(); ++i)
-  {
-    double *o = &out[static_cast<std::size_t>(p.id[i]) * 15];
-    const double v[15] = {p.x[i], p.y[i], p.z[i], p.vx[i], p.vy[i], p.vz[i], p.wx[i], p.wy[i],
-                          p.wz[i], f.fx[i], f.fy[i], f.fz[i], f.tx[i], f.ty[i], f.tz[i]};
-    std::memcpy(o, v, sizeof v);
-  }
-  return out;
-}
-
-bool bit_identical(const std::vector<double> &a, const std::vector<double> &b)
-{
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
-}
 
 } // namespace
 
@@ -239,8 +192,8 @@ TEST(DemEngine, ForcesAreContinuousAcrossForcedRebuilds)
   }
   const auto sa = state_by_id(*a), sb = state_by_id(*b);
   double worst = 0, scale = 0;
-  for (std::size_t i = 0; i < sa.size(); i += 15)
-    for (int k = 9; k < 12; ++k) // forces
+  for (std::size_t i = 0; i < sa.size(); i += state_values_per_particle)
+    for (std::size_t k = state_force_offset; k < state_force_offset + 3; ++k) // forces
     {
       worst = std::max(worst, std::abs(sa[i + k] - sb[i + k]));
       scale = std::max(scale, std::abs(sa[i + k]));

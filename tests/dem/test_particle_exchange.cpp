@@ -27,25 +27,8 @@ using namespace magbrush::dem::testing;
 
 namespace {
 
-// ~1200 frictional spheres (100 µm ± 10 %) falling on a stage in a periodic x–y box.
-Case packing_case()
-{
-  Material m = elastic_material("carrier", 1e8, 0.35, 2200);
-  m.friction = 0.45;
-  m.polygon_angles = 12;
-  m.damping = 0.6;
-  Case c = single_species_case(m);
-  c.populations[0].diameter_mean = 100e-6;
-  c.populations[0].diameter_std = 10e-6;
-  c.populations[0].count = 1200;
-  c.populations[0].insert_box = std::array<Vec3, 2>{Vec3{0, 0, 0}, Vec3{3e-3, 3e-3, 0.3e-3}};
-  c.dem.periodic_length_x = c.dem.periodic_length_y = 3e-3;
-  c.dem.gravity = {0, 0, -9.81};
-  c.dem.seed = 42;
-  add_rigid_plane(c, {0, 0, 0}, {0, 0, 1}, 0.3, 0.35);
-  c.materials.back().youngs_modulus = 5e10;
-  return c;
-}
+// ~1200 falling spheres (dem_test_scenes.h).
+Case packing_case() { return falling_spheres_case(1200, 3e-3, 0.3e-3, 42); }
 
 // A drain and a rain: every `every` steps the particles low in one corner (x < 0.6 mm,
 // z < 0.15 mm) leave, and a few new ones (a seeded random stream) appear high above the
@@ -116,39 +99,9 @@ std::unique_ptr<DemSystem> make_packing(const Case &c, long exchange_every)
   if (exchange_every > 0)
     sys->set_particle_exchange(std::make_unique<DrainAndRain>(exchange_every));
   sys->insert_particles();
-  std::mt19937_64 rng(3); // random initial velocities: contacts form within a few hundred steps
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  auto &p = sys->particles();
-  for (std::size_t i = 0; i < p.size(); ++i)
-  {
-    p.vx[i] = u(rng);
-    p.vy[i] = u(rng);
-    p.vz[i] = u(rng);
-  }
+  give_random_velocities(sys->particles(), 3); // contacts form within a few hundred steps
   sys->initialize();
   return sys;
-}
-
-// Every dynamic array and the id, in ascending id, as raw bytes.
-std::vector<double> state_by_id(const DemSystem &s)
-{
-  const auto &p = s.particles();
-  const auto &f = s.forces();
-  std::vector<std::size_t> order(p.size());
-  for (std::size_t i = 0; i < p.size(); ++i)
-    order[i] = i;
-  std::sort(order.begin(), order.end(), [&p](std::size_t a, std::size_t b) { return p.id[a] < p.id[b]; });
-  std::vector<double> out;
-  for (std::size_t i : order)
-    for (double v : {static_cast<double>(p.id[i]), p.x[i], p.y[i], p.z[i], p.vx[i], p.vy[i], p.vz[i], p.wx[i], p.wy[i],
-                     p.wz[i], f.fx[i], f.fy[i], f.fz[i], f.tx[i], f.ty[i], f.tz[i]})
-      out.push_back(v);
-  return out;
-}
-
-bool bit_identical(const std::vector<double> &a, const std::vector<double> &b)
-{
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
 }
 
 // The touching pairs' ξ by (smaller id, larger id), oriented from the smaller id.

@@ -110,27 +110,6 @@ void run_sampled(DemSystem &sys, FlowReport &report, double end)
   }
 }
 
-std::vector<double> state_by_id(const DemSystem &s)
-{
-  const auto &p = s.particles();
-  const auto &f = s.forces();
-  std::vector<std::size_t> order(p.size());
-  for (std::size_t i = 0; i < p.size(); ++i)
-    order[i] = i;
-  std::sort(order.begin(), order.end(), [&p](std::size_t a, std::size_t b) { return p.id[a] < p.id[b]; });
-  std::vector<double> out;
-  for (std::size_t i : order)
-    for (double v : {static_cast<double>(p.id[i]), p.x[i], p.y[i], p.z[i], p.vx[i], p.vy[i], p.vz[i], p.wx[i], p.wy[i],
-                     p.wz[i], p.radius[i], f.fx[i], f.fy[i], f.fz[i], f.tx[i], f.ty[i], f.tz[i]})
-      out.push_back(v);
-  return out;
-}
-
-bool bit_identical(const std::vector<double> &a, const std::vector<double> &b)
-{
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
-}
-
 struct MeanAndError
 {
   double mean = 0.0, error = 0.0; // the standard error of the mean over the blocks

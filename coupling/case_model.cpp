@@ -23,6 +23,14 @@ Vec2 Drum::center(double sleeve_radius) const
   return {d * std::cos(angle), d * std::sin(angle)};
 }
 
+bool Case::has_charged_population() const
+{
+  for (const auto &p : populations)
+    if (p.charge_to_mass != 0.0)
+      return true;
+  return false;
+}
+
 const Material &Case::material(const std::string &name) const
 {
   for (const auto &m : materials)

@@ -348,6 +348,8 @@ struct Case
   double measured_flux_angle_origin = 0.0; // [rad] roller angle = scan angle + this (the encoder offset)
 
   const Material &material(const std::string &name) const; // throws if absent
+  // Some population is charged (a non-zero mean q/m): the electric force terms are needed.
+  bool has_charged_population() const;
 };
 
 } // namespace magbrush

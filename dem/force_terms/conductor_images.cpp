@@ -62,9 +62,8 @@ std::string images_not_needed_because(const Case &c)
     return "electric.conductor_images is false (Kweon: the field is unchanged by the toner)";
   if (!c.sleeve)
     return "the scene has no sleeve or drum";
-  for (const auto &p : c.populations)
-    if (p.charge_to_mass != 0.0)
-      return "";
+  if (c.has_charged_population())
+    return "";
   return "no population is charged";
 }
 

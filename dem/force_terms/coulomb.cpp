@@ -1,6 +1,7 @@
 #include "dem/force_terms/coulomb.h"
 
 #include "dem/checkpoint_file.h"
+#include "dem/periodic_unwrap.h"
 #include "dem/dem_system.h"
 #include "dem/force_terms/force_term_registry.h"
 
@@ -70,24 +71,11 @@ void CoulombTerm::select(const dem::ParticleState &state)
 
 void CoulombTerm::gather(const dem::ParticleState &state)
 {
-  // Unwrapped along periodic axes: of the engine position's images, the one nearest to the
-  // previous position (a particle moves far less than half a period per step). A changed
-  // charge invalidates the held far field.
+  // Unwrapped along periodic axes (dem/periodic_unwrap.h). A changed charge invalidates the
+  // held far field.
   const std::size_t n = index_.size();
-  const std::vector<double> *engine[3] = {&state.x, &state.y, &state.z};
-  std::vector<double> *mine[3] = {&x_, &y_, &z_};
-  for (int d = 0; d < 3; ++d)
-  {
-    const double L = box_[d];
-    const double *from = engine[d]->data();
-    double *to = mine[d]->data();
-    for (std::size_t k = 0; k < n; ++k)
-    {
-      const double raw = from[index_[k]];
-      const double jump = to[k] - raw;
-      to[k] = (L > 0.0 && std::abs(jump) > 0.5 * L) ? raw + L * std::round(jump / L) : raw;
-    }
-  }
+  std::vector<double> *const mine[3] = {&x_, &y_, &z_};
+  dem::follow_unwrapped(state, index_, box_, mine);
   for (std::size_t k = 0; k < n; ++k)
     if (state.charge[index_[k]] != q_[k])
     {
@@ -202,9 +190,8 @@ std::string coulomb_not_needed_because(const Case &c)
 {
   if (!c.electric.coulomb)
     return "electric.coulomb is false";
-  for (const auto &p : c.populations)
-    if (p.charge_to_mass != 0.0)
-      return "";
+  if (c.has_charged_population())
+    return "";
   return "no population is charged";
 }
 

@@ -74,9 +74,8 @@ std::string electric_field_not_needed_because(const Case &c)
 {
   if (!c.electric.enabled)
     return "the case has no enabled electric section";
-  for (const auto &p : c.populations)
-    if (p.charge_to_mass != 0.0)
-      return "";
+  if (c.has_charged_population())
+    return "";
   return "no population is charged";
 }
 

@@ -1,5 +1,7 @@
 #include "dem/force_terms/magnetic_force_term.h"
 
+#include "dem/periodic_unwrap.h"
+
 #include "dem/checkpoint_file.h"
 #include "dem/dem_system.h"
 #include "dem/force_terms/force_term_registry.h"
@@ -84,27 +86,8 @@ void MagneticForceTerm::select_carriers(const dem::ParticleState &state)
 
 void MagneticForceTerm::gather_positions(const dem::ParticleState &state)
 {
-  // Unwrapped along periodic axes: of the engine position's images, the one nearest to the
-  // bead's previous position (a bead moves far less than half a period per step).
-  const std::size_t n = carrier_.size();
-  const std::vector<double> *engine[3] = {&state.x, &state.y, &state.z};
-  std::vector<double> *mine[3] = {&x_, &y_, &z_};
-  for (int d = 0; d < 3; ++d)
-  {
-    const double L = box_[d];
-    const double *from = engine[d]->data();
-    double *to = mine[d]->data();
-    if (L > 0.0)
-      for (std::size_t k = 0; k < n; ++k)
-      {
-        const double raw = from[carrier_[k]];
-        const double jump = to[k] - raw; // a multiple of L after a wrap, else a step's move
-        to[k] = std::abs(jump) > 0.5 * L ? raw + L * std::round(jump / L) : raw;
-      }
-    else
-      for (std::size_t k = 0; k < n; ++k)
-        to[k] = from[carrier_[k]];
-  }
+  std::vector<double> *const mine[3] = {&x_, &y_, &z_};
+  dem::follow_unwrapped(state, carrier_, box_, mine); // dem/periodic_unwrap.h
 }
 
 AppliedFieldFunction MagneticForceTerm::lookup_at(double t) const

@@ -221,6 +221,7 @@ std::vector<ResolvedEntry> resolved_entries(const Case &c)
   e.q("electric.coulomb_refresh", "electric.coulomb_refresh", c.electric.coulomb_refresh);
   e.b("electric.conductor_images", "electric.conductor_images", c.electric.conductor_images);
   e.i("electric.pair_image_terms", "electric.pair_image_terms", c.electric.pair_image_terms);
+  e.q("electric.hold_distance", "electric.hold_distance", c.electric.hold_distance);
   e.q("electric.image.edge_width", "electric.image.edge_width", im.edge_width);
 
   const auto &f = c.applied_field;

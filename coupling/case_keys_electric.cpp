@@ -44,6 +44,9 @@ std::vector<KeySpec> electric_keys()
       integer("electric.pair_image_terms",
               "Drum images per charge that act on the OTHER charges (explicit terms of the layered image series, the rest lumped keeping charge and dipole moment; 0 = the self force only).")
           .def("2").non_negative().max(20),
+      quantity("electric.hold_distance", D::length,
+               "The electric forces (qE, Coulomb, images) are evaluated again when some particle or the latent image has moved this far since their last evaluation, and held in between (0 = every step). 20 nm: force error against cost in docs/electrostatics.md.")
+          .def("20 nm").non_negative(),
       quantity("electric.image.edge_width", D::length, "Width of the smooth (raised-cosine) transition at each strip edge, at most the narrower strip (0 = sharp edges).")
           .def("0 um").non_negative().affects(A::electric),
   };

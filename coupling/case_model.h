@@ -157,6 +157,9 @@ struct Electric
   double coulomb_refresh = 2e-6; // far-field refresh interval [s] (0 = every step)
   bool conductor_images = true;  // false: Kweon's assumption, Φ unchanged by the toner
   int pair_image_terms = 2;      // explicit drum images per charge acting on the others (0 = none)
+  // The electric forces are evaluated again when a particle or the latent image has moved
+  // this far since the last evaluation, held in between (0 = every step; dem/force_terms/held_forces.h).
+  double hold_distance = 20e-9;  // [m]
 };
 
 // Applied magnetic field: from the roller (field solver grid) or uniform (the compression test).

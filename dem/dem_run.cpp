@@ -156,7 +156,12 @@ void DemRun::log_timings(double wall) const
   row("particle contacts", t.particle_contacts);
   row("wall contacts", t.wall_contacts);
   for (std::size_t k = 0; k < s.force_terms().size(); ++k)
+  {
     row(s.force_terms()[k]->name(), t.terms[k]);
+    const std::string note = s.force_terms()[k]->cost_note();
+    if (!note.empty())
+      log_ << "      (" << note << ")\n";
+  }
   row("integration", t.integrate);
   row("guards", t.guards);
   double rest = wall - t.neighbour - t.particle_contacts - t.wall_contacts - t.integrate - t.guards;

@@ -13,6 +13,7 @@
 #include "dem/particle_state.h"
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace magbrush::dem {
@@ -26,6 +27,14 @@ public:
   virtual ~ForceTerm() = default;
   virtual const char *name() const = 0;
   virtual void add_forces(const ParticleState &state, ForceBuffers &forces, double t) = 0;
+  // Optional, for terms whose force on a particle depends on that particle's own state and the
+  // time only (qE in the applied field, a charge's own images): add_forces_of() adds the forces
+  // of the listed particles alone, the same bits as add_forces() gives them. Held forces
+  // (force_terms/held_forces.h) then evaluate again only the particles that moved.
+  virtual bool acts_on_each_particle_alone() const { return false; }
+  virtual void add_forces_of(const ParticleState & /*state*/, ForceBuffers & /*forces*/, double /*t*/,
+                             const std::vector<std::uint32_t> & /*which*/)
+  {}
   // Optional, for terms that are a plain loop over the particles (gravity, drag): they may
   // run inside the engine's OpenMP team instead of in a parallel region of their own, which
   // saves a fork and a join per step (~45 µs with sleeping idle threads, measured). Such a
@@ -50,6 +59,9 @@ public:
   // without such state writes nothing.
   virtual void write_state(CheckpointWriter & /*out*/) const {}
   virtual void read_state(CheckpointReader & /*in*/) {}
+  // A line for the run log's time table on what the term's cost is made of (e.g. how often a
+  // held force was evaluated); "" for none.
+  virtual std::string cost_note() const { return ""; }
 };
 
 // A term that is a plain loop over the particles (gravity, drag): it runs inside the engine's

@@ -2,6 +2,7 @@
 
 #include "dem/dem_system.h"
 #include "dem/force_terms/force_term_registry.h"
+#include "dem/force_terms/held_forces.h"
 #include "electrostatics/coulomb_constants.h"
 
 #include <algorithm>
@@ -33,13 +34,14 @@ std::vector<GroundedSurface> ConductorImages::surfaces_of(const Case &c)
   return s;
 }
 
-void ConductorImages::add_forces(const dem::ParticleState &state, dem::ForceBuffers &forces, double)
+template <typename Index>
+void ConductorImages::add_forces_over(const dem::ParticleState &state, dem::ForceBuffers &forces, long count,
+                                      Index index) const
 {
-  const long n = static_cast<long>(state.size());
-#pragma omp parallel for schedule(static) if (n >= 2048)
-  for (long il = 0; il < n; ++il)
+#pragma omp parallel for schedule(static) if (count >= 2048)
+  for (long m = 0; m < count; ++m)
   {
-    const std::size_t i = static_cast<std::size_t>(il);
+    const std::size_t i = static_cast<std::size_t>(index(m));
     const double q = state.charge[i];
     if (q == 0.0)
       continue;
@@ -53,6 +55,18 @@ void ConductorImages::add_forces(const dem::ParticleState &state, dem::ForceBuff
       forces.fz[i] += f * normal[2];
     }
   }
+}
+
+void ConductorImages::add_forces(const dem::ParticleState &state, dem::ForceBuffers &forces, double)
+{
+  add_forces_over(state, forces, static_cast<long>(state.size()), [](long m) { return m; });
+}
+
+void ConductorImages::add_forces_of(const dem::ParticleState &state, dem::ForceBuffers &forces, double,
+                                    const std::vector<std::uint32_t> &which)
+{
+  add_forces_over(state, forces, static_cast<long>(which.size()),
+                  [&which](long m) { return which[static_cast<std::size_t>(m)]; });
 }
 
 namespace {
@@ -69,8 +83,9 @@ std::string images_not_needed_because(const Case &c)
 
 const bool registered = dem::register_force_term(
     {"conductor images", dem::force_term_order::conductor_images, images_not_needed_because,
-     [](const Case &c, const dem::DemSystem &) -> std::unique_ptr<dem::ForceTerm> {
-       return std::make_unique<ConductorImages>(ConductorImages::surfaces_of(c));
+     [](const Case &c, const dem::DemSystem &system) -> std::unique_ptr<dem::ForceTerm> {
+       return dem::held_for(std::make_unique<ConductorImages>(ConductorImages::surfaces_of(c)),
+                            c.electric.hold_distance, system.box().length);
      }});
 } // namespace
 

@@ -32,9 +32,16 @@ public:
 
   const char *name() const override { return "conductor images"; }
   void add_forces(const dem::ParticleState &state, dem::ForceBuffers &forces, double t) override;
+  bool acts_on_each_particle_alone() const override { return true; }
+  void add_forces_of(const dem::ParticleState &state, dem::ForceBuffers &forces, double t,
+                     const std::vector<std::uint32_t> &which) override;
 
 private:
   std::vector<GroundedSurface> surfaces_;
+
+  // The images of particles index(0) … index(count − 1).
+  template <typename Index>
+  void add_forces_over(const dem::ParticleState &state, dem::ForceBuffers &forces, long count, Index index) const;
 };
 
 } // namespace magbrush::electrostatics

@@ -4,6 +4,7 @@
 #include "dem/periodic_unwrap.h"
 #include "dem/dem_system.h"
 #include "dem/force_terms/force_term_registry.h"
+#include "dem/force_terms/held_forces.h"
 
 #include <cmath>
 #include <stdexcept>
@@ -198,7 +199,8 @@ std::string coulomb_not_needed_because(const Case &c)
 const bool registered = dem::register_force_term(
     {"Coulomb", dem::force_term_order::coulomb, coulomb_not_needed_because,
      [](const Case &c, const dem::DemSystem &system) -> std::unique_ptr<dem::ForceTerm> {
-       return std::make_unique<CoulombTerm>(CoulombTermSettings::from_case(c), system.box().length);
+       return dem::held_for(std::make_unique<CoulombTerm>(CoulombTermSettings::from_case(c), system.box().length),
+                            c.electric.hold_distance, system.box().length);
      }});
 } // namespace
 

@@ -2,6 +2,7 @@
 
 #include "dem/dem_system.h"
 #include "dem/force_terms/force_term_registry.h"
+#include "dem/force_terms/held_forces.h"
 
 #include "coupling/field_files.h"
 
@@ -21,18 +22,19 @@ ElectricFieldForce::ElectricFieldForce(std::shared_ptr<const NipPotentialField> 
   weights_ = field_->make_phase_weights();
 }
 
-void ElectricFieldForce::add_forces(const ParticleState &s, ForceBuffers &f, double t)
+template <typename Index>
+void ElectricFieldForce::add_forces_over(const ParticleState &s, ForceBuffers &f, double t, long count, Index index)
 {
   // One phase for the whole step: the image has travelled u(t) with the drum surface.
   field_->phase_weights(NipPotentialField::surface_travel(drum_, t), weights_);
   const NipPotentialField &field = *field_;
   const NipPotentialField::PhaseWeights &w = weights_;
   const std::array<double, 3> box = box_;
-  const long n = static_cast<long>(s.size());
   long charged = 0, outside = 0, first_outside = -1;
-#pragma omp parallel for schedule(static) reduction(+ : charged, outside) reduction(max : first_outside) if (n > 512)
-  for (long i = 0; i < n; ++i)
+#pragma omp parallel for schedule(static) reduction(+ : charged, outside) reduction(max : first_outside) if (count > 512)
+  for (long m = 0; m < count; ++m)
   {
+    const long i = static_cast<long>(index(m));
     const std::size_t k = static_cast<std::size_t>(i);
     const double q = s.charge[k];
     if (q == 0.0)
@@ -67,6 +69,17 @@ void ElectricFieldForce::add_forces(const ParticleState &s, ForceBuffers &f, dou
   }
 }
 
+void ElectricFieldForce::add_forces(const ParticleState &s, ForceBuffers &f, double t)
+{
+  add_forces_over(s, f, t, static_cast<long>(s.size()), [](long m) { return m; });
+}
+
+void ElectricFieldForce::add_forces_of(const ParticleState &s, ForceBuffers &f, double t,
+                                       const std::vector<std::uint32_t> &which)
+{
+  add_forces_over(s, f, t, static_cast<long>(which.size()), [&which](long m) { return which[static_cast<std::size_t>(m)]; });
+}
+
 namespace {
 // qE needs the nip field (electric section on, so the field stage stored it) and charges to act
 // on. The charges are known per population here, before any particle exists.
@@ -83,7 +96,11 @@ std::unique_ptr<ForceTerm> make_electric_field(const Case &c, const DemSystem &s
 {
   auto field = std::make_shared<const NipPotentialField>(
     NipPotentialField::for_case(c, field::electric_grid_path(c)));
-  return std::make_unique<ElectricFieldForce>(std::move(field), c.drum, system.box().length);
+  // Held between moves of the particles and of the latent image (held_forces.h).
+  const Drum drum = c.drum;
+  return held_for(std::make_unique<ElectricFieldForce>(std::move(field), c.drum, system.box().length),
+                  c.electric.hold_distance, system.box().length,
+                  [drum](double t) { return NipPotentialField::surface_travel(drum, t); });
 }
 
 const bool registered = register_force_term({"applied electric field qE", force_term_order::electric_field,

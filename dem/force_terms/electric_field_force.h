@@ -36,6 +36,9 @@ public:
 
   const char *name() const override { return "applied electric field qE"; }
   void add_forces(const ParticleState &state, ForceBuffers &forces, double t) override;
+  bool acts_on_each_particle_alone() const override { return true; }
+  void add_forces_of(const ParticleState &state, ForceBuffers &forces, double t,
+                     const std::vector<std::uint32_t> &which) override;
 
   // Lookups of charged particles so far, and how many of them fell outside the window.
   long lookups() const { return lookups_; }
@@ -49,6 +52,10 @@ private:
   NipPotentialField::PhaseWeights weights_;
   long lookups_ = 0, outside_ = 0;
   bool warned_ = false;
+
+  // qE on particles index(0) … index(count − 1).
+  template <typename Index>
+  void add_forces_over(const ParticleState &s, ForceBuffers &f, double t, long count, Index index);
 };
 
 } // namespace magbrush::dem

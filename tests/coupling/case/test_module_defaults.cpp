@@ -209,6 +209,7 @@ TEST(ModuleDefaults, FieldSolverSettingsOfADefaultCaseAreTheStructDefaults)
   EXPECT_SAME(c.electric, electric, coulomb_refresh);
   EXPECT_SAME_EXACT(c.electric, electric, conductor_images);
   EXPECT_SAME_EXACT(c.electric, electric, pair_image_terms);
+  EXPECT_SAME(c.electric, electric, hold_distance);
 }
 
 // The geometry: roller, poles, sleeve, drum, blades, plane walls.

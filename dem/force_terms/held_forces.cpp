@@ -1,0 +1,224 @@
+#include "dem/force_terms/held_forces.h"
+
+#include "dem/checkpoint_file.h"
+
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+
+namespace magbrush::dem {
+
+HeldForces::HeldForces(std::unique_ptr<ForceTerm> inner, double hold_distance, const std::array<double, 3> &box,
+                       std::function<double(double)> source_travel)
+  : inner_(std::move(inner)), hold_distance_(hold_distance), box_(box), source_travel_(std::move(source_travel))
+{
+  if (!inner_)
+    throw std::invalid_argument("held forces: no force term given");
+  if (!(hold_distance_ >= 0.0))
+    throw std::invalid_argument("held forces: the hold distance must be >= 0");
+  per_particle_ = inner_->acts_on_each_particle_alone();
+}
+
+double HeldForces::squared_move(const ParticleState &state, std::size_t i) const
+{
+  // Minimum image along the periodic axes: crossing the box is no move.
+  // A move is far below half the box, so one wrap is the only case (no division in this
+  // per-particle, per-step check).
+  double d[3] = {state.x[i] - x0_[i], state.y[i] - y0_[i], state.z[i] - z0_[i]};
+  for (int a = 0; a < 3; ++a)
+    if (box_[a] > 0.0 && std::abs(d[a]) > 0.5 * box_[a])
+      d[a] -= std::copysign(box_[a], d[a]);
+  return d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+}
+
+bool HeldForces::must_evaluate(const ParticleState &state, double t) const
+{
+  if (!valid_ || held_.fx.size() != state.size())
+    return true;
+  if (source_travel_ && std::abs(source_travel_(t) - source_travel_(evaluated_at_)) >= hold_distance_)
+    return true;
+  // The largest squared displacement since the last evaluation (a max is the same on any
+  // number of threads).
+  const long n = static_cast<long>(state.size());
+  double largest = 0.0;
+#pragma omp parallel for schedule(static) reduction(max : largest) if (n > 4096)
+  for (long i = 0; i < n; ++i)
+  {
+    const double d2 = squared_move(state, static_cast<std::size_t>(i));
+    largest = d2 > largest ? d2 : largest;
+  }
+  return largest >= hold_distance_ * hold_distance_;
+}
+
+void HeldForces::evaluate(const ParticleState &state, double t)
+{
+  held_.resize(state.size()); // zeroed
+  inner_->add_forces(state, held_, t);
+  x0_ = state.x;
+  y0_ = state.y;
+  z0_ = state.z;
+  evaluated_at_ = t;
+  valid_ = true;
+  evaluations_ += 1;
+}
+
+void HeldForces::evaluate_moved_particles(const ParticleState &state, double t)
+{
+  const std::size_t n = state.size();
+  if (held_.fx.size() != n) // the first step (or a state of another size): everybody
+  {
+    held_.resize(n);
+    x0_.assign(n, 0.0);
+    y0_.assign(n, 0.0);
+    z0_.assign(n, 0.0);
+    u0_.assign(n, 0.0);
+    stale_.assign(n, 1);
+  }
+  // Who moved (or whose source did), in index order: the list, and so the bits, are the same on
+  // any number of threads.
+  const double u = source_travel_ ? source_travel_(t) : 0.0, d2 = hold_distance_ * hold_distance_;
+  which_.clear();
+  for (std::size_t i = 0; i < n; ++i)
+    if (stale_[i] || std::abs(u - u0_[i]) >= hold_distance_ || squared_move(state, i) >= d2)
+      which_.push_back(static_cast<std::uint32_t>(i));
+  if (which_.empty())
+    return;
+  for (const std::uint32_t i : which_)
+  {
+    for (auto *a : {&held_.fx, &held_.fy, &held_.fz, &held_.tx, &held_.ty, &held_.tz})
+      (*a)[i] = 0.0;
+    x0_[i] = state.x[i];
+    y0_[i] = state.y[i];
+    z0_[i] = state.z[i];
+    u0_[i] = u;
+    stale_[i] = 0;
+  }
+  inner_->add_forces_of(state, held_, t, which_);
+  evaluations_ += static_cast<long>(which_.size());
+}
+
+void HeldForces::add_forces(const ParticleState &state, ForceBuffers &forces, double t)
+{
+  if (per_particle_)
+  {
+    calls_ += static_cast<long>(state.size());
+    evaluate_moved_particles(state, t);
+  }
+  else
+  {
+    ++calls_;
+    if (must_evaluate(state, t))
+      evaluate(state, t);
+  }
+  const long n = static_cast<long>(state.size());
+#pragma omp parallel for schedule(static) if (n > 4096)
+  for (long il = 0; il < n; ++il)
+  {
+    const std::size_t i = static_cast<std::size_t>(il);
+    forces.fx[i] += held_.fx[i];
+    forces.fy[i] += held_.fy[i];
+    forces.fz[i] += held_.fz[i];
+    forces.tx[i] += held_.tx[i];
+    forces.ty[i] += held_.ty[i];
+    forces.tz[i] += held_.tz[i];
+  }
+}
+
+void HeldForces::particles_reordered(const std::vector<std::int32_t> &order)
+{
+  inner_->particles_reordered(order);
+  if (held_.fx.size() != order.size())
+    return; // nothing held for these particles yet
+  held_.permute(order, scratch_);
+  for (auto *a : {&x0_, &y0_, &z0_})
+    permute_array(*a, order, scratch_);
+  if (per_particle_)
+  {
+    permute_array(u0_, order, scratch_);
+    std::vector<std::uint8_t> stale(order.size());
+    for (std::size_t k = 0; k < order.size(); ++k)
+      stale[k] = stale_[static_cast<std::size_t>(order[k])];
+    stale_.swap(stale);
+  }
+}
+
+void HeldForces::particles_changed(const std::vector<std::int32_t> &origin)
+{
+  inner_->particles_changed(origin);
+  if (!per_particle_ || held_.fx.empty())
+  {
+    valid_ = false; // held as a whole: everybody again at the next step
+    return;
+  }
+  // Per particle: the stayers keep what they hold, the newcomers are evaluated at the next step.
+  const std::size_t n = origin.size();
+  auto carry = [&](std::vector<double> &a) {
+    scratch_.assign(n, 0.0);
+    for (std::size_t k = 0; k < n; ++k)
+      if (origin[k] >= 0)
+        scratch_[k] = a[static_cast<std::size_t>(origin[k])];
+    a.swap(scratch_);
+  };
+  for (auto *a : {&held_.fx, &held_.fy, &held_.fz, &held_.tx, &held_.ty, &held_.tz, &x0_, &y0_, &z0_, &u0_})
+    carry(*a);
+  std::vector<std::uint8_t> stale(n, 1);
+  for (std::size_t k = 0; k < n; ++k)
+    if (origin[k] >= 0)
+      stale[k] = stale_[static_cast<std::size_t>(origin[k])];
+  stale_.swap(stale);
+}
+
+void HeldForces::write_state(CheckpointWriter &out) const
+{
+  inner_->write_state(out);
+  out.put<std::uint8_t>(valid_ ? 1 : 0);
+  out.put<double>(evaluated_at_);
+  out.put<std::int64_t>(evaluations_);
+  out.put<std::int64_t>(calls_);
+  for (const auto *a : {&held_.fx, &held_.fy, &held_.fz, &held_.tx, &held_.ty, &held_.tz, &x0_, &y0_, &z0_, &u0_})
+    out.put_array(*a);
+  out.put_array(stale_);
+}
+
+void HeldForces::read_state(CheckpointReader &in)
+{
+  inner_->read_state(in);
+  valid_ = in.get<std::uint8_t>() != 0;
+  evaluated_at_ = in.get<double>();
+  evaluations_ = static_cast<long>(in.get<std::int64_t>());
+  calls_ = static_cast<long>(in.get<std::int64_t>());
+  for (auto *a : {&held_.fx, &held_.fy, &held_.fz, &held_.tx, &held_.ty, &held_.tz, &x0_, &y0_, &z0_, &u0_})
+    in.get_array(*a);
+  in.get_array(stale_);
+  const std::size_t n = held_.fx.size();
+  for (const auto *a : {&held_.fy, &held_.fz, &held_.tx, &held_.ty, &held_.tz, &x0_, &y0_, &z0_})
+    if (a->size() != n)
+      in.fail("is corrupt (the held forces of '" + std::string(name()) + "' have arrays of different lengths)");
+  if (per_particle_ && (u0_.size() != n || stale_.size() != n))
+    in.fail("is corrupt (the held forces of '" + std::string(name()) + "' have arrays of different lengths)");
+}
+
+std::string HeldForces::cost_note() const
+{
+  char line[200];
+  const double share = calls_ > 0 ? 100.0 * static_cast<double>(evaluations_) / static_cast<double>(calls_) : 0.0;
+  if (per_particle_)
+    std::snprintf(line, sizeof line, "evaluated at %.2g %% of %ld particle-steps, each held until it moved %.3g nm",
+                  share, calls_, hold_distance_ * 1e9);
+  else
+    std::snprintf(line, sizeof line, "evaluated at %ld of %ld steps (%.2g %%), held until something moved %.3g nm",
+                  evaluations_, calls_, share, hold_distance_ * 1e9);
+  const std::string inner = inner_->cost_note();
+  return inner.empty() ? std::string(line) : std::string(line) + "; " + inner;
+}
+
+std::unique_ptr<ForceTerm> held_for(std::unique_ptr<ForceTerm> term, double hold_distance,
+                                    const std::array<double, 3> &box, std::function<double(double)> source_travel)
+{
+  if (hold_distance <= 0.0)
+    return term;
+  return std::make_unique<HeldForces>(std::move(term), hold_distance, box, std::move(source_travel));
+}
+
+} // namespace magbrush::dem

@@ -1,0 +1,91 @@
+// Multiple time stepping for slow forces: a force term evaluated only when something it
+// depends on has moved far enough to change it, and held in between.
+//
+// The electric forces of a development nip (qE in the nip field, Coulomb between the charges,
+// their images in the drum and the sleeve) change over distances of micrometres — the toner's
+// size, the strips' edges, the distance to the drum — while the step (0.5 ns, set by the
+// toner's Hertz contact) moves a particle by a nanometre or less. Evaluated at every step they
+// cost 20× the contacts (kweon_development: 93 % of the step, docs/development.md). Held until
+// a particle or the field's source has moved `hold_distance`, they are evaluated tens of times
+// less often, at a force error that grows linearly with that distance (measured against the
+// exact forces along the same trajectory by bench_held_electric_forces: docs/electrostatics.md).
+//
+// The rule is a distance, not a time, because a toner flying across the gap at 1 m/s and one
+// resting on a carrier need very different intervals: the fastest particle decides. Distances
+// are measured with the minimum image along the periodic axes, so crossing the box is no move.
+// A source that moves by itself (the latent image turns with the drum: `source_travel(t)`,
+// the distance it has travelled by time t) counts as a move too.
+//
+// Two ways to hold. A term whose force on a particle depends on that particle alone (qE, a
+// charge's own images: ForceTerm::acts_on_each_particle_alone) is held PER PARTICLE: each
+// particle is evaluated again when IT (or the source) has moved d since its own last
+// evaluation, so a few fast toner do not make the resting thousands pay. Any other term (Coulomb
+// between the charges) is held as a WHOLE: evaluated for everybody when the fastest particle has
+// moved d.
+//
+// The held forces (and torques) are the inner term's, so held at distance 0 they are its
+// forces at every step, bit for bit. Particles re-sorted: the held forces and the reference
+// positions follow them. Particles entering or leaving: evaluated again at the next step.
+// Checkpoint: the inner term's state, then the held forces, the reference positions and the
+// time of the last evaluation, so a restarted run continues bit for bit.
+#pragma once
+
+#include "dem/force_term.h"
+
+#include <array>
+#include <functional>
+#include <memory>
+
+namespace magbrush::dem {
+
+class HeldForces : public ForceTerm
+{
+public:
+  // `box`: the periodic lengths (0 = not periodic along that axis).
+  HeldForces(std::unique_ptr<ForceTerm> inner, double hold_distance, const std::array<double, 3> &box,
+             std::function<double(double)> source_travel = {});
+
+  const char *name() const override { return inner_->name(); }
+  void add_forces(const ParticleState &state, ForceBuffers &forces, double t) override;
+  void particles_reordered(const std::vector<std::int32_t> &order) override;
+  void particles_changed(const std::vector<std::int32_t> &origin) override;
+  void write_state(CheckpointWriter &out) const override;
+  void read_state(CheckpointReader &in) override;
+  std::string cost_note() const override;
+
+  const ForceTerm &inner() const { return *inner_; }
+  bool per_particle() const { return per_particle_; }
+  // Evaluations of the inner term so far (per particle: particle-evaluations), steps served
+  // (per particle: particle-steps).
+  long evaluations() const { return evaluations_; }
+  long calls() const { return calls_; }
+
+private:
+  std::unique_ptr<ForceTerm> inner_;
+  double hold_distance_;
+  std::array<double, 3> box_;
+  std::function<double(double)> source_travel_;
+
+  bool per_particle_;
+  bool valid_ = false;     // whole: the held forces belong to the particles present
+  double evaluated_at_ = 0.0; // whole: the time of the last evaluation
+  ForceBuffers held_;
+  std::vector<double> x0_, y0_, z0_; // positions at the last evaluation
+  std::vector<double> u0_;           // per particle: the source's travel at its last evaluation
+  std::vector<std::uint8_t> stale_;  // per particle: must be evaluated (entered, or never)
+  std::vector<std::uint32_t> which_; // per particle: those evaluated this step
+  std::vector<double> scratch_;
+  long evaluations_ = 0, calls_ = 0;
+
+  double squared_move(const ParticleState &state, std::size_t i) const;
+  bool must_evaluate(const ParticleState &state, double t) const;
+  void evaluate(const ParticleState &state, double t);
+  void evaluate_moved_particles(const ParticleState &state, double t);
+};
+
+// `term` held for `hold_distance` (> 0), or `term` itself (0: evaluated at every step).
+std::unique_ptr<ForceTerm> held_for(std::unique_ptr<ForceTerm> term, double hold_distance,
+                                    const std::array<double, 3> &box,
+                                    std::function<double(double)> source_travel = {});
+
+} // namespace magbrush::dem

@@ -28,7 +28,7 @@
 //    SKIPPED (after the physics checks), saying so.
 //
 // Cost: about 1 min on 2 cores in Release (the DEM: 1.8 ms of simulated time, 45,000 steps).
-#include "tests/scenes/nip/csv_columns.h"
+#include "tests/csv_columns.h"
 
 #include <gtest/gtest.h>
 #include "tests/test_temp_dir.h"

@@ -288,8 +288,9 @@ TEST(ReducedNipGuard, KawamotosFindingsEndToEnd)
     SCOPED_TRACE("report");
     report_shows_every_plot(run);
   }
-  if (!::testing::Test::HasFailure())
-    fs::remove_all(run.dir);
+  if (::testing::Test::HasFailure())
+    return; // a failure is the result (MAGBRUSH_KEEP_TEST_DIRS=1 keeps the run for a look)
+  fs::remove_all(run.dir);
   if (!with_report)
     GTEST_SKIP() << "the physics above passed, but the report was not made or checked: no python3 with matplotlib, "
                     "numpy and h5py (set MAGBRUSH_PYTHON)";

@@ -74,6 +74,9 @@ DrumContactInFrame resolve_drum_contact(const NipFrame &f, const DrumContact &c)
   DrumContactInFrame out;
   out.x = f.x_along(q.x, q.y);
   out.slip = dot(v_bead - v_drum, t_local);
+  const Vector3 relative = v_bead - v_drum;
+  const Vector3 relative_t = relative - dot(relative, n_out) * n_out;
+  out.slip_speed = std::sqrt(dot(relative_t, relative_t));
   out.normal = -dot(c.force_on_wall, n_out);
   out.tangential = dot(c.force_on_wall, t_local);
   return out;
@@ -151,6 +154,11 @@ void NipProfile::add_sample(double time, const std::vector<DrumContact> &contact
     slip_[k] += r.slip;
     slip2_[k] += r.slip * r.slip;
     ++count_[k];
+    if (r.slip_speed > sliding_speed())
+    {
+      fn_sliding_ += r.normal;
+      fn_sliding_downstream_ += r.normal * (r.slip / r.slip_speed);
+    }
     fn += r.normal;
     ft += r.tangential;
     ++touching;
@@ -211,6 +219,28 @@ double NipProfile::tangential_over_normal() const
     ft += ft_[k];
   }
   return fn > 0.0 ? ft / fn : nan;
+}
+
+double NipProfile::sliding_speed() const
+{
+  const double relative = std::abs(frame_.relative_surface_speed());
+  return relative > 0.0 ? 0.1 * relative : 1e-3;
+}
+
+double NipProfile::sliding_share() const
+{
+  double fn = 0.0;
+  for (const double f : fn_)
+    fn += f;
+  return fn > 0.0 ? fn_sliding_ / fn : nan;
+}
+
+double NipProfile::sliding_downstream_share() const
+{
+  double fn = 0.0;
+  for (const double f : fn_)
+    fn += f;
+  return fn > 0.0 ? fn_sliding_downstream_ / fn : nan;
 }
 
 double NipProfile::peak_normal_pressure() const
@@ -286,6 +316,11 @@ std::string NipProfile::summary_csv() const
   row("peak_normal_pressure", peak_normal_pressure(), "Pa", "largest bin normal pressure");
   row("normal_pressure_at_gap_centre", centre.normal_pressure, "Pa", "normal pressure of the centre bin");
   row("tangential_over_normal", tangential_over_normal(), "1", "sum of tangential / sum of normal forces on the drum");
+  row("sliding_share", sliding_share(), "1",
+      "share of the normal force on sliding contacts (slip faster than sliding_speed)");
+  row("sliding_downstream_share", sliding_downstream_share(), "1",
+      "the same, each contact weighted with the downstream cosine of its slip");
+  row("sliding_speed", sliding_speed(), "m/s", "slip speed above which a contact counts as sliding");
   row("normal_force_per_length", fn / frame_.slab_depth, "N/m", "total normal force on the drum per slab depth");
   row("tangential_force_per_length", ft / frame_.slab_depth, "N/m", "total tangential force per slab depth");
   row("touching_beads", touching, "1", "mean beads touching the drum within the profile");

@@ -7,7 +7,15 @@
 //  * normal and tangential pressure on the drum: Σ (force of the touching beads on the drum,
 //    normal component pushing into the drum / tangential component downstream) per bin, over
 //    the drum surface of the bin (arc length of the bin on the drum × slab depth);
-//  * density of the beads touching the drum [1/mm²] and the mean normal force per bead.
+//  * density of the beads touching the drum [1/mm²] and the mean normal force per bead;
+//  * which contacts slide: a contact whose contact point moves over the drum faster than a
+//    tenth of the relative surface speed (in any tangential direction, the slab depth
+//    included) slides, and Coulomb friction then pulls the drum along its slip with μ F_n.
+//    The shares of the normal force carried by sliding contacts (S) and by sliding contacts
+//    weighted with the downstream cosine of their slip (D) bound the ratio tangential/normal
+//    from the kinematics alone: μ (D − (1 − S)) ≤ Σ F_t / Σ F_n ≤ μ (D + (1 − S)), since a
+//    contact that sticks carries at most μ F_n either way. The bound is independent of the
+//    forces the ratio is made of (tests/scenes/nip asserts it on the reduced nip).
 //
 // Bins: centred on the gap centre, width nip.bin_width, along x (NipFrame: distance from the
 // gap centre along the common tangent, positive downstream); a contact is binned by the x of
@@ -48,6 +56,7 @@ struct DrumContactInFrame
   double slip = 0.0;       // tangential slip speed, bead relative to drum, downstream > 0 [m/s]
   double normal = 0.0;     // force pressing into the drum [N]
   double tangential = 0.0; // force on the drum along the downstream tangent [N]
+  double slip_speed = 0.0; // |tangential velocity of the bead's contact point relative to the drum|, 3D [m/s]
 };
 DrumContactInFrame resolve_drum_contact(const NipFrame &frame, const DrumContact &c);
 
@@ -85,6 +94,14 @@ public:
   double slip_at_gap_centre() const;          // mean slip of the centre bin [m/s]
   double tangential_over_normal() const;      // Σ F_t / Σ F_n over every bin
   double peak_normal_pressure() const;        // [Pa]
+  // Contacts slipping faster than this over the drum are sliding [m/s]: a tenth of the
+  // relative surface speed of sleeve and drum (1 mm/s when that is zero). A stuck contact's
+  // point only creeps with the elastic tangential spring, far slower.
+  double sliding_speed() const;
+  // Over the averaging window and the profile: S = Σ_sliding F_n / Σ F_n and
+  // D = Σ_sliding F_n (slip / slip_speed) / Σ F_n (the downstream cosine of each slip).
+  double sliding_share() const;
+  double sliding_downstream_share() const;
   // |B| of the applied field at the gap centre [T] when the case's magnetic grid could be read
   // at construction (else NaN); the magnetic pressure scale is B²/2μ0.
   double gap_centre_field() const { return gap_field_; }
@@ -103,6 +120,7 @@ private:
   int bins_half_ = 0;                 // bins k = −bins_half_ … +bins_half_
   std::vector<double> fn_, ft_, slip_, slip2_;
   std::vector<long> count_;
+  double fn_sliding_ = 0.0, fn_sliding_downstream_ = 0.0; // Σ F_n, Σ F_n cos over sliding contacts
   long samples_ = 0;
   double t_first_ = -1.0, t_last_ = -1.0;
   // Per-sample totals over the profile (for standard errors and the steady-state test).

@@ -4,6 +4,7 @@
 #include "common/child_process.h"
 
 #include <gtest/gtest.h>
+#include "tests/test_temp_dir.h"
 
 #include <filesystem>
 #include <fstream>
@@ -21,7 +22,7 @@ struct Result
 
 Result run(const std::vector<std::string> &command)
 {
-  const fs::path log = fs::temp_directory_path() / ("magbrush_cli_" + std::to_string(::getpid()) + ".log");
+  const fs::path log = magbrush::testing::test_temp_dir("cli") / "output.log"; // removed at exit
   magbrush::ChildOutput output;
   output.stdout_path = log.string();
   output.stderr_to_stdout = true;
@@ -72,7 +73,7 @@ TEST(ProgramCommandLines, DemRejectsTheFieldSolversOptions)
 TEST(ProgramCommandLines, RunHandsEachStageOnlyItsOwnOptions)
 {
   // check declares neither -np (field) nor --threads (dem): it must not receive them.
-  const std::string out = (fs::temp_directory_path() / ("magbrush_cli_run_" + std::to_string(::getpid()))).string();
+  const std::string out = (magbrush::testing::test_temp_dir("cli") / "run").string();
   const Result r = run({bin + "magbrush", "run", nip_case, "--only", "check", "-np", "2", "--threads", "3", "--force",
                         "-q", "--set", "output.directory=" + out});
   EXPECT_EQ(r.status, 0) << r.output;

@@ -9,6 +9,8 @@
 #include "coupling/field_files.h"
 #include "coupling/field_grid.h"
 
+#include "tests/test_temp_dir.h"
+
 #include <gtest/gtest.h>
 #include <omp.h>
 
@@ -174,8 +176,7 @@ TEST(ElectricFieldForce, ChargeInAMovingCosineImageFieldMatchesThePlanarSolution
 TEST(ElectricFieldForce, StaleGridIsRefusedNamingTheKey)
 {
   const std::string yaml = std::string(MAGBRUSH_SOURCE_DIR) + "/cases/kweon_full_roller.yaml";
-  const fs::path dir = fs::temp_directory_path() / "magbrush_electric_force_test";
-  fs::create_directories(dir);
+  const fs::path dir = magbrush::testing::test_temp_dir("electric_stale_grid"); // this process's own
   const Case c = load_case(yaml, {"field.output_dir=" + dir.string()});
   ASSERT_TRUE(c.electric.enabled);
   NipPotentialGrid grid = nip_grid(-1e-3, 1e-3, 6, 0.0, 1e-3, 6, [](double, double) { return 1.0; },
@@ -200,7 +201,6 @@ TEST(ElectricFieldForce, StaleGridIsRefusedNamingTheKey)
   // The drum's speed moves the image but is not a field input.
   const Case faster = load_case(yaml, {"field.output_dir=" + dir.string(), "drum.rpm=-200rpm"});
   EXPECT_NO_THROW(NipPotentialField::for_case(faster, field::electric_grid_path(faster)));
-  fs::remove_all(dir);
 }
 
 // On with an enabled electric section and a charged population; the log's reason otherwise.

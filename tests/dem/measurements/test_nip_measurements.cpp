@@ -172,6 +172,43 @@ TEST(NipProfile, HandPlacedBeadsGiveExactBinValues)
   EXPECT_NE(profile.summary_csv().find("slip_at_gap_centre"), std::string::npos);
 }
 
+// Which contacts slide, from the slip of each contact point alone: beads at the gap centre
+// (contact point moving with the drum there at v_drum along the downstream tangent t, no spin)
+// pressing 1 mN each, with hand-chosen velocities relative to the drum.
+TEST(NipProfile, SlidingSharesFromTheSlipOfEachContact)
+{
+  const Case c = nip_case(0.4);
+  NipProfile profile(c);
+  const NipFrame &f = profile.frame();
+  const double v_drum = -c.drum.omega() * c.drum.radius; // the drum surface, downstream
+  const double threshold = 0.1 * f.relative_surface_speed();
+  EXPECT_NEAR(profile.sliding_speed(), threshold, 1e-15);
+  const double r = 30e-6, overlap = 0.2e-6;
+  const Vector3 t{f.tx, f.ty, 0.0}, z{0.0, 0.0, 1.0};
+  auto bead = [&](const Vector3 &relative, double normal_mN) {
+    DrumContact b;
+    b.position = on_drum(f, 0.0, r - overlap);
+    b.radius = r;
+    b.velocity = v_drum * t + relative;
+    b.force_on_wall = {normal_mN * 1e-3 * f.nx, normal_mN * 1e-3 * f.ny, 0.0}; // +n: into the drum
+    return b;
+  };
+  // Downstream at 3 × the threshold; upstream at 2 ×; at 45° between downstream and the slab
+  // depth (|slip| 2 × the threshold: the depth counts); creeping at half the threshold along
+  // the depth (sticks); pressing twice as hard and creeping downstream (sticks).
+  const double s = threshold;
+  const std::vector<DrumContact> contacts{bead(3 * s * t, 1), bead(-2 * s * t, 1),
+                                          bead(std::sqrt(2.0) * s * (t + z), 1), bead(0.5 * s * z, 1),
+                                          bead(0.9 * s * t, 2)};
+  profile.add_sample(1e-3, contacts);
+  // Σ F_n = 6 mN; sliding: the first three (3 mN); downstream cosines 1, −1, 1/√2.
+  EXPECT_NEAR(profile.sliding_share(), 3.0 / 6.0, 1e-12);
+  EXPECT_NEAR(profile.sliding_downstream_share(), (1.0 - 1.0 + std::sqrt(0.5)) / 6.0, 1e-9);
+  const std::string summary = profile.summary_csv();
+  EXPECT_NE(summary.find("sliding_share,0.5,"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("sliding_downstream_share,"), std::string::npos) << summary;
+}
+
 TEST(ChainInclination, HandPlacedPairsGiveTheirBranchAngle)
 {
   Case c = nip_case(0.0);

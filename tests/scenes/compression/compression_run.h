@@ -32,6 +32,11 @@ struct ReducedScene
   // far field none, cutoff 4 d, plus our slab tail); false: the case's, i.e. the project
   // defaults (no cutoff: the cell-multipole far field).
   bool paper_magnetics = true;
+  // With sweep_and_slide: false ends the run after the field sweep (3.9 ms), without the slide.
+  bool slide = true;
+  // The carrier's saturation magnetisation M_s [A/m] (Fröhlich–Kennelly); 0 = the case's
+  // linear μr.
+  double saturation_magnetisation = 0.0;
 };
 
 // Kawamoto's bead count of this size on 2 x 2 mm² (equal mass per area), scaled to the box.
@@ -54,6 +59,22 @@ constexpr Window slide_steady{6.7e-3, 7.7e-3}; // the last 0.25 mm of the slide
 
 Case reduced_case(const ReducedScene &s, const std::string &output_dir);
 
+// Which plate contacts slide, over the steady part of the slide (slide_steady), from the
+// kinematics alone: a contact whose contact point moves over the plate faster than
+// `sliding_speed` slides (Coulomb: it pulls the plate along its slip with μ F_n). S = share of
+// the normal force on sliding contacts; D = the same weighted with the cosine between each
+// slip and −x̂ (the plate slides along +x over beads that lag behind: their slip relative to
+// the plate is along −x). Then |F_t|/F_n ≥ |F_t·x̂|/F_n ≥ μ (D − (1 − S)), a bound that does
+// not use the forces the ratio is made of.
+struct PlateSliding
+{
+  static constexpr double sliding_speed = 0.025; // [m/s]: a tenth of the plate's 0.25 m/s
+  double fn = 0.0, fn_sliding = 0.0, fn_sliding_along = 0.0; // sums over samples and contacts
+  long samples = 0;
+  double share() const { return fn > 0.0 ? fn_sliding / fn : 0.0; }
+  double along_share() const { return fn > 0.0 ? fn_sliding_along / fn : 0.0; }
+};
+
 struct RunResult
 {
   std::vector<dem::PlateCompressionRow> rows;
@@ -62,6 +83,7 @@ struct RunResult
   double wall_s = 0.0;     // run() wall time
   double magnetic_s = 0.0; // of which the magnetic term
   std::string log;
+  PlateSliding sliding; // over slide_steady (empty without the slide)
 };
 
 // Runs the case (fresh: insert, settle, run to dem.duration) with the magnetics and the plate

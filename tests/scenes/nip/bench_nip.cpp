@@ -17,7 +17,7 @@
 // Default CASE: tests/scenes/nip/kawamoto_nip_reduced.yaml (0.3 mm slab, about 1 min per run with
 // the papers' magnetics). The full default scene: --case cases/kawamoto_nip.yaml (see
 // docs/nip.md for its measured times). Runs in build/bench_nip_runs/ (kept for inspection).
-#include "tests/scenes/nip/csv_columns.h"
+#include "tests/csv_columns.h"
 
 #include <cmath>
 #include <cstdio>

@@ -1,5 +1,5 @@
 // Reads a magbrush CSV (header row, '#' comment lines skipped) into columns by header name:
-// what the nip regression test and the nip benchmark check their numbers from.
+// what the nip regression test, the nip benchmark and the flux command's test read back.
 #pragma once
 
 #include <cstdlib>

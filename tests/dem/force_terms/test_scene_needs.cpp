@@ -152,7 +152,8 @@ TEST(SceneNeeds, TheLogSaysWhatWasSkippedAndWhy)
                            "force term off: Stokes drag (dem.air_viscosity is zero)\n",
                            "force term off: applied electric field qE (the case has no enabled electric section)\n",
                            "force term off: Coulomb (no population is charged)\n",
-                           "adhesion: off (no pair of materials has a Hamaker constant)"})
+                           "adhesion: off (no pair of materials has a Hamaker constant)",
+                           "applied magnetic field: uniform, |B| up to 0.13 T, in closed form (no grid lookups)\n"})
     EXPECT_NE(text.find(line), std::string::npos) << "missing: " << line << "\n" << text;
 }
 

@@ -1,7 +1,7 @@
 // The stress suite (issue 15, item 1): the engine pushed to where it breaks. Each case must
 // either give the right answer (checked against an exact result) or stop with a message that
 // names the cause — and, in a run, keep a last good checkpoint and write nothing that is not a
-// number. Each case appends a row to the suite's table (stress_table.h; tools/stress,
+// number (time series, snapshots and checkpoint are read back). Each case appends a row to the suite's table (stress_table.h; tools/stress,
 // docs/stress.md).
 //
 // Built twice: dem_stress_quick (label stress_quick, in the default suite: the reduced cases,
@@ -17,6 +17,7 @@
 #include "coupling/case_parser.h"
 
 #include <gtest/gtest.h>
+#include <hdf5.h>
 #include <omp.h>
 
 #include <cmath>
@@ -208,7 +209,9 @@ TEST(STRESS_SUITE, TimeStepAgainstTheStableLimitWithFastImpacts)
       const std::string setting = format("dt = %.2g x limit, 60 um carrier at %.3g m/s on 50 GPa", f, v);
       judge_impact("time step", setting, r, omp_get_wtime() - t0);
       if (f > 1.0)
+      {
         EXPECT_TRUE(r.refused) << "a step above the limit must be refused: " << setting;
+      }
     }
 }
 
@@ -501,11 +504,53 @@ PlateRun press_to_monolayer(long beads, double plate_speed, double wall_friction
   return out;
 }
 
-// What a run left behind: a readable, finite last checkpoint and a finite time series.
+// Every value of the float datasets of one HDF5 snapshot is finite (and the checksums read).
+bool snapshot_is_finite(const fs::path &h5, std::string &bad)
+{
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  const hid_t f = H5Fopen(h5.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (f < 0)
+  {
+    bad = h5.string() + " cannot be opened";
+    return false;
+  }
+  bool ok = true;
+  for (const char *name : {"position", "velocity", "angular_velocity", "force", "radius"})
+  {
+    const hid_t d = H5Dopen2(f, name, H5P_DEFAULT);
+    const hid_t space = d >= 0 ? H5Dget_space(d) : -1;
+    const hssize_t count = space >= 0 ? H5Sget_simple_extent_npoints(space) : -1;
+    std::vector<double> values(static_cast<std::size_t>(std::max<hssize_t>(count, 0)));
+    const bool read = count >= 0 && H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()) >= 0;
+    if (space >= 0)
+      H5Sclose(space);
+    if (d >= 0)
+      H5Dclose(d);
+    if (!read)
+      bad = h5.string() + ": dataset " + name + " unreadable";
+    for (double v : values)
+      if (!std::isfinite(v))
+        bad = h5.string() + ": a non-finite value in " + name;
+    ok = ok && bad.empty();
+  }
+  H5Fclose(f);
+  return ok;
+}
+
+// What a run left behind: a readable, finite last checkpoint, a finite time series and finite
+// snapshots.
 void expect_good_outputs(const PlateRun &r, const Case &c)
 {
   std::string bad;
   EXPECT_TRUE(csv_is_finite(r.dir / "dem" / "time_series.csv", bad)) << bad;
+  long snapshots = 0;
+  for (const auto &entry : fs::recursive_directory_iterator(r.dir / "dem"))
+    if (entry.path().extension() == ".h5")
+    {
+      ++snapshots;
+      EXPECT_TRUE(snapshot_is_finite(entry.path(), bad)) << bad;
+    }
+  EXPECT_GT(snapshots, 0) << "no snapshot was written";
   const fs::path checkpoint = r.dir / "dem" / "checkpoint.bin";
   ASSERT_TRUE(fs::exists(checkpoint)) << r.log;
   DemSystem restored(c);

@@ -4,6 +4,7 @@
 #include "dem/force_terms/force_term_registry.h"
 
 #include "coupling/field_files.h"
+#include "coupling/zero_electric_field.h"
 
 #include <cmath>
 #include <cstdio>
@@ -75,10 +76,8 @@ std::string electric_field_not_needed_because(const Case &c)
   if (!c.electric.enabled)
     return "the case has no enabled electric section";
   // The nip field is the bias solution plus the latent image's: with both zero, E = 0
-  // everywhere and qE would only read the grid to add zeros.
-  const LatentImage &image = c.electric.image;
-  const bool no_image = image.kind == LatentImage::Kind::none || (image.dark_value == 0.0 && image.light_value == 0.0);
-  if (c.electric.bias == 0.0 && no_image)
+  // everywhere and qE would only read the grid to add zeros (the field stage stores none).
+  if (electric_field_is_zero(c))
     return "the electric field is zero (electric.bias = 0 V and no latent image)";
   if (c.has_charged_population())
     return "";

@@ -4,14 +4,51 @@
 // Exit codes: 0 written, 1 invalid case or meshing failure, 2 usage error.
 #include "app/subcommand.h"
 
+#include "common/atomic_file.h"
+#include "coupling/case_hash.h"
 #include "coupling/case_parser.h"
 #include "geometry/mesh_common.h"
 #include "geometry/mesh_nip.h"
 #include "geometry/mesh_roller.h"
 
+#include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <string>
 
 namespace {
+
+// A mesh is up to date when it exists and the digest of the inputs it was written from
+// (coupling/case_hash.h mesh_hash, stored next to it as <mesh>.inputs) equals the case's: then
+// it is not rewritten (meshing the roller takes ~10 s). The reason for remeshing is printed.
+std::string inputs_file(const std::string &mesh) { return mesh + ".inputs"; }
+
+bool mesh_is_current(const std::string &mesh, const std::string &hash, std::string &reason)
+{
+  if (!std::filesystem::exists(mesh))
+  {
+    reason = "no mesh yet";
+    return false;
+  }
+  std::ifstream in(inputs_file(mesh));
+  std::string stored;
+  if (!(in >> stored))
+  {
+    reason = "no record of the inputs it was written from (" + inputs_file(mesh) + ")";
+    return false;
+  }
+  if (stored != hash)
+  {
+    reason = "its inputs changed (stored hash " + stored + ", case " + hash + ")";
+    return false;
+  }
+  return true;
+}
+
+void record_inputs(const std::string &mesh, const std::string &hash)
+{
+  magbrush::write_file_atomically(inputs_file(mesh), [&](std::ostream &out) { out << hash << "\n"; });
+}
 
 // The options, declared once: the parser and `magbrush run` read them (common/command_line.h).
 const magbrush::cli::CommandSpec &mesh_command_line()
@@ -19,7 +56,7 @@ const magbrush::cli::CommandSpec &mesh_command_line()
   static const magbrush::cli::CommandSpec spec = [] {
     magbrush::cli::CommandSpec s;
     s.program = "magbrush mesh";
-    s.usage = "magbrush mesh CASE.yaml [--set key=value ...] [-o DIR] [--only roller|nip]\n"
+    s.usage = "magbrush mesh CASE.yaml [--set key=value ...] [-o DIR] [--only roller|nip] [--force]\n"
               "                    [--verbose] [--gui-free]";
     s.description =
         "Writes the quadrilateral meshes the field solver reads (MSH 2.2 ASCII, written atomically):\n"
@@ -29,6 +66,8 @@ const magbrush::cli::CommandSpec &mesh_command_line()
         "                  boundaries (needs drum.present)\n"
         "and prints, per region, the cells and the meshed area against the exact area, per boundary\n"
         "the faces and the length. Region and boundary tags are listed in geometry/mesh_tags.h.\n"
+        "A mesh whose inputs did not change since it was written (DIR/<mesh>.inputs holds their\n"
+        "digest) is not rewritten; --force remeshes.\n"
         "Element sizes: field.mesh_size_sleeve, field.mesh_size_gap, field.mesh_size_far; the shell\n"
         "starts at field.outer_radius_factor times the radius enclosing the scene.\n";
     s.positionals = {{"CASE.yaml", "the case file"}};
@@ -37,6 +76,7 @@ const magbrush::cli::CommandSpec &mesh_command_line()
         {"--output", {"-o"}, "DIR", "where to write (default: meshes/<case name>)", false, {}, /*for_pipeline=*/false},
         {"--only", {}, "roller|nip", "only the roller or only the nip mesh", false, {"roller", "nip"}, false},
         {"--verbose", {"-v"}, "", "show Gmsh's progress messages"},
+        {"--force", {}, "", "remesh even when the stored mesh is up to date"},
         {"--gui-free", {}, "", "accepted for scripts; magbrush never opens the Gmsh GUI"}};
     s.epilog = "Exit status: 0 written, 1 invalid case or meshing failure, 2 usage error.\n";
     return s;
@@ -79,16 +119,30 @@ int mesh(const magbrush::cli::ParsedArguments &args)
   }
   try
   {
+    const std::string hash = magbrush::mesh_hash(c);
+    const bool force = args.has("--force");
+    // Writes one mesh unless it is up to date; says which and why.
+    const auto write_unless_current = [&](const char *what, const std::string &path, auto write) {
+      std::string reason;
+      if (!force && mesh_is_current(path, hash, reason))
+      {
+        std::cout << what << " mesh: up to date (" << path << ", inputs hash " << hash << "): not remeshed\n\n";
+        return;
+      }
+      // Forget the old record first: a run killed between the mesh and its record remeshes.
+      std::filesystem::remove(inputs_file(path));
+      std::cout << what << " mesh (" << (force ? std::string("--force") : reason) << ")\n"
+                << magbrush::format_mesh_summary(write(path)) << "\n";
+      record_inputs(path, hash);
+    };
     if (want_roller && roller_possible)
-      std::cout << "roller mesh\n"
-                << magbrush::format_mesh_summary(magbrush::write_roller_mesh(c, output_dir + "/roller.msh", options))
-                << "\n";
+      write_unless_current("roller", output_dir + "/roller.msh",
+                           [&](const std::string &p) { return magbrush::write_roller_mesh(c, p, options); });
     else if (want_roller)
       std::cout << "roller mesh: skipped (the case has no roller)\n\n";
     if (want_nip && nip_possible)
-      std::cout << "nip mesh\n"
-                << magbrush::format_mesh_summary(magbrush::write_nip_mesh(c, output_dir + "/nip.msh", options))
-                << "\n";
+      write_unless_current("nip", output_dir + "/nip.msh",
+                           [&](const std::string &p) { return magbrush::write_nip_mesh(c, p, options); });
     else if (want_nip)
       std::cout << "nip mesh: skipped (no drum in the case)\n\n";
   }
@@ -97,7 +151,7 @@ int mesh(const magbrush::cli::ParsedArguments &args)
     std::cerr << "magbrush mesh: " << c.source_file << ": " << e.what() << "\n";
     return 1;
   }
-  std::cout << "meshes written to " << output_dir << "/\n";
+  std::cout << "meshes in " << output_dir << "/\n";
   return 0;
 }
 

@@ -62,6 +62,18 @@ std::string field_hash(const Case &c, FieldKind k)
   return digest(k == FieldKind::magnetic ? "magnetic-v1\n" : "electric-v1\n", field_inputs(c, k));
 }
 
+std::string mesh_hash(const Case &c)
+{
+  std::vector<std::pair<std::string, std::string>> inputs;
+  for (const auto &e : resolved_entries(c))
+  {
+    const KeySpec *spec = find_key_spec(e.pattern);
+    if (spec && spec->affects != Affects::none)
+      inputs.emplace_back(e.path, e.exact);
+  }
+  return digest("mesh-v1\n", inputs);
+}
+
 std::vector<std::pair<std::string, std::string>> case_inputs(const Case &c)
 {
   std::vector<std::pair<std::string, std::string>> inputs;

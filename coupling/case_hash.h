@@ -26,6 +26,11 @@ std::vector<std::pair<std::string, std::string>> field_inputs(const Case &c, Fie
 // FNV-1a 64-bit digest of field_inputs as 16 hex digits.
 std::string field_hash(const Case &c, FieldKind k);
 
+// Every input that changes a stored field (magnetic or electric), blades included: the Gmsh
+// meshes are built from a subset of these, so `magbrush mesh` rewrites a mesh only when this
+// digest changed (a superset of the mesh's inputs: never stale, sometimes remeshed needlessly).
+std::string mesh_hash(const Case &c);
+
 // Every resolved input of the case, "key path" -> value (SI, full precision), in schema
 // order: the identity of a case, which a DEM checkpoint carries (dem/checkpoint_file.h).
 std::vector<std::pair<std::string, std::string>> case_inputs(const Case &c);

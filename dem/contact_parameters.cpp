@@ -278,9 +278,12 @@ std::string ContactTable::describe() const
   }
   if (adhesive_)
   {
-    std::snprintf(line, sizeof line, "  adhesion: cut-off gap z0 %.3g m, range %.3g m\n", cutoff_, range_);
+    std::snprintf(line, sizeof line, "  adhesion: cut-off gap z0 %.3g m, range %.3g m%s\n", cutoff_, range_,
+                  particles_adhesive_ ? "" : "; off between particles (no particle pair has a Hamaker constant)");
     out += line;
   }
+  else
+    out += "  adhesion: off (no pair of materials has a Hamaker constant): the contact kernels run without it\n";
   return out;
 }
 

@@ -111,6 +111,19 @@ void DemRun::log_setup() const
   for (const ForceTermChoice &choice : force_terms_)
     if (!choice.on)
       log_ << "  force term off: " << choice.name << " (" << choice.reason << ")\n";
+  // Where the carriers' applied field comes from: a uniform field costs no grid lookup.
+  bool magnetic = false;
+  for (const ForceTermChoice &choice : force_terms_)
+    magnetic = magnetic || (choice.on && choice.name == "magnetic dipoles");
+  if (magnetic && case_.applied_field.kind == AppliedField::Kind::uniform)
+  {
+    std::snprintf(line, sizeof line,
+                  "  applied magnetic field: uniform, |B| up to %.4g T, in closed form (no grid lookups)\n",
+                  case_.applied_field.uniform_magnitude);
+    log_ << line;
+  }
+  else if (magnetic)
+    log_ << "  applied magnetic field: the roller's stored grid, interpolated at every carrier\n";
   if (const auto *flow = dynamic_cast<const ParticleFlow *>(s.particle_exchange()))
   {
     const FlowSettings &f = case_.flow;

@@ -98,6 +98,8 @@ public:
   // ramp or a wall path given from t = 0 has not started yet).
   void settle(double duration);
 
+  // The case the system was built from (its settings as resolved; diagnostics read them).
+  const Case &scene_case() const { return case_; }
   double time() const { return time_; }
   long step_count() const { return step_; }
   double time_step() const { return dt_; }

@@ -30,9 +30,10 @@ void StabilityGuards::pair_overlap(const StepClock &clock, const std::string &pa
   char msg[768];
   std::snprintf(msg, sizeof msg,
                 "stability guard: at step %ld (t = %.6g s) %s overlaps particle id %d by %.1f %% of the smaller "
-                "radius (limit dem.max_overlap_fraction = %.1f %%). Contacts are too soft for the loads or "
-                "the time step (%.3g s) is too large: increase Young's modulus, reduce dem.time_step, or check "
-                "the insertion and the force terms",
+                "radius (limit dem.max_overlap_fraction = %.1f %%). Contacts are too soft for the loads, "
+                "the time step (%.3g s) is too large, or a wall on a prescribed path presses particles that "
+                "cannot get out of its way: increase Young's modulus, reduce dem.time_step, slow or stop the "
+                "wall earlier, or check the insertion and the force terms",
                 clock.step, clock.time, particle.c_str(), partner_id, 100.0 * overlap_fraction,
                 100.0 * max_overlap_, clock.dt);
   throw StabilityError(msg);

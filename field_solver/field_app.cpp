@@ -1,6 +1,7 @@
 #include "field_solver/field_app.h"
 
 #include "coupling/case_hash.h"
+#include "coupling/zero_electric_field.h"
 #include "common/atomic_file.h"
 #include "coupling/field_grid.h"
 #include "coupling/multipole_ring.h"
@@ -258,6 +259,14 @@ bool compute_electric_field(const Case &c, const FieldRunOptions &options, MPI_C
   if (!c.sleeve || !c.drum.present)
     throw std::runtime_error("electric.enabled is set, but the nip field needs a sleeve and "
                              "a drum (drum.present); add the drum or disable electric");
+  if (electric_field_is_zero(c))
+  {
+    if (is_root(comm))
+      std::cout << "magbrush-field: electric field: skipped, it is zero (electric.bias = 0 V and no latent "
+                   "image); the DEM runs no qE"
+                << std::endl;
+    return false;
+  }
 
   const std::string h5 = field_file(c, "electric.h5");
   const std::string hash = field_hash(c, FieldKind::electric);

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <stdexcept>
 
 namespace magbrush::magnetics {
 
@@ -34,8 +36,26 @@ void TwoSphereCorrection::prepare_tables(const std::vector<double> &beta)
     for (std::size_t b = a; b < distinct.size(); ++b)
     {
       const double pair_beta = 0.5 * (distinct[a] + distinct[b]);
-      if (!tables_.count(pair_beta))
+      if (tables_.count(pair_beta))
+        continue;
+      try
+      {
         tables_[pair_beta] = TwoSphereTable::shared(pair_beta, settings_.switch_end);
+      }
+      catch (const std::runtime_error &e)
+      {
+        // The series converges ever more slowly as μr grows (touching, perfectly permeable
+        // spheres attract with a force that grows without bound): say which input and what to
+        // do, not which internal limit was hit.
+        char what[512];
+        std::snprintf(what, sizeof what,
+                      "magnetics: the exact two-sphere correction (dem.magnetic_model: corrected) cannot be "
+                      "tabulated for carriers of mu_r = %.4g (beta = %.6f): the force between touching beads "
+                      "grows without bound as mu_r -> infinity and its multipole series does not converge. Use a "
+                      "lower materials.*.mu_r (measured carriers: 3-10), or dem.magnetic_model: mutual_dipole. (",
+                      mu_r_from_beta(pair_beta), pair_beta);
+        throw std::runtime_error(what + std::string(e.what()) + ")");
+      }
     }
 }
 

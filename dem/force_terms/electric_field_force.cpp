@@ -5,6 +5,7 @@
 #include "dem/force_terms/held_forces.h"
 
 #include "coupling/field_files.h"
+#include "coupling/zero_electric_field.h"
 
 #include <cmath>
 #include <cstdio>
@@ -87,6 +88,10 @@ std::string electric_field_not_needed_because(const Case &c)
 {
   if (!c.electric.enabled)
     return "the case has no enabled electric section";
+  // The nip field is the bias solution plus the latent image's: with both zero, E = 0
+  // everywhere and qE would only read the grid to add zeros (the field stage stores none).
+  if (electric_field_is_zero(c))
+    return "the electric field is zero (electric.bias = 0 V and no latent image)";
   if (c.has_charged_population())
     return "";
   return "no population is charged";

@@ -430,6 +430,13 @@ std::string magnetics_not_needed_because(const Case &c)
 {
   if (c.applied_field.kind == AppliedField::Kind::none)
     return "the case has no applied field";
+  // A zero field induces no dipoles: no solve, no grid read. (uniform_magnitude is the peak of
+  // a schedule, so a schedule that is zero throughout is caught too.)
+  if (c.applied_field.kind == AppliedField::Kind::uniform && c.applied_field.uniform_magnitude == 0.0)
+    return "the applied uniform field is zero (applied_field.magnitude and every schedule value are 0 T)";
+  if (c.applied_field.kind == AppliedField::Kind::roller && c.roller &&
+      std::all_of(c.roller->poles.begin(), c.roller->poles.end(), [](const Pole &p) { return p.strength == 0.0; }))
+    return "every pole of the roller has zero strength (the roller field is zero)";
   for (const auto &p : c.populations)
     if (p.kind == ParticleKind::carrier)
       return "";

@@ -86,3 +86,17 @@ TEST(FieldApp, StoresFieldsAndReusesThemUntilTheirInputsChange)
   EXPECT_NE(biased.find("computing the electric field"), std::string::npos) << biased;
   fs::remove_all(out_dir);
 }
+
+// A zero nip field (no bias, both image potentials 0) is not solved, and not stored: the DEM's
+// qE term is off for it (tests/dem/force_terms/test_scene_needs.cpp).
+TEST(FieldApp, ZeroElectricFieldIsNotSolved)
+{
+  fs::remove_all(out_dir);
+  int rc = 0;
+  const std::string log = run_field("--only electric --set electric.bias=0V --set electric.image.dark_potential=0V "
+                                    "--set electric.image.light_potential=0V",
+                                    rc);
+  ASSERT_EQ(rc, 0) << log;
+  EXPECT_NE(log.find("electric field: skipped, it is zero"), std::string::npos) << log;
+  EXPECT_FALSE(fs::exists(out_dir + "/kweon_full_roller_electric.h5"));
+}

@@ -182,3 +182,32 @@ TEST(MeshCommand, ErrorsAndHelp)
   const Result bad = run(cases + "kweon_full_roller.yaml --set drum.gap=-1mm -o " + scratch("cmd_bad"));
   EXPECT_EQ(bad.status, 1) << bad.output;
 }
+
+// A mesh whose inputs did not change is not rewritten, and the output says so; a changed
+// field input, or --force, remeshes. (Meshing the full roller takes ~10 s at the defaults.)
+TEST(MeshCommand, UnchangedInputsAreNotRemeshed)
+{
+  const std::string dir = scratch("cmd_reuse");
+  const std::string args = cases + "kawamoto_nip.yaml" + coarse + " --only nip -o " + dir;
+  const Result first = run(args);
+  ASSERT_EQ(first.status, 0) << first.output;
+  EXPECT_NE(first.output.find("nip mesh (no mesh yet)"), std::string::npos) << first.output;
+  const auto written = fs::last_write_time(dir + "/nip.msh");
+
+  const Result again = run(args);
+  ASSERT_EQ(again.status, 0) << again.output;
+  EXPECT_NE(again.output.find("nip mesh: up to date"), std::string::npos) << again.output;
+  EXPECT_EQ(fs::last_write_time(dir + "/nip.msh"), written);
+
+  // The run-control keys change no mesh.
+  const Result longer = run(args + " --set dem.duration=2ms");
+  EXPECT_NE(longer.output.find("nip mesh: up to date"), std::string::npos) << longer.output;
+
+  const Result gap = run(args + " --set drum.gap=0.45mm");
+  ASSERT_EQ(gap.status, 0) << gap.output;
+  EXPECT_NE(gap.output.find("its inputs changed"), std::string::npos) << gap.output;
+  expect_mesh(dir + "/nip.msh", {"air", "shell"}, {"outer_boundary", "sleeve_surface", "drum_substrate"});
+
+  const Result forced = run(args + " --set drum.gap=0.45mm --force");
+  EXPECT_NE(forced.output.find("nip mesh (--force)"), std::string::npos) << forced.output;
+}

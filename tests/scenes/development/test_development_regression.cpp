@@ -14,7 +14,7 @@
 //  * the table has what a user plots: the standard error, the bound, the run time, and the plot.
 //
 // Cost: about 2 × 1 min on 2 cores in Release.
-#include "tests/scenes/nip/csv_columns.h"
+#include "tests/csv_columns.h"
 #include "tests/test_temp_dir.h"
 
 #include <gtest/gtest.h>

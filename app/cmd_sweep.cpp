@@ -11,6 +11,13 @@
 //   (common/study_table.h), with a measured series compared when given, and the nip profiles
 //   into sweep_profiles.csv → tools/plot_sweep.py draws each key against the varied value
 //   (error bars, the physical bound, the measured points) and the profiles side by side.
+//
+// Where the points run: serially (a plain `magbrush sweep`), on the ranks of an MPI job
+// (`mpirun -np K magbrush sweep`, point i on rank i mod K: app/sweep_ranks.h), or as the tasks of
+// a Slurm job array (`--emit slurm` writes it, app/sweep_slurm.h; each task runs `--point i`).
+// Each point leaves its run time and status in <point>/sweep_point.csv, and the table is built
+// from the point folders by one process (the serial sweep, rank 0 after every rank finished, or
+// `--merge`): the same code, so the same table wherever the points ran.
 #include "app/run_pipeline.h"
 #include "app/subcommand.h"
 #include "app/sweep_ranks.h"

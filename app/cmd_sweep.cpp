@@ -11,8 +11,17 @@
 //   (common/study_table.h), with a measured series compared when given, and the nip profiles
 //   into sweep_profiles.csv → tools/plot_sweep.py draws each key against the varied value
 //   (error bars, the physical bound, the measured points) and the profiles side by side.
+//
+// Where the points run: serially (a plain `magbrush sweep`), on the ranks of an MPI job
+// (`mpirun -np K magbrush sweep`, point i on rank i mod K: app/sweep_ranks.h), or as the tasks of
+// a Slurm job array (`--emit slurm` writes it, app/sweep_slurm.h; each task runs `--point i`).
+// Each point leaves its run time and status in <point>/sweep_point.csv, and the table is built
+// from the point folders by one process (the serial sweep, rank 0 after every rank finished, or
+// `--merge`): the same code, so the same table wherever the points ran.
 #include "app/run_pipeline.h"
 #include "app/subcommand.h"
+#include "app/sweep_ranks.h"
+#include "app/sweep_slurm.h"
 
 #include "coupling/case_parser.h"
 #include "coupling/case_schema.h"
@@ -49,7 +58,9 @@ const cli::CommandSpec &sweep_command_line()
     cli::CommandSpec s;
     s.program = "magbrush sweep";
     s.usage = "magbrush sweep CASE --vary key=v1,v2[,...] [--vary key=...] [--set key=value ...]\n"
-              "                      [--name NAME] [--no-keep-layer] [--skip STAGE[,STAGE]] [options of the stages]";
+              "                      [--name NAME] [--no-keep-layer] [--skip STAGE[,STAGE]] [options of the stages]\n"
+              "                      [--point INDEX | --merge | --emit slurm]\n"
+              "       mpirun -np K magbrush sweep CASE --vary ...";
     s.description = R"(Runs the pipeline (check, field, dem, report; the Gmsh meshes are not needed per point) once
 for every combination of the --vary values, each point in
 <output.directory>/sweep_<NAME>/<point>/ (its own fields/, dem/, report/), then compares the
@@ -70,6 +81,22 @@ d/d0, so that the supplied carrier volume (the layer) stays the same, as in the 
 42/50/60 um comparison, and a fixed dem.time_step by d/d0 (the stable step is proportional to
 the bead size); --no-keep-layer switches that off.
 The options of the stages (named in brackets) go to the stages that declare them, at every point.
+
+Beyond one process (the points are independent; the table is the same bit for bit but for
+run_time_s):
+  mpirun -np K magbrush sweep ...   point i runs on rank i mod K; rank 0 writes the table, the
+                       profiles and the plots once every rank has finished. Each rank's DEM gets
+                       --threads if given, else its share of the node: min(the cores mpirun
+                       binds it to, the node's cores / its ranks on the node). OpenMPI binds
+                       each rank to one core at -np 2: add --bind-to none (or --map-by
+                       slot:PE=N) for more threads per rank. The field stage's -np N still
+                       starts its own mpirun from inside a rank (a job of its own).
+  --emit slurm         writes sweep_<NAME>.slurm (a job array, task i runs --point i) and
+                       sweep_<NAME>_merge.slurm (--merge, submitted with
+                       --dependency=afterok on the array) into the sweep's folder, and prints
+                       the sbatch line; edit the resource lines first.
+  --point INDEX / --merge   the two steps by hand (a point's run time and status are kept in
+                       its folder, <point>/sweep_point.csv).
 )";
     s.positionals = {{"CASE", "the case file"}};
     s.options = {{"--vary", {}, "key=v1,v2", "the values of one key to run (repeatable: every combination)", true},
@@ -79,7 +106,12 @@ The options of the stages (named in brackets) go to the stages that declare them
                  {"--skip", {}, "STAGE[,STAGE]", "stages not run at each point (default: mesh)"},
                  {"--measured", {}, "FILE", "a measured series to compare: CSV with the varied key and a summary key "
                                             "as columns (e.g. electric.bias,tma_kg_per_m2; values in SI or with units)"},
-                 {"--tolerance", {}, "FRACTION", "relative error counted as agreement with --measured (default 0.1)"}};
+                 {"--tolerance", {}, "FRACTION", "relative error counted as agreement with --measured (default 0.1)"},
+                 {"--point", {}, "INDEX", "run only point INDEX (0-based, in the order of the table) and keep its\n"
+                                          "result in its folder: one task of a job array; --merge builds the table"},
+                 {"--merge", {}, "", "run nothing: the table, profiles and plots from the points' folders"},
+                 {"--emit", {}, "slurm", "run nothing: write a Slurm job array (one task per point, --point) and its\n"
+                                         "merge step (--merge) into the sweep's folder", false, {"slurm"}}};
     const auto of_stages = stage_options();
     s.options.insert(s.options.end(), of_stages.begin(), of_stages.end());
     s.epilog = R"(Examples (Fig. 22-27):
@@ -253,135 +285,250 @@ MeasuredComparison compare_with(const MeasuredSeries &series, const std::vector<
   return m;
 }
 
-int sweep(const cli::ParsedArguments &args)
+// The sweep as its arguments define it: the same in every process that takes part (each MPI
+// rank, each Slurm array task, the merge step), so that point n is the same point everywhere.
+struct SweepPlan
 {
-  const std::string case_path = args.positional(0), skip = args.value("--skip", "mesh");
-  std::string name = args.value("--name");
-  const std::vector<std::string> overrides = args.values("--set");
-  const bool keep_layer = !args.has("--no-keep-layer");
+  std::string case_path, skip, name;
+  std::vector<std::string> overrides;
+  bool keep_layer = true;
   std::vector<Vary> vary;
-  for (const auto &v : args.values("--vary"))
-    vary.push_back(parse_vary(v));
-  if (vary.empty())
-    throw cli::UsageError("nothing to vary: give --vary key=v1,v2,...");
   std::optional<MeasuredSeries> measured;
-  const double tolerance = std::atof(args.value("--tolerance", "0.1").c_str());
-  if (args.has("--measured") && vary.size() > 1)
-    throw cli::UsageError("--measured compares along one varied key; this sweep varies " + std::to_string(vary.size()));
-  if (!(tolerance > 0.0))
+  double tolerance = 0.1;
+  Case base;
+  fs::path sweep_dir;
+  std::vector<std::vector<std::size_t>> points; // per point: the index of its value of each --vary
+};
+
+SweepPlan plan_sweep(const cli::ParsedArguments &args)
+{
+  SweepPlan plan;
+  plan.case_path = args.positional(0);
+  plan.skip = args.value("--skip", "mesh");
+  plan.name = args.value("--name");
+  plan.overrides = args.values("--set");
+  plan.keep_layer = !args.has("--no-keep-layer");
+  for (const auto &v : args.values("--vary"))
+    plan.vary.push_back(parse_vary(v));
+  if (plan.vary.empty())
+    throw cli::UsageError("nothing to vary: give --vary key=v1,v2,...");
+  plan.tolerance = std::atof(args.value("--tolerance", "0.1").c_str());
+  if (args.has("--measured") && plan.vary.size() > 1)
+    throw cli::UsageError("--measured compares along one varied key; this sweep varies " +
+                          std::to_string(plan.vary.size()));
+  if (!(plan.tolerance > 0.0))
     throw cli::UsageError("--tolerance expects a positive fraction (0.1 = 10 %), found '" +
                           args.value("--tolerance", "") + "'");
   if (args.has("--measured"))
-    measured = read_measured(args.value("--measured"), vary[0].key);
-  const Case base = load_case(case_path, overrides);
-  if (name.empty())
-    for (const auto &v : vary)
-      name += (name.empty() ? "" : "_") + v.key.substr(v.key.find_last_of('.') + 1);
-  const fs::path sweep_dir = fs::path(base.output.directory) / ("sweep_" + name);
-  fs::create_directories(sweep_dir);
+    plan.measured = read_measured(args.value("--measured"), plan.vary[0].key);
+  plan.base = load_case(plan.case_path, plan.overrides);
+  if (plan.name.empty())
+    for (const auto &v : plan.vary)
+      plan.name += (plan.name.empty() ? "" : "_") + v.key.substr(v.key.find_last_of('.') + 1);
+  plan.sweep_dir = fs::path(plan.base.output.directory) / ("sweep_" + plan.name);
 
   // Every combination (the last --vary runs fastest).
-  std::vector<std::vector<std::size_t>> points(1);
-  for (const auto &v : vary)
+  plan.points.assign(1, {});
+  for (const auto &v : plan.vary)
   {
     std::vector<std::vector<std::size_t>> next;
-    for (const auto &p : points)
+    for (const auto &p : plan.points)
       for (std::size_t k = 0; k < v.values.size(); ++k)
       {
         next.push_back(p);
         next.back().push_back(k);
       }
-    points = next;
+    plan.points = next;
   }
-  std::cout << "magbrush sweep: " << points.size() << " points into " << sweep_dir.string() << "/\n";
+  return plan;
+}
 
-  std::vector<StudyPoint> table;
-  std::vector<double> first_x; // the first varied key's SI value per point (for --measured)
-  std::ostringstream profiles;
-  profiles << "# magbrush sweep profiles of " << case_path << " (columns after 'point' as in nip_profile.csv)\n";
-  bool profile_header = false;
-  int failures = 0;
-  for (std::size_t n = 0; n < points.size(); ++n)
+// One point: its folder label, the overrides that make it, its case and its folder.
+struct PointSetup
+{
+  std::string label;
+  std::vector<std::string> overrides;
+  Case point_case;
+  fs::path dir;
+};
+
+PointSetup set_up_point(const SweepPlan &plan, std::size_t n)
+{
+  PointSetup point;
+  point.overrides = plan.overrides;
+  point.label = "p" + std::to_string(n);
+  for (std::size_t k = 0; k < plan.vary.size(); ++k)
   {
-    std::vector<std::string> point_overrides = overrides;
-    std::string label = "p" + std::to_string(n);
-    for (std::size_t k = 0; k < vary.size(); ++k)
+    const std::string &key = plan.vary[k].key, &val = plan.vary[k].values[plan.points[n][k]];
+    point.overrides.push_back(key + "=" + val);
+    point.label += "_" + label_of(key, val);
+  }
+  // Keep the supplied carrier volume when a diameter changes: count × (d0/d)³, std × d/d0.
+  point.point_case = load_case(plan.case_path, point.overrides);
+  for (std::size_t k = 0; k < plan.vary.size() && plan.keep_layer; ++k)
+  {
+    std::string selector;
+    const Population *p0 = population_of(plan.base, plan.vary[k].key, selector);
+    if (!p0 || plan.vary[k].key.substr(plan.vary[k].key.find_last_of('.') + 1) != "diameter" || p0->count <= 0)
+      continue;
+    const Population *p1 = population_of(point.point_case, plan.vary[k].key, selector);
+    const double ratio = p0->diameter_mean / p1->diameter_mean;
+    const long count = std::lround(static_cast<double>(p0->count) * ratio * ratio * ratio);
+    point.overrides.push_back("populations." + selector + ".count=" + std::to_string(count));
+    char std_text[64];
+    std::snprintf(std_text, sizeof std_text, "%.9g", p0->diameter_std / ratio);
+    point.overrides.push_back("populations." + selector + ".diameter_std=" + std_text);
+    // The stable step scales with the bead size (Hertz contact time ∝ d): a case that fixes
+    // its step keeps the same fraction of the limit.
+    if (plan.base.dem.time_step > 0.0)
     {
-      const std::string &key = vary[k].key, &val = vary[k].values[points[n][k]];
-      point_overrides.push_back(key + "=" + val);
-      label += "_" + label_of(key, val);
+      std::snprintf(std_text, sizeof std_text, "%.9g", plan.base.dem.time_step / ratio);
+      point.overrides.push_back("dem.time_step=" + std::string(std_text));
     }
-    // Keep the supplied carrier volume when a diameter changes: count × (d0/d)³, std × d/d0.
-    Case point_case = load_case(case_path, point_overrides);
-    for (std::size_t k = 0; k < vary.size() && keep_layer; ++k)
+  }
+  point.dir = plan.sweep_dir / point.label;
+  point.overrides.push_back("output.directory=" + point.dir.string());
+  point.overrides.push_back("field.output_dir=" + (point.dir / "fields").string());
+  point.point_case = load_case(plan.case_path, point.overrides);
+  return point;
+}
+
+// What the table needs of a point that its folder does not already hold (dem/summary.csv,
+// dem/nip_profile.csv): its run time and status, as the table's cells. Every way of running a
+// point (serially, on an MPI rank, as a Slurm task) writes it, and the table is always built
+// from the folders, by whichever process merges.
+constexpr const char *point_result_name = "sweep_point.csv";
+
+// `rank`: the MPI rank that ran it (0 without mpirun), for the record (not in the table).
+void write_point_result(const fs::path &dir, const std::string &run_time_cell, const std::string &status, int rank)
+{
+  write_text_atomically((dir / point_result_name).string(),
+                        "# magbrush sweep: this point's run, for the sweep's table\nrun_time_s,status,rank\n" +
+                            run_time_cell + "," + status + "," + std::to_string(rank) + "\n");
+}
+
+// {run time cell, status}; {"nan", "missing"} when the point has not (or not yet) run.
+std::pair<std::string, std::string> read_point_result(const fs::path &dir)
+{
+  std::ifstream in(dir / point_result_name);
+  std::string line;
+  bool header = true;
+  while (std::getline(in, line))
+  {
+    if (line.empty() || line[0] == '#')
+      continue;
+    if (header)
     {
-      std::string selector;
-      const Population *p0 = population_of(base, vary[k].key, selector);
-      if (!p0 || vary[k].key.substr(vary[k].key.find_last_of('.') + 1) != "diameter" || p0->count <= 0)
-        continue;
-      const Population *p1 = population_of(point_case, vary[k].key, selector);
-      const double ratio = p0->diameter_mean / p1->diameter_mean;
-      const long count = std::lround(static_cast<double>(p0->count) * ratio * ratio * ratio);
-      point_overrides.push_back("populations." + selector + ".count=" + std::to_string(count));
-      char std_text[64];
-      std::snprintf(std_text, sizeof std_text, "%.9g", p0->diameter_std / ratio);
-      point_overrides.push_back("populations." + selector + ".diameter_std=" + std_text);
-      // The stable step scales with the bead size (Hertz contact time ∝ d): a case that fixes
-      // its step keeps the same fraction of the limit.
-      if (base.dem.time_step > 0.0)
-      {
-        std::snprintf(std_text, sizeof std_text, "%.9g", base.dem.time_step / ratio);
-        point_overrides.push_back("dem.time_step=" + std::string(std_text));
-      }
+      header = false;
+      continue;
     }
-    const fs::path point_dir = sweep_dir / label;
-    point_overrides.push_back("output.directory=" + point_dir.string());
-    point_overrides.push_back("field.output_dir=" + (point_dir / "fields").string());
-    point_case = load_case(case_path, point_overrides);
-    std::cout << "\n##### magbrush sweep: point " << n + 1 << "/" << points.size() << ": " << label << " ("
-              << (point_case.populations.empty() ? 0 : point_case.populations[0].count) << " beads) #####"
-              << std::endl;
-    std::vector<std::string> run_args = {"run", case_path, "--skip", skip};
-    for (const auto &o : point_overrides)
+    const auto cells = split(line, ',');
+    if (cells.size() >= 2)
+      return {cells[0], cells[1]};
+  }
+  return {"nan", "missing"};
+}
+
+// Runs point n's pipeline in its folder and keeps its result there; returns the pipeline's
+// exit code. `threads` > 0: the DEM's --threads when the user gave none (an MPI rank's share).
+// A point that throws counts as failed rather than ending the process: on an MPI rank an
+// escaping error would leave the other ranks waiting for this one forever.
+int run_point(const SweepPlan &plan, std::size_t n, const cli::ParsedArguments &args, int threads, int rank)
+{
+  const auto started = std::chrono::steady_clock::now();
+  int rc = 1;
+  fs::path dir = plan.sweep_dir / ("p" + std::to_string(n));
+  try
+  {
+    const PointSetup point = set_up_point(plan, n);
+    dir = point.dir;
+    fs::create_directories(point.dir);
+    fs::remove(point.dir / point_result_name); // a result of an earlier run must not stand for this one
+    std::cout << "\n##### magbrush sweep: point " << n + 1 << "/" << plan.points.size() << ": " << point.label
+              << " (" << (point.point_case.populations.empty() ? 0 : point.point_case.populations[0].count)
+              << " beads) #####" << std::endl;
+    std::vector<std::string> run_args = {"run", plan.case_path, "--skip", plan.skip};
+    for (const auto &o : point.overrides)
     {
       run_args.push_back("--set");
       run_args.push_back(o);
     }
     const auto stage_words = options_for_the_stages(args);
     run_args.insert(run_args.end(), stage_words.begin(), stage_words.end());
-    const auto started = std::chrono::steady_clock::now();
-    const int rc = run_pipeline(run_args);
-    const double run_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-    if (rc != 0)
-      ++failures;
+    if (threads > 0 && !args.has("--threads"))
+    {
+      run_args.push_back("--threads");
+      run_args.push_back(std::to_string(threads));
+    }
+    rc = run_pipeline(run_args);
+  }
+  catch (const std::exception &e)
+  {
+    std::cerr << "magbrush sweep: point " << n << " failed: " << e.what() << "\n";
+    rc = 1;
+  }
+  const double run_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  char cell[64];
+  std::snprintf(cell, sizeof cell, "%.1f", run_time);
+  try
+  {
+    fs::create_directories(dir);
+    write_point_result(dir, cell, rc == 0 ? "ok" : "failed", rank);
+  }
+  catch (const std::exception &e)
+  {
+    std::cerr << "magbrush sweep: cannot keep point " << n << "'s result: " << e.what() << "\n";
+    rc = rc == 0 ? 1 : rc;
+  }
+  return rc;
+}
+
+// The table, the profiles and the plots from every point's folder. Returns 1 when a point
+// failed or has not run (its row says which), else 0.
+int merge_points(const SweepPlan &plan)
+{
+  std::vector<StudyPoint> table;
+  std::vector<double> first_x; // the first varied key's SI value per point (for --measured)
+  std::ostringstream profiles;
+  profiles << "# magbrush sweep profiles of " << plan.case_path << " (columns after 'point' as in nip_profile.csv)\n";
+  bool profile_header = false;
+  std::vector<std::string> failed, missing;
+  for (std::size_t n = 0; n < plan.points.size(); ++n)
+  {
+    const PointSetup point = set_up_point(plan, n);
+    const auto [run_time_cell, status] = read_point_result(point.dir);
+    if (status == "missing")
+      missing.push_back(std::to_string(n) + " (" + point.label + ")");
+    else if (status != "ok")
+      failed.push_back(std::to_string(n) + " (" + point.label + ")");
     // Gather the point's key numbers (whatever its measurements report) and profile.
     StudyPoint row;
-    row.label = label;
-    for (std::size_t k = 0; k < vary.size(); ++k)
-      row.leading.push_back(vary[k].values[points[n][k]]);
+    row.label = point.label;
+    for (std::size_t k = 0; k < plan.vary.size(); ++k)
+      row.leading.push_back(plan.vary[k].values[plan.points[n][k]]);
     char cell[64];
-    for (std::size_t k = 0; k < vary.size(); ++k)
+    for (std::size_t k = 0; k < plan.vary.size(); ++k)
     {
-      const double x = si_value(vary[k].key, vary[k].values[points[n][k]]);
+      const double x = si_value(plan.vary[k].key, plan.vary[k].values[plan.points[n][k]]);
       std::snprintf(cell, sizeof cell, "%.9g", x);
       row.leading.push_back(cell);
       if (k == 0)
         first_x.push_back(x);
     }
-    const double d = point_case.populations.empty() ? 0.0 : point_case.populations[0].diameter_mean;
-    row.leading.push_back(std::to_string(point_case.populations.empty() ? 0L : point_case.populations[0].count));
+    const Case &c = point.point_case;
+    const double d = c.populations.empty() ? 0.0 : c.populations[0].diameter_mean;
+    row.leading.push_back(std::to_string(c.populations.empty() ? 0L : c.populations[0].count));
     std::snprintf(cell, sizeof cell, "%.4g", d * 1e6);
     row.leading.push_back(cell);
-    row.summary = read_summary_csv((point_dir / "dem" / "summary.csv").string());
+    row.summary = read_summary_csv((point.dir / "dem" / "summary.csv").string());
     // Kawamoto's contact density scales as 1/d²: density × d² is the size-free number (Fig. 24).
     for (const auto &r : std::vector<SummaryRow>(row.summary))
       if (r.key == "density_at_gap_centre_per_mm2")
         row.summary.push_back({"density_x_d2_at_gap_centre", r.value * (d * 1e3) * (d * 1e3),
                                std::numeric_limits<double>::quiet_NaN()});
-    std::snprintf(cell, sizeof cell, "%.1f", run_time);
-    row.trailing = {cell, rc == 0 ? "ok" : "failed"};
+    row.trailing = {run_time_cell, status};
     table.push_back(row);
-    std::ifstream prof(point_dir / "dem" / "nip_profile.csv");
+    std::ifstream prof(point.dir / "dem" / "nip_profile.csv");
     std::string line;
     bool header = true;
     while (std::getline(prof, line))
@@ -396,30 +543,31 @@ int sweep(const cli::ParsedArguments &args)
         profile_header = true;
         continue;
       }
-      profiles << label << "," << line << "\n";
+      profiles << point.label << "," << line << "\n";
     }
   }
   std::vector<std::string> leading_header;
-  for (const auto &v : vary)
+  for (const auto &v : plan.vary)
     leading_header.push_back(v.key);
-  for (const auto &v : vary)
+  for (const auto &v : plan.vary)
     leading_header.push_back(si_header(v.key));
   leading_header.push_back("count");
   leading_header.push_back("diameter_um");
   std::optional<MeasuredComparison> comparison;
-  if (measured)
-    comparison = compare_with(*measured, first_x, tolerance);
-  const std::string summary = study_table_csv("magbrush sweep of " + case_path, leading_header,
+  if (plan.measured)
+    comparison = compare_with(*plan.measured, first_x, plan.tolerance);
+  const std::string summary = study_table_csv("magbrush sweep of " + plan.case_path, leading_header,
                                               {"run_time_s", "status"}, table, comparison);
-  write_text_atomically((sweep_dir / "sweep_summary.csv").string(), summary);
-  write_text_atomically((sweep_dir / "sweep_profiles.csv").string(), profiles.str());
-  std::cout << "\nmagbrush sweep: " << (sweep_dir / "sweep_summary.csv").string() << "\n" << summary;
+  fs::create_directories(plan.sweep_dir);
+  write_text_atomically((plan.sweep_dir / "sweep_summary.csv").string(), summary);
+  write_text_atomically((plan.sweep_dir / "sweep_profiles.csv").string(), profiles.str());
+  std::cout << "\nmagbrush sweep: " << (plan.sweep_dir / "sweep_summary.csv").string() << "\n" << summary;
 
   // The comparison plots (tools/plot_sweep.py).
   const std::string chosen = find_tool_script("plot_sweep.py");
   const char *env_python = std::getenv("MAGBRUSH_PYTHON");
   const std::string python = env_python ? env_python : (fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3");
-  const std::vector<std::string> command = {python, chosen, "--dir", sweep_dir.string()};
+  const std::vector<std::string> command = {python, chosen, "--dir", plan.sweep_dir.string()};
   std::string failure = chosen.empty() ? "tools/plot_sweep.py not found; set MAGBRUSH_TOOLS to the tools folder" : "";
   try
   {
@@ -433,14 +581,117 @@ int sweep(const cli::ParsedArguments &args)
   }
   if (!failure.empty())
     std::cerr << "magbrush sweep: the comparison plots failed (" << failure << ": " << python << " " << chosen
-              << " --dir " << sweep_dir.string() << "); the CSV files are written\n";
-  if (failures > 0)
+              << " --dir " << plan.sweep_dir.string() << "); the CSV files are written\n";
+  auto listed = [](const std::vector<std::string> &items) {
+    std::string text;
+    for (const auto &i : items)
+      text += (text.empty() ? "" : ", ") + i;
+    return text;
+  };
+  if (!missing.empty())
+    std::cerr << "magbrush sweep: " << missing.size() << " of " << plan.points.size()
+              << " points have not run (no " << point_result_name << " in their folders): " << listed(missing)
+              << "; run them with --point INDEX, then merge again\n";
+  if (!failed.empty())
+    std::cerr << "magbrush sweep: " << failed.size() << " of " << plan.points.size()
+              << " points failed (their rows say so; see their logs in the point folders): " << listed(failed) << "\n";
+  return missing.empty() && failed.empty() ? 0 : 1;
+}
+
+// The sweep's own words as given, for the Slurm scripts: the case and any file by absolute
+// path, without --emit (the scripts add --point or --merge).
+std::vector<std::string> words_for_slurm(const cli::ParsedArguments &args)
+{
+  std::vector<std::string> words = {fs::absolute(executable_dir() + "/magbrush").lexically_normal().string(), "sweep",
+                                    fs::absolute(args.positional(0)).lexically_normal().string()};
+  for (const auto &given : args.given())
   {
-    std::cerr << "magbrush sweep: " << failures << " of " << points.size()
-              << " points failed (their rows say so; see their logs in the point folders)\n";
-    return 1;
+    if (given.option->name == "--emit")
+      continue;
+    words.push_back(given.option->name);
+    if (given.option->takes_value())
+      words.push_back(given.option->name == "--measured" ? fs::absolute(given.value).lexically_normal().string()
+                                                         : given.value);
   }
+  return words;
+}
+
+int emit_slurm(const SweepPlan &plan, const cli::ParsedArguments &args)
+{
+  fs::create_directories(plan.sweep_dir);
+  const fs::path folder = fs::absolute(plan.sweep_dir).lexically_normal();
+  SlurmSweep job;
+  job.job_name = "sweep_" + plan.name;
+  job.points = plan.points.size();
+  job.work_dir = fs::current_path().string();
+  job.log_dir = folder.string();
+  job.point_command = words_for_slurm(args);
+  job.merge_command = job.point_command;
+  job.merge_command.push_back("--merge");
+  job.threads_given = args.has("--threads");
+  const fs::path array_script = folder / (job.job_name + ".slurm");
+  const fs::path merge_script = folder / (job.job_name + "_merge.slurm");
+  write_text_atomically(array_script.string(), slurm_array_script(job, merge_script.string(), array_script.string()));
+  write_text_atomically(merge_script.string(), slurm_merge_script(job));
+  fs::permissions(array_script, fs::perms::owner_exec | fs::perms::group_exec, fs::perm_options::add);
+  fs::permissions(merge_script, fs::perms::owner_exec | fs::perms::group_exec, fs::perm_options::add);
+  std::cout << "magbrush sweep: " << plan.points.size() << " points as a Slurm job array (nothing run):\n  "
+            << array_script.string() << "\n  " << merge_script.string() << "\nSubmit them with\n  jid=$(sbatch --parsable "
+            << shell_quoted(array_script.string()) << ") && sbatch --dependency=afterok:$jid "
+            << shell_quoted(merge_script.string()) << "\n";
   return 0;
+}
+
+// --point's value: an index of this sweep's points, or an error naming the range.
+std::size_t point_index(const cli::ParsedArguments &args, const SweepPlan &plan)
+{
+  const std::string text = args.value("--point");
+  const std::size_t n = plan.points.size();
+  char *end = nullptr;
+  const long long i = std::strtoll(text.c_str(), &end, 10);
+  if (text.empty() || *end != '\0' || i < 0 || static_cast<unsigned long long>(i) >= n)
+    throw cli::UsageError("--point expects a point of this sweep, 0 to " + std::to_string(n - 1) + " (" +
+                          std::to_string(n) + " points), found '" + text + "'");
+  return static_cast<std::size_t>(i);
+}
+
+int sweep(const cli::ParsedArguments &args)
+{
+  const bool one_point = args.has("--point"), merge_only = args.has("--merge"), emit = args.has("--emit");
+  if (one_point + merge_only + emit > 1)
+    throw cli::UsageError("--point, --merge and --emit are steps of their own: give one of them");
+  if ((one_point || merge_only || emit) && launched_by_mpi())
+    throw cli::UsageError(std::string(one_point ? "--point" : merge_only ? "--merge" : "--emit") +
+                          " is one process's step: run it without mpirun (mpirun -np K magbrush sweep ... "
+                          "deals the points to the ranks by itself)");
+  const SweepPlan plan = plan_sweep(args);
+  if (emit)
+    return emit_slurm(plan, args);
+  if (merge_only)
+    return merge_points(plan);
+  fs::create_directories(plan.sweep_dir);
+  if (one_point)
+    return run_point(plan, point_index(args, plan), args, 0, 0);
+
+  // Every point, dealt to the ranks of an MPI job (one rank of one without mpirun).
+  const SweepRanks ranks;
+  const int threads = ranks.threads_per_rank();
+  if (ranks.rank() == 0)
+    std::cout << "magbrush sweep: " << plan.points.size() << " points into " << plan.sweep_dir.string() << "/\n";
+  if (ranks.distributed())
+    std::cout << "magbrush sweep: rank " << ranks.rank() << " of " << ranks.size() << " runs points "
+              << ranks.rank() << ", " << ranks.rank() + ranks.size() << ", ... with "
+              << (args.has("--threads") ? args.value("--threads") : std::to_string(threads)) << " DEM threads"
+              << std::endl;
+  int failures = 0;
+  for (std::size_t n = 0; n < plan.points.size(); ++n)
+    if (ranks.owns(n) && run_point(plan, n, args, threads, ranks.rank()) != 0)
+      ++failures;
+  // Every rank has finished its points here: rank 0 alone writes the table, once.
+  const int failed_anywhere = ranks.sum_over_ranks(failures);
+  if (ranks.rank() != 0)
+    return failed_anywhere > 0 ? 1 : 0;
+  return merge_points(plan);
 }
 
 int run_sweep(const std::vector<std::string> &args)

@@ -1,0 +1,232 @@
+// `magbrush sweep` beyond one process, on the small box scene of test_sweep.cpp (two points,
+// DEM only): `mpirun -np 2 magbrush sweep` deals the points to two ranks, and a Slurm job
+// array's steps (--emit slurm, each --point, --merge) run here one after the other. Either way
+// the table must equal the serial sweep's bit for bit in every column but the run time, and
+// each point's DEM time series (energies, contacts, wall forces at full precision) must be the
+// same file: the points ran the same simulation wherever they ran.
+#include "common/child_process.h"
+
+#include "tests/test_temp_dir.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const char *box_case = R"(name: sweep_box
+scene: box
+planes:
+  - {name: stage, point: [0 mm, 0 mm, 0 mm], normal: [0, 0, 1], material: wall}
+materials:
+  carrier: {youngs_modulus: 100 MPa, poisson_ratio: 0.35, density: 2200 kg/m^3, friction: 0.45, damping: 0.6}
+  wall: {youngs_modulus: 5e4 MPa, poisson_ratio: 0.3, friction: 0.35}
+populations:
+  - {name: carrier, kind: carrier, material: carrier, diameter: 100 um, count: 100, insert_box: [[0 mm, 0 mm, 0.05 mm], [1 mm, 1 mm, 1 mm]]}
+dem: {duration: 20 us, output_interval: 10 us, periodic_length_x: 1 mm, periodic_length_y: 1 mm, gravity: [0, 0, -9.81 m/s^2]}
+)";
+
+const std::string magbrush = std::string(MAGBRUSH_BINARY_DIR) + "/bin/magbrush";
+
+struct Result
+{
+  int status;
+  std::string output;
+};
+
+std::string text_of(const fs::path &file)
+{
+  std::ifstream in(file);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+Result run(const fs::path &log, const std::vector<std::string> &command)
+{
+  magbrush::ChildOutput output;
+  output.stdout_path = log.string();
+  output.stderr_to_stdout = true;
+  const int status = magbrush::run_program(command, output);
+  return {status, text_of(log)};
+}
+
+// The sweep's words after `magbrush`, into `out`.
+std::vector<std::string> sweep_words(const fs::path &dir, const fs::path &out)
+{
+  return {"sweep", (dir / "box.yaml").string(), "--vary", "populations.carrier.diameter=100um,120um",
+          "--skip", "mesh,field,report", "--set", "output.directory=" + out.string()};
+}
+
+std::vector<std::string> with(std::vector<std::string> words, const std::vector<std::string> &more)
+{
+  words.insert(words.end(), more.begin(), more.end());
+  return words;
+}
+
+std::vector<std::vector<std::string>> rows_of(const fs::path &csv)
+{
+  std::vector<std::vector<std::string>> rows;
+  std::istringstream in(text_of(csv));
+  std::string line;
+  while (std::getline(in, line))
+  {
+    if (line.empty() || line[0] == '#')
+      continue;
+    std::vector<std::string> cells;
+    std::stringstream l(line);
+    for (std::string c; std::getline(l, c, ',');)
+      cells.push_back(c);
+    rows.push_back(cells);
+  }
+  return rows;
+}
+
+const char *const point_folders[] = {"p0_diameter-100um", "p1_diameter-120um"};
+
+// Every cell but run_time_s equal, as text (bit for bit); the run times present and numeric.
+void expect_same_table_but_run_time(const fs::path &serial, const fs::path &other)
+{
+  const auto a = rows_of(serial / "sweep_diameter" / "sweep_summary.csv");
+  const auto b = rows_of(other / "sweep_diameter" / "sweep_summary.csv");
+  ASSERT_EQ(a.size(), 3u);
+  ASSERT_EQ(b.size(), a.size());
+  ASSERT_EQ(b[0], a[0]) << "the headers differ";
+  std::size_t run_time = a[0].size();
+  for (std::size_t k = 0; k < a[0].size(); ++k)
+    if (a[0][k] == "run_time_s")
+      run_time = k;
+  ASSERT_LT(run_time, a[0].size()) << "no run_time_s column";
+  for (std::size_t r = 1; r < a.size(); ++r)
+  {
+    ASSERT_EQ(b[r].size(), a[r].size()) << "row " << r;
+    for (std::size_t k = 0; k < a[r].size(); ++k)
+    {
+      if (k == run_time)
+        continue;
+      EXPECT_EQ(b[r][k], a[r][k]) << "row " << r << ", column " << a[0][k];
+    }
+    EXPECT_GE(std::stod(b[r][run_time]), 0.0);
+  }
+  EXPECT_EQ(a[1].back(), "ok");
+  EXPECT_EQ(a[2].back(), "ok");
+  EXPECT_EQ(text_of(other / "sweep_diameter" / "sweep_profiles.csv"),
+            text_of(serial / "sweep_diameter" / "sweep_profiles.csv"));
+  for (const char *point : point_folders)
+  {
+    const std::string series = text_of(serial / "sweep_diameter" / point / "dem" / "time_series.csv");
+    EXPECT_GT(series.size(), 100u) << point;
+    EXPECT_EQ(text_of(other / "sweep_diameter" / point / "dem" / "time_series.csv"), series) << point;
+  }
+}
+
+class DistributedSweep : public ::testing::Test
+{
+protected:
+  static void SetUpTestSuite()
+  {
+    dir_ = magbrush::testing::test_temp_dir("app_sweep_distributed");
+    std::ofstream(dir_ / "box.yaml") << box_case;
+    serial_ = run(dir_ / "serial.log", with({magbrush}, sweep_words(dir_, dir_ / "serial")));
+  }
+  static void TearDownTestSuite() { fs::remove_all(dir_); }
+
+  static fs::path dir_;
+  static Result serial_;
+};
+fs::path DistributedSweep::dir_;
+Result DistributedSweep::serial_;
+
+TEST_F(DistributedSweep, TwoMpiRanksGiveTheSerialTableBitForBit)
+{
+  ASSERT_EQ(serial_.status, 0) << serial_.output;
+  if (!magbrush::program_exists("mpirun"))
+    GTEST_SKIP() << "mpirun is not on the PATH (OpenMPI not installed): the MPI sweep is not tested";
+  // OpenMPI refuses root (containers, CI) unless told so; oversubscribe: two ranks on any machine.
+  setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
+  setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
+  const Result mpi = run(dir_ / "mpi.log", with({"mpirun", "-np", "2", "--oversubscribe", magbrush},
+                                                sweep_words(dir_, dir_ / "mpi")));
+  ASSERT_EQ(mpi.status, 0) << mpi.output;
+  // Each rank ran its own point (i mod 2), and the table was written once.
+  EXPECT_NE(mpi.output.find("rank 0 of 2 runs points 0, 2"), std::string::npos) << mpi.output;
+  EXPECT_NE(mpi.output.find("rank 1 of 2 runs points 1, 3"), std::string::npos) << mpi.output;
+  std::size_t tables = 0;
+  for (auto at = mpi.output.find("sweep_summary.csv\n"); at != std::string::npos;
+       at = mpi.output.find("sweep_summary.csv\n", at + 1))
+    ++tables;
+  EXPECT_EQ(tables, 1u) << mpi.output;
+  // The point folders record the rank that ran them: point i on rank i mod 2.
+  for (int i = 0; i < 2; ++i)
+    EXPECT_EQ(rows_of(dir_ / "mpi" / "sweep_diameter" / point_folders[i] / "sweep_point.csv").at(1).at(2),
+              std::to_string(i))
+      << point_folders[i];
+  expect_same_table_but_run_time(dir_ / "serial", dir_ / "mpi");
+}
+
+TEST_F(DistributedSweep, SlurmArrayStepsRunOneByOneGiveTheSerialTable)
+{
+  ASSERT_EQ(serial_.status, 0) << serial_.output;
+  const fs::path out = dir_ / "slurm";
+  const Result emitted = run(dir_ / "emit.log", with({magbrush}, with(sweep_words(dir_, out), {"--emit", "slurm"})));
+  ASSERT_EQ(emitted.status, 0) << emitted.output;
+  const fs::path array = out / "sweep_diameter" / "sweep_diameter.slurm";
+  const fs::path merge = out / "sweep_diameter" / "sweep_diameter_merge.slurm";
+  ASSERT_TRUE(fs::exists(array)) << emitted.output;
+  ASSERT_TRUE(fs::exists(merge)) << emitted.output;
+  // Nothing ran: no point folder yet.
+  EXPECT_FALSE(fs::exists(out / "sweep_diameter" / point_folders[0]));
+  const std::string script = text_of(array), merge_script = text_of(merge);
+  EXPECT_EQ(script.rfind("#!/bin/bash\n", 0), 0u);
+  EXPECT_NE(script.find("\n#SBATCH --array=0-1\n"), std::string::npos) << script;
+  EXPECT_NE(script.find("\n#SBATCH --cpus-per-task="), std::string::npos) << script;
+  EXPECT_NE(script.find("exec " + magbrush + " sweep " + (dir_ / "box.yaml").string() + " --vary "),
+            std::string::npos)
+    << script;
+  EXPECT_NE(script.find("--point \"$SLURM_ARRAY_TASK_ID\""), std::string::npos) << script;
+  EXPECT_EQ(script.substr(script.find("\nexec ")).find("--emit"), std::string::npos) << script;
+  EXPECT_NE(script.find("--dependency=afterok:$jid"), std::string::npos) << script;
+  EXPECT_EQ(merge_script.find("--array"), std::string::npos) << merge_script;
+  EXPECT_NE(merge_script.find(" --merge\n"), std::string::npos) << merge_script;
+  // Valid bash (sbatch reads the #SBATCH lines, bash the rest).
+  for (const auto &s : {array, merge})
+  {
+    const Result syntax = run(dir_ / "syntax.log", {"bash", "-n", s.string()});
+    EXPECT_EQ(syntax.status, 0) << s << ": " << syntax.output;
+  }
+
+  // A merge before any point ran says which points are missing and fails.
+  const Result early = run(dir_ / "early.log", {"bash", merge.string()});
+  EXPECT_NE(early.status, 0);
+  EXPECT_NE(early.output.find("2 of 2 points have not run"), std::string::npos) << early.output;
+
+  // Slurm's stand-in: each array task as Slurm would start it (the script, SLURM_ARRAY_TASK_ID
+  // set), one after the other, then the merge step.
+  for (const char *task : {"0", "1"})
+  {
+    setenv("SLURM_ARRAY_TASK_ID", task, 1);
+    setenv("SLURM_CPUS_PER_TASK", "1", 1);
+    const Result point = run(dir_ / "task.log", {"bash", array.string()});
+    ASSERT_EQ(point.status, 0) << "task " << task << ": " << point.output;
+    EXPECT_EQ(point.output.find("sweep_summary.csv"), std::string::npos) << "a task wrote the table";
+  }
+  unsetenv("SLURM_ARRAY_TASK_ID");
+  unsetenv("SLURM_CPUS_PER_TASK");
+  const Result merged = run(dir_ / "merge.log", {"bash", merge.string()});
+  ASSERT_EQ(merged.status, 0) << merged.output;
+  expect_same_table_but_run_time(dir_ / "serial", out);
+
+  // A point outside the sweep is refused, naming the range.
+  const Result outside = run(dir_ / "outside.log", with({magbrush}, with(sweep_words(dir_, out), {"--point", "2"})));
+  EXPECT_NE(outside.status, 0);
+  EXPECT_NE(outside.output.find("--point expects a point of this sweep, 0 to 1 (2 points), found '2'"),
+            std::string::npos)
+    << outside.output;
+}
+
+} // namespace

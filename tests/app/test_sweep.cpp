@@ -4,6 +4,8 @@
 #include "common/child_process.h"
 #include "common/study_table.h"
 
+#include "tests/app/sweep_box_case.h"
+#include "tests/csv_columns.h"
 #include "tests/test_temp_dir.h"
 
 #include <gtest/gtest.h>
@@ -15,18 +17,6 @@
 namespace {
 
 namespace fs = std::filesystem;
-
-const char *box_case = R"(name: sweep_box
-scene: box
-planes:
-  - {name: stage, point: [0 mm, 0 mm, 0 mm], normal: [0, 0, 1], material: wall}
-materials:
-  carrier: {youngs_modulus: 100 MPa, poisson_ratio: 0.35, density: 2200 kg/m^3, friction: 0.45, damping: 0.6}
-  wall: {youngs_modulus: 5e4 MPa, poisson_ratio: 0.3, friction: 0.35}
-populations:
-  - {name: carrier, kind: carrier, material: carrier, diameter: 100 um, count: 100, insert_box: [[0 mm, 0 mm, 0.05 mm], [1 mm, 1 mm, 1 mm]]}
-dem: {duration: 20 us, output_interval: 10 us, periodic_length_x: 1 mm, periodic_length_y: 1 mm, gravity: [0, 0, -9.81 m/s^2]}
-)";
 
 struct Result
 {
@@ -49,30 +39,12 @@ Result magbrush_run(const fs::path &dir, const std::vector<std::string> &args)
   return r;
 }
 
-std::vector<std::vector<std::string>> rows_of(const fs::path &csv)
-{
-  std::vector<std::vector<std::string>> rows;
-  std::ifstream in(csv);
-  std::string line;
-  while (std::getline(in, line))
-  {
-    if (line.empty() || line[0] == '#')
-      continue;
-    std::vector<std::string> cells;
-    std::stringstream l(line);
-    for (std::string c; std::getline(l, c, ',');)
-      cells.push_back(c);
-    rows.push_back(cells);
-  }
-  return rows;
-}
-
 } // namespace
 
 TEST(Sweep, TabulatesEveryPointWithItsSIValueRunTimeAndMeasuredComparison)
 {
   const fs::path dir = magbrush::testing::test_temp_dir("app_sweep");
-  std::ofstream(dir / "box.yaml") << box_case;
+  std::ofstream(dir / "box.yaml") << magbrush::testing::sweep_box_case;
   // The box scene has no measurement with a summary; its steady-state verdict is "nan" (nothing
   // tested), which the comparison must carry through as "no verdict".
   std::ofstream(dir / "measured.csv") << "# a measured series\npopulations.carrier.diameter,steady_state\n100um,1\n";
@@ -81,7 +53,7 @@ TEST(Sweep, TabulatesEveryPointWithItsSIValueRunTimeAndMeasuredComparison)
                                       "--set", "output.directory=" + (dir / "out").string(), "--measured",
                                       (dir / "measured.csv").string()});
   ASSERT_EQ(r.status, 0) << r.output;
-  const auto rows = rows_of(dir / "out" / "sweep_diameter" / "sweep_summary.csv");
+  const auto rows = magbrush::testing::read_csv_rows(dir / "out" / "sweep_diameter" / "sweep_summary.csv");
   ASSERT_EQ(rows.size(), 3u) << r.output;
   const auto &h = rows[0];
   auto column = [&](const std::string &name) {

@@ -6,6 +6,8 @@
 // same file: the points ran the same simulation wherever they ran.
 #include "common/child_process.h"
 
+#include "tests/app/sweep_box_case.h"
+#include "tests/csv_columns.h"
 #include "tests/test_temp_dir.h"
 
 #include <gtest/gtest.h>
@@ -18,18 +20,6 @@
 namespace {
 
 namespace fs = std::filesystem;
-
-const char *box_case = R"(name: sweep_box
-scene: box
-planes:
-  - {name: stage, point: [0 mm, 0 mm, 0 mm], normal: [0, 0, 1], material: wall}
-materials:
-  carrier: {youngs_modulus: 100 MPa, poisson_ratio: 0.35, density: 2200 kg/m^3, friction: 0.45, damping: 0.6}
-  wall: {youngs_modulus: 5e4 MPa, poisson_ratio: 0.3, friction: 0.35}
-populations:
-  - {name: carrier, kind: carrier, material: carrier, diameter: 100 um, count: 100, insert_box: [[0 mm, 0 mm, 0.05 mm], [1 mm, 1 mm, 1 mm]]}
-dem: {duration: 20 us, output_interval: 10 us, periodic_length_x: 1 mm, periodic_length_y: 1 mm, gravity: [0, 0, -9.81 m/s^2]}
-)";
 
 const std::string magbrush = std::string(MAGBRUSH_BINARY_DIR) + "/bin/magbrush";
 
@@ -69,31 +59,13 @@ std::vector<std::string> with(std::vector<std::string> words, const std::vector<
   return words;
 }
 
-std::vector<std::vector<std::string>> rows_of(const fs::path &csv)
-{
-  std::vector<std::vector<std::string>> rows;
-  std::istringstream in(text_of(csv));
-  std::string line;
-  while (std::getline(in, line))
-  {
-    if (line.empty() || line[0] == '#')
-      continue;
-    std::vector<std::string> cells;
-    std::stringstream l(line);
-    for (std::string c; std::getline(l, c, ',');)
-      cells.push_back(c);
-    rows.push_back(cells);
-  }
-  return rows;
-}
-
 const char *const point_folders[] = {"p0_diameter-100um", "p1_diameter-120um"};
 
 // Every cell but run_time_s equal, as text (bit for bit); the run times present and numeric.
 void expect_same_table_but_run_time(const fs::path &serial, const fs::path &other)
 {
-  const auto a = rows_of(serial / "sweep_diameter" / "sweep_summary.csv");
-  const auto b = rows_of(other / "sweep_diameter" / "sweep_summary.csv");
+  const auto a = magbrush::testing::read_csv_rows(serial / "sweep_diameter" / "sweep_summary.csv");
+  const auto b = magbrush::testing::read_csv_rows(other / "sweep_diameter" / "sweep_summary.csv");
   ASSERT_EQ(a.size(), 3u);
   ASSERT_EQ(b.size(), a.size());
   ASSERT_EQ(b[0], a[0]) << "the headers differ";
@@ -131,7 +103,7 @@ protected:
   static void SetUpTestSuite()
   {
     dir_ = magbrush::testing::test_temp_dir("app_sweep_distributed");
-    std::ofstream(dir_ / "box.yaml") << box_case;
+    std::ofstream(dir_ / "box.yaml") << magbrush::testing::sweep_box_case;
     serial_ = run(dir_ / "serial.log", with({magbrush}, sweep_words(dir_, dir_ / "serial")));
   }
   static void TearDownTestSuite() { fs::remove_all(dir_); }
@@ -163,7 +135,7 @@ TEST_F(DistributedSweep, TwoMpiRanksGiveTheSerialTableBitForBit)
   EXPECT_EQ(tables, 1u) << mpi.output;
   // The point folders record the rank that ran them: point i on rank i mod 2.
   for (int i = 0; i < 2; ++i)
-    EXPECT_EQ(rows_of(dir_ / "mpi" / "sweep_diameter" / point_folders[i] / "sweep_point.csv").at(1).at(2),
+    EXPECT_EQ(magbrush::testing::read_csv_rows(dir_ / "mpi" / "sweep_diameter" / point_folders[i] / "sweep_point.csv").at(1).at(2),
               std::to_string(i))
       << point_folders[i];
   expect_same_table_but_run_time(dir_ / "serial", dir_ / "mpi");

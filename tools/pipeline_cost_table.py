@@ -10,10 +10,10 @@ synthetic table:
   flux density against angle): the largest deviation over the profile divided by the
   profile's largest magnitude (an error of the peak-normalised profile, as the field
   solver's own check reports it);
-* the noise of an observable: the relative error of a repeat of the reference that differs
-  only in the random seed. The DEM's trajectories are chaotic, so any change of a knob moves
-  a measured mean by about this much even when the knob itself changes nothing; an error at
-  or below the noise is reported as "below noise", never as a small number;
+* the noise of an observable: the largest relative change among repeats of the reference that
+  differ only in the random seed (another realisation of the same scene). A knob that makes
+  the DEM's trajectories diverge moves a measured mean by up to this much by chance alone, so
+  an error at or below the noise is reported as "below noise", never as a small number;
 * the cheapest setting of a knob within a tolerance: the fastest setting whose error is
   certified below the tolerance. An error below the noise only certifies "below the noise",
   so where the noise itself exceeds the tolerance no setting can be certified and the answer

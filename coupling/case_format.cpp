@@ -291,6 +291,7 @@ std::vector<ResolvedEntry> resolved_entries(const Case &c)
   e.q("inflow.areal_mass", "inflow.areal_mass", flow.inflow_areal_mass);
   e.q("inflow.angle", "inflow.angle", flow.inflow_angle);
   e.q("inflow.layer_height", "inflow.layer_height", flow.inflow_layer_height);
+  e.s("inflow.supply", "inflow.supply", flow.inflow_supply);
   e.q("inflow.interval", "inflow.interval", flow.interval);
   e.q("outflow.angle", "outflow.angle", flow.outflow_angle);
   e.q("outflow.width", "outflow.width", flow.outflow_width);
@@ -302,6 +303,14 @@ std::vector<ResolvedEntry> resolved_entries(const Case &c)
   e.q("development.measure_to", "development.measure_to", c.development.measure_to);
   e.q("development.sample_interval", "development.sample_interval", c.development.sample_interval);
   e.q("development.average_from", "development.average_from", c.development.average_from);
+  e.q("dma.after_blade", "dma.after_blade", c.dma.after_blade);
+  e.q("dma.window", "dma.window", c.dma.window);
+  e.q("dma.height", "dma.height", c.dma.height);
+  e.q("dma.front_window", "dma.front_window", c.dma.front_window);
+  e.q("dma.release_from", "dma.release_from", c.dma.release_from);
+  e.q("dma.release_to", "dma.release_to", c.dma.release_to);
+  e.q("dma.sample_interval", "dma.sample_interval", c.dma.sample_interval);
+  e.q("dma.average_from", "dma.average_from", c.dma.average_from);
   e.q("statistics.steady_drift", "statistics.steady_drift", c.statistics.steady_drift);
   e.i("statistics.blocks", "statistics.blocks", c.statistics.blocks);
   e.q("nip.average_from", "nip.average_from", c.nip.average_from);

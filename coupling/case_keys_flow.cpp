@@ -25,6 +25,11 @@ std::vector<KeySpec> flow_keys()
       quantity("inflow.layer_height", D::length, "New particles are placed within this distance of the sleeve surface "
                                                  "(at random, without overlap).")
           .def("0.5 mm").positive(),
+      choice("inflow.supply", {"fixed", "sump"},
+             "fixed: exactly areal_mass is fed, and a run whose entry arc has no room for it stops with an error; "
+             "sump: the inflow stands for a sump that offers areal_mass, and what finds no room in the entry arc "
+             "(a pile backed up from a doctor blade) stays in the sump: the mass picked up is then measured, not set.")
+          .def("fixed"),
       quantity("inflow.interval", D::time, "Time between exchanges: insertions and removals happen every interval.")
           .def("1 us").positive(),
 

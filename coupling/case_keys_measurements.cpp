@@ -33,6 +33,29 @@ std::vector<KeySpec> measurement_keys()
       quantity("development.average_from", D::time, "Sample from this time on (after the transient).")
           .def("0 s").non_negative(),
 
+      section("dma", "The developer on the sleeve after the doctor blade (a roller scene with a doctor blade): "
+                     "developer mass per area (DMA) in a window past the blade and from the flux through it, the "
+                     "blade's load, the developer held in front of the blade, the fraction released "
+                     "(docs/regulation.md)."),
+      quantity("dma.after_blade", D::angle, "The DMA window is centred this far past the doctor blade's tip, in the "
+                                            "direction the sleeve turns; the flux is counted through its centre line.")
+          .def("10 deg").positive().max(pi),
+      quantity("dma.window", D::angle, "Angular width of the DMA window.").def("10 deg").positive().max(pi),
+      quantity("dma.height", D::length, "Only particles within this distance of the sleeve surface count (the "
+                                        "layer the sleeve carries).")
+          .def("2 mm").positive(),
+      quantity("dma.front_window", D::angle, "The developer held in front of the blade is weighed in this sector "
+                                             "just before its tip.")
+          .def("20 deg").positive().max(pi),
+      quantity("dma.release_from", D::angle, "Release: a radial line before the release sector (roller angle); "
+                                             "equal to dma.release_to: not measured.")
+          .def("0 deg").min(-2.0 * pi).max(2.0 * pi),
+      quantity("dma.release_to", D::angle, "Release: a radial line after it; the released fraction is "
+                                           "1 - (flux after) / (flux before), near the sleeve.")
+          .def("0 deg").min(-2.0 * pi).max(2.0 * pi),
+      quantity("dma.sample_interval", D::time, "Time between samples.").def("10 us").positive(),
+      quantity("dma.average_from", D::time, "Sample from this time on (after the transient).").def("0 s").non_negative(),
+
       section("statistics", "How a run's measured means are judged (every measurement's summary, dem/summary.csv): "
                             "standard errors by block averaging, steady state by the drift between halves."),
       number("statistics.steady_drift", "A mean counts as steady when the means of the two halves of its averaging "

@@ -285,6 +285,23 @@ struct DevelopmentSettings
   double average_from = 0.0;      // [s]
 };
 
+// The developer on the sleeve after the doctor blade (dem/measurements/developer_mass_per_area.h):
+// the developer mass per area (DMA) in a window downstream of the blade, the same from the
+// flux through the window's centre line, the blade's load, the developer held in front of the
+// blade and, when a release sector is given, the fraction of the developer that leaves the
+// sleeve there. Angles are roller angles; offsets count in the direction the sleeve turns.
+struct DmaSettings
+{
+  double after_blade = 10.0 * 3.14159265358979323846 / 180.0;  // window centre: this far past the blade tip [rad]
+  double window = 10.0 * 3.14159265358979323846 / 180.0;       // angular width of the window [rad]
+  double height = 2e-3;              // only particles within this of the sleeve surface count [m]
+  double front_window = 20.0 * 3.14159265358979323846 / 180.0; // sector before the blade weighed [rad]
+  double release_from = 0.0;         // release: flux line before the release [rad]
+  double release_to = 0.0;           // and after it [rad] (equal: not measured)
+  double sample_interval = 10e-6;    // [s]
+  double average_from = 0.0;         // [s]
+};
+
 // How the measurements' summaries judge their means (dem/measurements/sample_series.h).
 struct StatisticsSettings
 {
@@ -305,6 +322,9 @@ struct FlowSettings
   double inflow_areal_mass = 0.0;    // developer (carrier + toner) mass per sleeve area [kg/m²] (0 = no inflow)
   double inflow_angle = 0.0;         // entry angle [rad]
   double inflow_layer_height = 0.5e-3; // the new particles are placed within this of the sleeve surface [m]
+  // "fixed": exactly areal_mass is fed (an error when it finds no room); "sump": areal_mass is
+  // offered, and what finds no room in the entry arc stays in the sump (the pick-up is measured).
+  std::string inflow_supply = "fixed";
   double interval = 1e-6;            // time between exchanges [s]
   double outflow_angle = 0.0;        // start of the removal sector [rad]
   double outflow_width = 0.0;        // its angular extent [rad] (0 = no outflow sector)
@@ -345,6 +365,7 @@ struct Case
   CompressionSettings compression; // added by the compression study
   StatisticsSettings statistics;   // standard errors and the steady-state test of every summary
   DevelopmentSettings development; // the toner-development measurement
+  DmaSettings dma;                    // the developer on the sleeve after the doctor blade
   FlowSettings flow;                  // particles entering and leaving (inflow, outflow, flow report)
   OutputSettings output;
   std::string measured_flux_file;     // optional gaussmeter scan to overlay in the report

@@ -778,6 +778,15 @@ private:
     c.development.measure_to = q(dv, "measure_to");
     c.development.sample_interval = q(dv, "sample_interval");
     c.development.average_from = q(dv, "average_from");
+    const Scope dm = top.child("dma");
+    c.dma.after_blade = q(dm, "after_blade");
+    c.dma.window = q(dm, "window");
+    c.dma.height = q(dm, "height");
+    c.dma.front_window = q(dm, "front_window");
+    c.dma.release_from = q(dm, "release_from");
+    c.dma.release_to = q(dm, "release_to");
+    c.dma.sample_interval = q(dm, "sample_interval");
+    c.dma.average_from = q(dm, "average_from");
     const Scope st = top.child("statistics");
     c.statistics.steady_drift = q(st, "steady_drift");
     c.statistics.blocks = static_cast<int>(integer(st, "blocks"));
@@ -1014,6 +1023,7 @@ private:
     f.inflow_areal_mass = q(in, "areal_mass");
     f.inflow_angle = q(in, "angle");
     f.inflow_layer_height = q(in, "layer_height");
+    f.inflow_supply = str(in, "supply");
     f.interval = q(in, "interval");
     f.outflow_angle = q(out, "angle");
     f.outflow_width = q(out, "width");

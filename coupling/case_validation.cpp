@@ -215,6 +215,14 @@ void check_planes(const Case &c, std::vector<CaseIssue> &out)
   }
 }
 
+const Population *first_carrier(const Case &c)
+{
+  for (const auto &p : c.populations)
+    if (p.kind == ParticleKind::carrier)
+      return &p;
+  return nullptr;
+}
+
 void check_populations(const Case &c, std::vector<CaseIssue> &out)
 {
   bool has_carrier = false;
@@ -238,7 +246,10 @@ void check_populations(const Case &c, std::vector<CaseIssue> &out)
                                                  " (mean " + L(p.diameter_mean) + ", std " + L(p.diameter_std) +
                                                  "); expected std <= mean / 3"});
     const int given = (p.count > 0) + (p.mass > 0.0) + (p.concentration > 0.0);
-    if (given != 1)
+    // The carrier population the inflow feeds may start empty: all of it comes with the sleeve.
+    const bool fed_from_empty = given == 0 && c.flow.inflow() && p.kind == ParticleKind::carrier &&
+                                (c.flow.inflow_population.empty() ? &p == first_carrier(c) : c.flow.inflow_population == p.name);
+    if (given != 1 && !fed_from_empty)
       out.push_back({path, "give exactly one of count, mass, concentration (found " + std::to_string(given) + ")"});
     if (p.concentration > 0.0 && p.kind != ParticleKind::toner)
       out.push_back({path + ".concentration", "concentration (toner mass / carrier mass) is for toner populations only"});
@@ -263,7 +274,7 @@ void check_populations(const Case &c, std::vector<CaseIssue> &out)
           out.push_back({path + ".insert_box", "the box's first corner must be below its second in x, y and z"});
           break;
         }
-    if (!p.insert_box && p.layer_thickness <= 0.0)
+    if (!p.insert_box && p.layer_thickness <= 0.0 && !fed_from_empty)
       out.push_back({path, "say where the particles go: insert_box or layer_thickness"});
     if (p.layer_thickness > 0.0 && !c.sleeve)
       out.push_back({path + ".layer_thickness", "a layer on the sleeve needs a sleeve"});

@@ -100,6 +100,10 @@ std::vector<double> draw_diameters(const Case &c, const Population &p, double ca
     return d;
   }
   double target = p.mass;
+  // A population the inflow feeds may start empty (checked by the case validation): its
+  // particles, and the toner attached to them, all come with the sleeve.
+  if (c.flow.inflow() && target <= 0.0 && (p.concentration <= 0.0 || carrier_mass <= 0.0))
+    return d;
   if (target <= 0.0 && p.concentration > 0.0)
   {
     if (carrier_mass <= 0.0)
@@ -143,6 +147,8 @@ void insert_populations(const Case &c, const DemWalls &walls, const PeriodicBox 
     const Population &p = c.populations[s];
     const Material &mat = c.material(p.material);
     auto &d = diameters[s];
+    if (d.empty())
+      continue; // fed by the inflow only
     std::sort(d.begin(), d.end(), std::greater<double>()); // largest first: jams last
     const std::vector<double> charge = draw_charges(p, d, mat.density, charge_rng);
     // The region's sampler, given the radius.

@@ -64,6 +64,7 @@ ParticleSource::ParticleSource(const Case &c, const DemWalls &walls, const Perio
   omega_ = c.sleeve->omega();
   spin_up_ = c.sleeve->spin_up_time;
   areal_mass_ = f.inflow_areal_mass;
+  sump_ = f.inflow_supply == "sump";
   carrier_share_ = 1.0 / (1.0 + tc);
   // Random insertion jams near 30-40 % solid; refuse a layer that would need more.
   const double free_height = height_ - carrier_.d_mean;
@@ -232,7 +233,14 @@ void ParticleSource::create(const ParticleState &state, double t, ParticleState 
     if (owed_carrier_ < 0.5 * sphere_mass(d, carrier_.density))
       break;
     if (!place_carrier(d, theta_in_, span, t, enter))
+    {
+      if (sump_) // no room: the rest stays in the sump
+      {
+        declined_mass_ += owed_carrier_;
+        owed_carrier_ = 0.0;
+      }
       break;
+    }
     owed_carrier_ -= sphere_mass(d, carrier_.density);
     pending_d_ = 0.0;
   }
@@ -252,6 +260,7 @@ void ParticleSource::write_state(CheckpointWriter &out) const
   out.put(t_last_);
   out.put(owed_carrier_);
   out.put(pending_d_);
+  out.put(declined_mass_);
   out.put_array(owed_toner_);
   out.put_array(count_);
   out.put_array(mass_);
@@ -265,6 +274,7 @@ void ParticleSource::read_state(CheckpointReader &in)
   t_last_ = in.get<double>();
   owed_carrier_ = in.get<double>();
   pending_d_ = in.get<double>();
+  declined_mass_ = in.get<double>();
   in.get_array(owed_toner_);
   in.get_array(count_);
   in.get_array(mass_);

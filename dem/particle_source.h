@@ -18,7 +18,11 @@
 // is owed to the next carrier). The carriers' share of Γ is Γ / (1 + ΣTC).
 //
 // What is owed and not placed (a drawn diameter that did not fit, mass below one particle)
-// stays owed: over a run the mass created follows Γ R φ(t) L_z to within one particle. The
+// stays owed: over a run the mass created follows Γ R φ(t) L_z to within one particle.
+// With inflow.supply: sump the inflow stands for a sump that OFFERS Γ: when the entry arc has
+// no room (the pile in front of a doctor blade has backed up to it), what is owed beyond the
+// fraction of a particle is declined and counted (declined_mass), and the mass picked up is
+// what the flow report measures. The
 // random stream, the mass owed and the counts are written into checkpoints.
 #pragma once
 
@@ -50,6 +54,9 @@ public:
   // One particle per fed population at its smallest diameter (for the stable time step).
   void smallest_particles(ParticleState &out) const;
 
+  // Offered by a sump (inflow.supply: sump) and left there for want of room so far [kg].
+  double declined_mass() const { return declined_mass_; }
+
   // Created so far, per population index: number and mass [kg].
   const std::vector<long> &created_count() const { return count_; }
   const std::vector<double> &created_mass() const { return mass_; }
@@ -74,6 +81,7 @@ private:
   PeriodicBox box_;
   double R_ = 0.0, Lz_ = 0.0, height_ = 0.0, theta_in_ = 0.0, omega_ = 0.0, spin_up_ = 0.0;
   double areal_mass_ = 0.0, carrier_share_ = 1.0;
+  bool sump_ = false; // inflow.supply: sump
 
   // State (checkpointed).
   std::mt19937_64 rng_;
@@ -81,6 +89,7 @@ private:
   double owed_carrier_ = 0.0;
   std::vector<double> owed_toner_;
   double pending_d_ = 0.0; // a carrier diameter drawn and not yet placed (0: none)
+  double declined_mass_ = 0.0;
   std::vector<long> count_;
   std::vector<double> mass_;
 

@@ -6,6 +6,7 @@
 //  * out: particles and mass removed by the outflow so far (its own counters);
 //  * present: particles and mass in the scene now, summed from the particle state.
 //    The budget reads in − out = present − present(0): three independent counts;
+//    With a sump inflow (inflow.supply: sump), due − declined is what the inflow was to create;
 //  * the flux through the radial line flow_report.flux_angle since the previous sample and the
 //    areal mass around the line (line_flux.h), counted from positions alone.
 //
@@ -31,6 +32,7 @@ struct FlowReportRow
   long crossed = 0;
   double flux = 0.0;         // crossed_mass / time since the previous row [kg/s]
   double areal_mass = 0.0;   // around the flux line [kg/m²]
+  double declined_mass = 0.0; // offered by a sump inflow and left there for want of room so far [kg]
 };
 
 class FlowReport : public Measurement

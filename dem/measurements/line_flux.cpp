@@ -19,6 +19,8 @@ LineFluxSample LineFlux::sample(double time, const ParticleState &s)
   double window_mass = 0.0;
   for (std::size_t i = 0; i < s.size(); ++i)
   {
+    if (std::hypot(s.x[i], s.y[i]) > max_radius_)
+      continue;
     // Angle from the line in the sense of rotation, in (−π, π].
     const double a = sense_ * std::remainder(std::atan2(s.y[i], s.x[i]) - angle_, 2.0 * M_PI);
     now_.push_back({s.id[i], a, s.mass[i]});

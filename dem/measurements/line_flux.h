@@ -15,6 +15,7 @@
 #include "dem/particle_state.h"
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace magbrush::dem {
@@ -33,11 +34,16 @@ public:
   // `sense` = +1 when the sleeve turns counter-clockwise, −1 otherwise.
   LineFlux(double angle, double sense, double window, double sleeve_radius, double slab_length);
 
+  // Only particles within `r` of the roller axis are seen (the layer on the sleeve, not what
+  // falls off it); a particle beyond it at either sample does not cross. Default: all.
+  void set_max_radius(double r) { max_radius_ = r; }
+
   // Counts the crossings since the previous call and the areal mass now.
   LineFluxSample sample(double time, const ParticleState &state);
 
 private:
   double angle_, sense_, window_, R_, Lz_;
+  double max_radius_ = std::numeric_limits<double>::infinity();
   bool first_ = true;
   // Previous and current sample: id, signed angle from the line, mass; sorted by id.
   struct Seen

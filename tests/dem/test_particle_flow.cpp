@@ -305,3 +305,63 @@ TEST(DemParticleFlow, InflowThatCannotBeHeldIsRefusedNamingTheKey)
   EXPECT_NE(refusal(no_slab).find("dem.periodic_length"), std::string::npos) << refusal(no_slab);
   EXPECT_EQ(refusal(conveyor_case(2e-3)), "");
 }
+
+// A pocket on the sleeve: walls across it 2° before the entry and 8° past it, 20 µm off it
+// (beads of 100 µm cannot pass): the layer piles up in it until the entry arc is full. A fixed supply stops the run with a
+// message naming the cause; a sump (inflow.supply: sump) leaves what finds no room in the
+// sump, and the mass it created plus the mass it declined is the mass offered.
+TEST(DemParticleFlow, ASumpLeavesWhatFindsNoRoomAndAFixedSupplyStops)
+{
+  omp_set_num_threads(2);
+  auto blocked = [](const std::string &supply) {
+    Case c = conveyor_case(0.5e-3);
+    c.flow.inflow_supply = supply;
+    c.flow.outflow_width = 0.0; // nothing leaves
+    c.flow.inflow_areal_mass = 0.3;
+    c.flow.inflow_layer_height = 1e-3;
+    for (const double a0 : {84 * deg, 98 * deg})
+    {
+      BladeOrGuide block;
+      block.name = a0 < 90 * deg ? "back" : "front";
+      block.material = "sleeve";
+      const double a1 = a0 + 4 * deg, r0 = sleeve_radius + 20e-6, r1 = sleeve_radius + 2.5e-3;
+      block.polygon = {{r0 * std::cos(a0), r0 * std::sin(a0)}, {r0 * std::cos(a1), r0 * std::sin(a1)},
+                       {r1 * std::cos(a1), r1 * std::sin(a1)}, {r1 * std::cos(a0), r1 * std::sin(a0)}};
+      c.blades.push_back(block);
+    }
+    return c;
+  };
+  const double end = 0.012; // the sleeve offers ~300 beads; the pocket's entry arc is full with ~100
+  {
+    const Case c = blocked("sump");
+    auto sys = make_conveyor(c);
+    FlowReport report(c);
+    run_sampled(*sys, report, end);
+    const auto *flow = dynamic_cast<const ParticleFlow *>(sys->particle_exchange());
+    ASSERT_NE(flow, nullptr);
+    const ParticleSource &in = *flow->source();
+    double created = 0.0;
+    for (double m : in.created_mass())
+      created += m;
+    const double one_bead = 2200.0 * M_PI / 6.0 * std::pow(130e-6, 3); // the largest drawn (3 sigma)
+    std::printf("sump: offered %.4g kg, created %.4g kg, declined %.4g kg, %zu beads present\n", in.mass_due(end),
+                created, in.declined_mass(), sys->particles().size());
+    EXPECT_GT(in.declined_mass(), 0.25 * in.mass_due(end)) << "the full pocket should turn much of the offer away";
+    EXPECT_NEAR(created + in.declined_mass(), in.mass_due(end), one_bead);
+    EXPECT_EQ(report.rows().back().declined_mass, in.declined_mass());
+  }
+  {
+    const Case c = blocked("fixed");
+    auto sys = make_conveyor(c);
+    std::string message;
+    try
+    {
+      sys->advance(std::lround(end / sys->time_step()));
+    }
+    catch (const std::runtime_error &e)
+    {
+      message = e.what();
+    }
+    EXPECT_NE(message.find("does not fit into the entry arc"), std::string::npos) << message;
+  }
+}

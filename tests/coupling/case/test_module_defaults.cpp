@@ -326,6 +326,7 @@ TEST(ModuleDefaults, MeasurementAndOutputSettingsOfADefaultCaseAreTheStructDefau
   EXPECT_SAME(c.flow, flow, inflow_areal_mass);
   EXPECT_SAME(c.flow, flow, inflow_angle);
   EXPECT_SAME(c.flow, flow, inflow_layer_height);
+  EXPECT_SAME_EXACT(c.flow, flow, inflow_supply);
   EXPECT_SAME(c.flow, flow, interval);
   EXPECT_SAME(c.flow, flow, outflow_angle);
   EXPECT_SAME(c.flow, flow, outflow_width);
@@ -335,6 +336,17 @@ TEST(ModuleDefaults, MeasurementAndOutputSettingsOfADefaultCaseAreTheStructDefau
   EXPECT_SAME(c.flow, flow, density_window);
   EXPECT_FALSE(c.flow.inflow());
   EXPECT_FALSE(c.flow.outflow());
+
+  // The developer after the doctor blade (dma).
+  const DmaSettings dma;
+  EXPECT_SAME(c.dma, dma, after_blade);
+  EXPECT_SAME(c.dma, dma, window);
+  EXPECT_SAME(c.dma, dma, height);
+  EXPECT_SAME(c.dma, dma, front_window);
+  EXPECT_SAME(c.dma, dma, release_from);
+  EXPECT_SAME(c.dma, dma, release_to);
+  EXPECT_SAME(c.dma, dma, sample_interval);
+  EXPECT_SAME(c.dma, dma, average_from);
 
   const OutputSettings output;
   EXPECT_SAME_EXACT(c.output, output, directory);

@@ -1,0 +1,89 @@
+// The developer the doctor blade lets through (Kweon et al. Fig. 5–7): the developer mass per
+// area (DMA) on the sleeve between the blade and the nip, which sets how much developer — and
+// so how much toner — reaches the development nip.
+//
+// Every sample (case keys dma.*, coupling/case_keys_measurements.cpp):
+//  * DMA, areal form: the mass of the particles in the window of width dma.window centred
+//    dma.after_blade past the blade's tip (in the sense the sleeve turns), within dma.height
+//    of the sleeve surface, over the sleeve area of the window, R Δθ L_z;
+//  * DMA, flux form: the mass that crossed the window's centre line since the previous sample
+//    (line_flux.h, counted from positions by particle id) per time, over v_sleeve L_z. A layer
+//    riding on the sleeve gives the areal form; a layer that slips behind the sleeve gives
+//    less. At a steady state both are constant;
+//  * the toner concentration in the window (toner mass / carrier mass), when there is toner;
+//  * the blade's load per slab length: the force the particles exert on the blade, resolved
+//    along the radius through its tip (pushing it away from the sleeve: +) and along the
+//    sleeve's motion there;
+//  * the developer held in front of the blade: the mass in the sector dma.front_window just
+//    before the tip, at any distance from the sleeve, per slab length (Kweon Fig. 5: the
+//    accumulation that the auxiliary guide wall removes);
+//  * with a release sector (dma.release_from ≠ dma.release_to): the masses crossing the two
+//    lines within dma.height of the sleeve; the RELEASED FRACTION is 1 − (after)/(before).
+//
+// The summary (dem/summary.csv, gathered by `magbrush sweep`) gives the means over the samples
+// from dma.average_from with block-averaged standard errors and the steady-state drift, and
+// the bound DMA ≲ ρ_bulk × gap: a layer cannot leave the blade's gap denser than a random close
+// packing (solid fraction 0.64) moving at the sleeve speed; ρ_bulk = 0.64 ρ_carrier (1 + TC),
+// the toner filling the voids.
+#pragma once
+
+#include "dem/measurement.h"
+#include "dem/measurements/line_flux.h"
+#include "dem/measurements/sample_series.h"
+
+#include "coupling/case_model.h"
+
+#include <string>
+#include <vector>
+
+namespace magbrush::dem {
+
+class DeveloperMassPerArea : public Measurement
+{
+public:
+  explicit DeveloperMassPerArea(const Case &c);
+  // The scene calls for it: a sleeve, a periodic slab and a doctor blade.
+  static bool applies(const Case &c);
+
+  const char *name() const override { return "developer mass per area"; }
+  double interval() const override { return settings_.sample_interval; }
+  void sample(const DemSystem &system) override;
+  void write(const std::string &directory) const override;
+  std::vector<SummaryValue> summary() const override;
+
+  // One sample from the particles and the force on the blade [N] (what sample() extracts
+  // from the engine; tests call it with hand-made scenes).
+  void add_sample(double time, const ParticleState &particles, const Vector3 &force_on_blade);
+
+  // The blade tip's roller angle [rad] and the bound ρ_bulk × gap [kg/m²].
+  double blade_angle() const { return blade_angle_; }
+  double dma_bound() const { return bulk_density_ * gap_; }
+  std::string csv() const;
+
+private:
+  struct Row
+  {
+    double time = 0, dma = 0, dma_flux = 0, toner_concentration = 0;
+    double blade_radial = 0, blade_along = 0; // [N/m]
+    double held_in_front = 0;                 // [kg/m]
+    double release_before = 0, release_after = 0; // crossed masses since the previous sample [kg]
+  };
+
+  DmaSettings settings_;
+  StatisticsSettings statistics_;
+  double R_ = 0, Lz_ = 0, sense_ = 1, speed_ = 0;
+  double blade_angle_ = 0, gap_ = 0, bulk_density_ = 0;
+  std::string blade_name_;
+  std::vector<char> is_toner_; // per population index
+  LineFlux centre_line_, release_before_, release_after_;
+  bool release_ = false;
+  double previous_time_ = -1.0;
+  std::vector<Row> rows_;
+  SampleSeries dma_, dma_flux_, concentration_, blade_radial_, blade_along_, held_;
+  SampleSeries released_before_, released_after_;
+
+  // Angle of p from `angle` in the sense the sleeve turns, in (−π, π].
+  double angle_from(double px, double py, double angle) const;
+};
+
+} // namespace magbrush::dem

@@ -1,0 +1,160 @@
+// The DMA measurement against values computed here from hand-made scenes: a ring of beads
+// riding on the sleeve (areal DMA from the count in the window; the flux form equals it over
+// whole spacings of the ring), the height filter, the developer held in front of the blade,
+// the blade's load resolved at its tip, the bound from the generated blade's gap, and a
+// release that drops every other bead (released fraction 1/2).
+#include "dem/measurements/developer_mass_per_area.h"
+
+#include "coupling/case_parser.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+using namespace magbrush;
+using namespace magbrush::dem;
+
+namespace {
+
+constexpr double deg = M_PI / 180.0;
+constexpr double R = 10e-3, Lz = 0.2e-3;
+
+// A roller scene with a generated doctor blade at 270 deg, gap 0.5 mm, sleeve turning
+// counter-clockwise at 400 rpm; `extra` adds keys (dma.*).
+Case blade_case(const std::string &extra = "")
+{
+  const std::string text = R"(
+name: dma_test
+scene: roller
+roller:
+  shaft_radius: 3 mm
+  magnet_radius: 9.3 mm
+  poles:
+    - {name: N1, angle: 0 deg, strength: 100 kA/m, polarity: N}
+sleeve: {diameter: 20 mm, thickness: 0.5 mm, rpm: 400 rpm}
+blades:
+  - {name: doctor, kind: doctor_blade, angle: 270 deg, gap: 0.5 mm, thickness: 1.5 mm, length: 8 mm}
+materials:
+  carrier: {youngs_modulus: 1e3 MPa, density: 2200 kg/m^3, mu_r: 3.9}
+  sleeve: {youngs_modulus: 5e4 MPa}
+  wall: {youngs_modulus: 5e4 MPa}
+populations:
+  - {name: carrier, kind: carrier, diameter: 50 um, count: 10, insert_box: [[9 mm, -1 mm, 0 mm], [11 mm, 1 mm, 0.2 mm]]}
+dem: {periodic_length: 0.2 mm, duration: 1 ms}
+)" + extra;
+  return parse_case_text(text, "dma_test.yaml");
+}
+
+// N beads of mass m evenly spaced around the sleeve at height h, the whole ring turned by φ.
+ParticleState ring(int n, double h, double phi, double m_each)
+{
+  ParticleState s;
+  const double r = 25e-6, density = m_each / (4.0 / 3.0 * M_PI * r * r * r);
+  for (int k = 0; k < n; ++k)
+  {
+    const double a = phi + 2.0 * M_PI * (k + 0.5) / n;
+    s.add({(R + h) * std::cos(a), (R + h) * std::sin(a), 0.1e-3}, r, density, 0, 0.0);
+  }
+  return s;
+}
+
+} // namespace
+
+TEST(DeveloperMassPerArea, BladeTipAndBoundFromTheGeneratedBlade)
+{
+  const Case c = blade_case();
+  ASSERT_TRUE(DeveloperMassPerArea::applies(c));
+  const DeveloperMassPerArea dma(c);
+  EXPECT_NEAR(std::remainder(dma.blade_angle() - 270 * deg, 2 * M_PI), 0.0, 1e-9);
+  EXPECT_NEAR(dma.dma_bound(), 0.64 * 2200.0 * 0.5e-3, 1e-9);
+}
+
+TEST(DeveloperMassPerArea, AreaAndFluxFormsOfARingRidingOnTheSleeve)
+{
+  const Case c = blade_case("dma: {after_blade: 10 deg, window: 12 deg, height: 1 mm, sample_interval: 10 us}\n");
+  DeveloperMassPerArea dma(c);
+  const int n = 360;                      // one bead per degree: 12 in the window, none on its edges
+  const double m = 1e-10, spacing = 2 * M_PI / n;
+  const double omega = c.sleeve->omega(); // the ring rides with the sleeve
+  const double dt = spacing / 4.0 / omega;
+  // Turned by an eighth of a spacing at the start, no bead ever sits on an edge or the line.
+  for (int k = 0; k <= 4 * 25; ++k)     // 25 whole spacings after the first sample
+    dma.add_sample(k * dt, ring(n, 0.2e-3, spacing / 8.0 + omega * k * dt, m), Vector3{});
+  const double exact = m / (spacing * R * Lz); // the ring's mass per sleeve area
+  const auto summary = dma.summary();
+  auto value = [&](const std::string &key) {
+    for (const auto &v : summary)
+      if (v.key == key)
+        return v.value;
+    return std::nan("");
+  };
+  // The window holds 12 beads at every sample (turns of a quarter spacing keep the count).
+  EXPECT_NEAR(value("dma_kg_per_m2"), exact, 1e-9 * exact);
+  // One bead crosses the centre line per spacing turned: over whole spacings, exactly the areal form.
+  EXPECT_NEAR(value("dma_flux_kg_per_m2"), exact, 1e-9 * exact);
+  // Held in front: 20 deg before the tip hold 20 beads.
+  EXPECT_NEAR(value("developer_held_in_front_of_blade_kg_per_m"), 20 * m / Lz, 1e-9 * 20 * m / Lz);
+}
+
+TEST(DeveloperMassPerArea, OnlyTheLayerOnTheSleeveCounts)
+{
+  const Case c = blade_case("dma: {height: 1 mm}\n");
+  DeveloperMassPerArea low(c), high(c);
+  low.add_sample(0.0, ring(360, 0.9e-3, 0.0, 1e-10), Vector3{});
+  high.add_sample(0.0, ring(360, 1.1e-3, 0.0, 1e-10), Vector3{});
+  EXPECT_GT(low.summary()[0].value, 0.0);
+  EXPECT_EQ(high.summary()[0].value, 0.0);
+}
+
+TEST(DeveloperMassPerArea, BladeLoadAlongItsRadiusAndAlongTheSleevesMotion)
+{
+  const Case c = blade_case();
+  DeveloperMassPerArea dma(c);
+  // The tip is at 270 deg: the outward radius is −y, the sleeve (counter-clockwise) moves +x there.
+  dma.add_sample(0.0, ParticleState{}, Vector3{2e-3, -3e-3, 0.0});
+  const auto s = dma.summary();
+  for (const auto &v : s)
+  {
+    if (v.key == "blade_force_N_per_m")
+      EXPECT_NEAR(v.value, 3e-3 / Lz, 1e-9);
+    if (v.key == "blade_drag_N_per_m")
+      EXPECT_NEAR(v.value, 2e-3 / Lz, 1e-9);
+  }
+}
+
+TEST(DeveloperMassPerArea, ReleasedFractionWhenEveryOtherBeadLeavesTheSleeve)
+{
+  // Release lines at 150 and 200 deg; past 175 deg the odd beads are 5 mm off the sleeve.
+  const Case c = blade_case("dma: {release_from: 150 deg, release_to: 200 deg, height: 1 mm}\n");
+  DeveloperMassPerArea dma(c);
+  const int n = 360;
+  const double spacing = 2 * M_PI / n, omega = c.sleeve->omega(), dt = spacing / 4.0 / omega;
+  for (int k = 0; k <= 4 * 40; ++k)
+  {
+    ParticleState s = ring(n, 0.2e-3, omega * k * dt, 1e-10);
+    for (std::size_t i = 1; i < s.size(); i += 2)
+    {
+      const double a = std::fmod(std::atan2(s.y[i], s.x[i]) + 2 * M_PI, 2 * M_PI);
+      if (a > 175 * deg && a < 300 * deg)
+      {
+        const double scale = (R + 5e-3) / std::hypot(s.x[i], s.y[i]);
+        s.x[i] *= scale, s.y[i] *= scale;
+      }
+    }
+    dma.add_sample(k * dt, s, Vector3{});
+  }
+  double fraction = std::nan("");
+  for (const auto &v : dma.summary())
+    if (v.key == "released_fraction")
+      fraction = v.value;
+  EXPECT_NEAR(fraction, 0.5, 1e-9);
+}
+
+TEST(DeveloperMassPerArea, RegisteredOnlyForASceneWithADoctorBlade)
+{
+  Case c = blade_case();
+  EXPECT_TRUE(DeveloperMassPerArea::applies(c));
+  c.blades.clear();
+  EXPECT_FALSE(DeveloperMassPerArea::applies(c));
+}

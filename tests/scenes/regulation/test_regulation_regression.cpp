@@ -1,0 +1,98 @@
+// The DMA study end to end on the regulation cell (cases/kweon_regulation.yaml: the sector of
+// Kweon's roller around the doctor blade, oversupplied by an inflow before it, the excess
+// spilling off the pile in front of it, the regulated layer measured past it), through
+// `magbrush sweep` exactly as a user runs the study (check, field, DEM, table and plots), at two
+// blade gaps, shortened to 9 ms (the layer reaches the DMA window after about 6 ms).
+//
+// What must hold at any moment of regulation, steady or not — and what the test asserts:
+//  * the blade regulates: a wider gap lets more developer through, by several standard errors;
+//  * below the bound ρ_bulk × gap (the sweep's column next to the DMA): a layer cannot leave
+//    the gap denser than a random close packing moving with the sleeve;
+//  * the blade holds developer back: there is a pile in front of it and a load on it;
+//  * mass is conserved to the particle: at every row of each point's flow report, the beads
+//    present are those created minus those removed, and their masses agree likewise;
+//  * the table has what a user plots: standard errors, the bound, the run time, the plot.
+//
+// Cost: about 2 × 2 min on 2 cores in Release.
+#include "tests/csv_columns.h"
+#include "tests/test_temp_dir.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+namespace fs = std::filesystem;
+
+TEST(RegulationRegression, DmaRisesWithTheBladeGapBelowTheBulkBoundAndMassIsConserved)
+{
+  const fs::path dir = magbrush::testing::test_temp_dir("regulation_regression");
+  const std::string cmd = "cd '" + dir.string() + "' && OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 '" +
+                          std::string(MAGBRUSH_BINARY_DIR) + "/bin/magbrush' sweep '" + MAGBRUSH_SOURCE_DIR +
+                          "/cases/kweon_regulation.yaml' --vary blades.doctor.gap=0.3mm,0.6mm --name gap "
+                          "--set dem.duration=9ms --set dma.average_from=6.5ms --set output.directory=results "
+                          "> sweep.log 2>&1";
+  const int raw = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 0) << "magbrush sweep failed: see " << (dir / "sweep.log");
+
+  const fs::path sweep = dir / "results" / "sweep_gap";
+  const auto table = magbrush::testing::read_csv_columns(sweep / "sweep_summary.csv");
+  for (const char *column : {"dma_kg_per_m2", "dma_kg_per_m2_stderr", "dma_kg_per_m2_bound", "dma_flux_kg_per_m2",
+                             "blade_force_N_per_m", "developer_held_in_front_of_blade_kg_per_m", "run_time_s"})
+  {
+    ASSERT_TRUE(table.count(column)) << "sweep_summary.csv has no column " << column;
+    ASSERT_EQ(table.at(column).size(), 2u) << column;
+  }
+  auto value = [&](const char *column, int point) { return std::atof(table.at(column)[point].c_str()); };
+  const double narrow = value("dma_kg_per_m2", 0), wide = value("dma_kg_per_m2", 1);
+  std::printf("DMA %.4g ± %.2g kg/m^2 at 0.3 mm, %.4g ± %.2g kg/m^2 at 0.6 mm; bounds %.4g, %.4g; flux form %.4g, "
+              "%.4g; blade %.3g, %.3g N/m; held %.3g, %.3g kg/m\n",
+              narrow, value("dma_kg_per_m2_stderr", 0), wide, value("dma_kg_per_m2_stderr", 1),
+              value("dma_kg_per_m2_bound", 0), value("dma_kg_per_m2_bound", 1), value("dma_flux_kg_per_m2", 0),
+              value("dma_flux_kg_per_m2", 1), value("blade_force_N_per_m", 0), value("blade_force_N_per_m", 1),
+              value("developer_held_in_front_of_blade_kg_per_m", 0),
+              value("developer_held_in_front_of_blade_kg_per_m", 1));
+
+  EXPECT_GT(narrow, 0.0) << "no developer passed the 0.3 mm gap";
+  const double se = std::hypot(value("dma_kg_per_m2_stderr", 0), value("dma_kg_per_m2_stderr", 1));
+  EXPECT_GT(se, 0.0);
+  EXPECT_GT(wide - narrow, 3.0 * se) << "the DMA must rise with the blade gap, by three standard errors";
+  for (int p = 0; p < 2; ++p)
+  {
+    EXPECT_LT(value("dma_kg_per_m2", p), value("dma_kg_per_m2_bound", p)) << "point " << p;
+    EXPECT_GT(value("blade_force_N_per_m", p), 0.0) << "point " << p;
+    EXPECT_GT(value("developer_held_in_front_of_blade_kg_per_m", p), 0.0) << "point " << p;
+    EXPECT_GT(value("run_time_s", p), 0.0);
+  }
+  // The bound is ρ_bulk × gap: the gaps' ratio.
+  EXPECT_NEAR(value("dma_kg_per_m2_bound", 1) / value("dma_kg_per_m2_bound", 0), 2.0, 1e-5); // CSV: 6 digits
+  EXPECT_TRUE(fs::exists(sweep / "sweep_dma_kg_per_m2.png"));
+
+  // Mass conserved to the particle in each point (its flow report: in, out, present).
+  int reports = 0;
+  for (const auto &entry : fs::recursive_directory_iterator(sweep))
+  {
+    if (entry.path().filename() != "flow_report.csv")
+      continue;
+    ++reports;
+    const auto flow = magbrush::testing::read_csv_columns(entry.path());
+    ASSERT_TRUE(flow.count("present") && flow.count("in") && flow.count("out")) << entry.path();
+    const std::size_t rows = flow.at("present").size();
+    ASSERT_GT(rows, 100u) << entry.path();
+    long removed = 0;
+    for (std::size_t r = 0; r < rows; ++r)
+    {
+      const long in = std::atol(flow.at("in")[r].c_str()), out = std::atol(flow.at("out")[r].c_str());
+      ASSERT_EQ(std::atol(flow.at("present")[r].c_str()), in - out) << entry.path() << " row " << r;
+      const double in_mass = std::atof(flow.at("in_mass_kg")[r].c_str());
+      const double out_mass = std::atof(flow.at("out_mass_kg")[r].c_str());
+      ASSERT_NEAR(std::atof(flow.at("present_mass_kg")[r].c_str()), in_mass - out_mass, 1e-7 * in_mass)
+          << entry.path() << " row " << r;
+      removed = out;
+    }
+    EXPECT_GT(removed, 0) << entry.path() << ": nothing left the cell (no spill, no outflow)";
+  }
+  EXPECT_EQ(reports, 2);
+}

@@ -120,9 +120,6 @@ void DemSystem::advance(long steps)
 
 void DemSystem::advance_steps(long steps)
 {
-  // The kernel's records, for as many particles as there are now (a checkpoint read may have
-  // changed that); the drift writes them before the contacts read them.
-  records_.resize(particles_.size());
   // A team may be larger now than at initialize() (omp_set_num_threads between calls).
   if (thread_flags_.size() < static_cast<std::size_t>(omp_get_max_threads()))
     thread_flags_.resize(static_cast<std::size_t>(omp_get_max_threads()));
@@ -210,8 +207,6 @@ DemSystem::Pause DemSystem::run_team(long &steps_left, Resume from)
       }
       if (at != Resume::final_kick)
       {
-        if (at == Resume::contacts) // after a rebuild: the particles moved in memory
-          refresh_records_phase();  // ends with a barrier
         pair_and_row_phase(mine); // ends with barrier P
         clock.charge(times_.particle_contacts);
         if (team_has_overlap_alarm())

@@ -126,7 +126,6 @@ void DemSystem::initialize()
 #pragma omp parallel if (parallel())
   {
     StepFlags &mine = my_flags();
-    refresh_records_phase();
     pair_and_row_phase(mine);
     column_phase();
     if (walls_.size() > 0)
@@ -158,7 +157,6 @@ void DemSystem::rebuild_neighbour_list(const std::vector<std::int32_t> *origin)
   x0_ = particles_.x;
   y0_ = particles_.y;
   z0_ = particles_.z;
-  records_.resize(particles_.size()); // (re)written before the contacts that follow
   force_rebuild_ = false;
   ++rebuilds_;
 }
@@ -258,7 +256,6 @@ void DemSystem::kick_and_drift_phase(StepFlags &mine)
     s.z[i] += dt * s.vz[i];
     const double dx = s.x[i] - x0_[i], dy = s.y[i] - y0_[i], dz = s.z[i] - z0_[i];
     max_drift2 = std::max(max_drift2, dx * dx + dy * dy + dz * dz);
-    records_.write(i, s); // what this step's contacts read
   }
   mine.max_drift2 = max_drift2;
 #pragma omp barrier
@@ -297,16 +294,6 @@ std::string DemSystem::describe_particle(std::size_t i, const Vector3 &at) const
 // ---------------------------------------------------------------------------------------
 // Particle–particle contacts (the kernel and the order of the sums: pair_kernel.h).
 
-// Every particle's record for the pair kernel, where the contacts do not follow the drift
-// (the first forces, a rebuild that re-sorted or exchanged particles). Ends with a barrier.
-void DemSystem::refresh_records_phase()
-{
-  const long n = static_cast<long>(particles_.size());
-#pragma omp for schedule(static)
-  for (long k = 0; k < n; ++k)
-    records_.write(static_cast<std::size_t>(k), particles_);
-}
-
 // Phase 1 (all threads, work-shared; ends with a barrier): pairs and rows, block by block.
 // Sets this thread's overlap alarm when one of its pairs overlaps beyond the guard.
 void DemSystem::pair_and_row_phase(StepFlags &mine)
@@ -327,7 +314,9 @@ void DemSystem::pair_and_row_phase(StepFlags &mine)
   const std::size_t types = table_.species() * table_.columns();
   const double *coef = coefficient_fields_.data();
   NeighbourList &W = list_; // the pair slots written here
-  const PairKernelData D{records_.data(), s.species.data(), L.owner.data(), L.partner.data(),
+  const PairKernelData D{s.x.data(), s.y.data(), s.z.data(), s.vx.data(), s.vy.data(), s.vz.data(),
+                         s.wx.data(), s.wy.data(), s.wz.data(), s.radius.data(), s.mass.data(),
+                         s.inv_inertia.data(), s.species.data(), L.owner.data(), L.partner.data(),
                          L.image.data(), shift[0], shift[1], shift[2], coef, coef + types, coef + 2 * types,
                          coef + 3 * types, coef + 4 * types, coef + 5 * types,
                          static_cast<std::int64_t>(table_.columns()), table_.species() == 1, dt_,
@@ -605,7 +594,7 @@ std::size_t DemSystem::memory_bytes() const
     b += a->capacity() * sizeof(double);
   for (const auto *a : {&s.species, &s.id, &contact_count_, &iscratch_})
     b += a->capacity() * sizeof(std::int32_t);
-  return b + wall_slots_.memory_bytes() + list_.memory_bytes() + records_.memory_bytes();
+  return b + wall_slots_.memory_bytes() + list_.memory_bytes();
 }
 
 // ---------------------------------------------------------------------------------------

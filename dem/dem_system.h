@@ -19,7 +19,6 @@
 #include "dem/contact_parameters.h"
 #include "dem/force_term.h"
 #include "dem/neighbour_list.h"
-#include "dem/pair_kernel.h"
 #include "dem/particle_exchange.h"
 #include "dem/particle_state.h"
 #include "dem/stability_guards.h"
@@ -151,9 +150,6 @@ private:
   ParticleState particles_;
   ForceBuffers forces_;
   NeighbourList list_;
-  // The pair kernel's copy of the particles (pair_kernel.h): written by the drift of every
-  // step, and all at once where the contacts follow something else (refresh_records_phase).
-  PairParticleRecords records_;
   std::vector<std::unique_ptr<ForceTerm>> terms_;
   std::unique_ptr<ParticleExchange> exchange_;
   long entered_ = 0, left_ = 0;
@@ -203,7 +199,6 @@ private:
   // (work-shared loops inside, reporting into the calling thread's StepFlags); see
   // dem_advance.cpp for their order and barriers.
   void kick_and_drift_phase(StepFlags &mine);
-  void refresh_records_phase(); // every particle's record (after a rebuild); ends with a barrier
   void pair_and_row_phase(StepFlags &mine);
   void column_phase();
   void wall_phase(StepFlags &mine);

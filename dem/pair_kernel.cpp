@@ -19,8 +19,10 @@ inline int pair_loop(const PairKernelData &D, const RowTorques &T, std::int64_t 
 {
   // Local restrict copies: the outputs alias neither the inputs nor each other, and the
   // compiler must not reload the pointers from D after every store.
-  using R = PairParticleRecords;
-  const double *__restrict P = D.particles;
+  const double *__restrict x = D.x, *__restrict y = D.y, *__restrict z = D.z;
+  const double *__restrict vx = D.vx, *__restrict vy = D.vy, *__restrict vz = D.vz;
+  const double *__restrict wx = D.wx, *__restrict wy = D.wy, *__restrict wz = D.wz;
+  const double *__restrict radius = D.radius, *__restrict mass = D.mass, *__restrict inv_inertia = D.inv_inertia;
   const std::int32_t *__restrict species = D.species, *__restrict owner = D.owner, *__restrict partner = D.partner;
   const std::int32_t *__restrict image = D.image;
   const double *__restrict shift_x = D.shift_x, *__restrict shift_y = D.shift_y, *__restrict shift_z = D.shift_z;
@@ -48,12 +50,9 @@ inline int pair_loop(const PairKernelData &D, const RowTorques &T, std::int64_t 
   for (std::int64_t p = p_begin; p < p_end; ++p)
   {
     const std::int64_t i = owner[p], j = partner[p];
-    // Record offsets of i and j (indexing P itself keeps its restrict promise visible).
-    const std::int64_t bi = static_cast<std::int64_t>(R::stride) * i, bj = static_cast<std::int64_t>(R::stride) * j;
     const int im = image[p];
-    const Vector3 d{P[bj + R::x] - P[bi + R::x] + shift_x[im], P[bj + R::y] - P[bi + R::y] + shift_y[im],
-                    P[bj + R::z] - P[bi + R::z] + shift_z[im]};
-    const double ri = P[bi + R::radius], rj = P[bj + R::radius], reach = ri + rj;
+    const Vector3 d{x[j] - x[i] + shift_x[im], y[j] - y[i] + shift_y[im], z[j] - z[i] + shift_z[im]};
+    const double ri = radius[i], rj = radius[j], reach = ri + rj;
     const double r2 = dot(d, d);
     const bool touch = r2 < reach * reach;
     // With adhesion, pairs within its range attract across the gap: they need the true
@@ -70,17 +69,17 @@ inline int pair_loop(const PairKernelData &D, const RowTorques &T, std::int64_t 
     // Distances from the centres to the plane of the contact circle.
     c.lever_i = 0.5 * (dist + (ri * ri - rj * rj) * inv_dist);
     c.lever_j = dist - c.lever_i;
-    const Vector3 wi{P[bi + R::wx], P[bi + R::wy], P[bi + R::wz]}, wj{P[bj + R::wx], P[bj + R::wy], P[bj + R::wz]};
-    const Vector3 vij{P[bi + R::vx] - P[bj + R::vx], P[bi + R::vy] - P[bj + R::vy], P[bi + R::vz] - P[bj + R::vz]};
+    const Vector3 wi{wx[i], wy[i], wz[i]}, wj{wx[j], wy[j], wz[j]};
+    const Vector3 vij{vx[i] - vx[j], vy[i] - vy[j], vz[i] - vz[j]};
     c.v_rel = vij + cross(c.lever_i * wi + c.lever_j * wj, c.n);
     c.w_rel = wi - wj;
     c.R_star = ri * rj / reach;
-    const double mi = P[bi + R::mass], mj = P[bj + R::mass];
+    const double mi = mass[i], mj = mass[j];
     c.m_star = mi * mj / (mi + mj);
     c.radius_i = ri;
     c.radius_j = rj;
-    c.inv_inertia_i = P[bi + R::inv_inertia];
-    c.inv_inertia_j = P[bj + R::inv_inertia];
+    c.inv_inertia_i = inv_inertia[i];
+    c.inv_inertia_j = inv_inertia[j];
     ContactCoefficients k = uniform_k;
     if (!Uniform)
     {

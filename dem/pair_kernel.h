@@ -18,69 +18,16 @@
 // vectorises; an AVX-512 or AVX2 clone is picked at load time where the CPU has one. Vector
 // and scalar code give the same bits: every operation is an IEEE add, multiply, divide or
 // square root in the same order, and fused multiply-adds are off (dem/CMakeLists.txt).
-//
-// The particles' data reach the kernel as one record per particle (PairParticleRecords), not
-// as the engine's twelve separate arrays: a partner j then costs two cache lines, not twelve,
-// and the kernel's accesses form two streams (rows i and partners j) instead of some fifty
-// (twelve arrays, each read at i and at the partners one cell, one row and one plane of cells
-// ahead). On 55k particles, whose arrays no longer fit the cache, that made the kernel
-// ~10 % faster (docs/dem_vs_lammps.md); the arrays stay the engine's state, the records are a
-// copy the step refreshes (DemSystem::kick_and_drift_phase).
 #pragma once
 
-#include "dem/particle_state.h"
-
 #include <cstdint>
-#include <vector>
 
 namespace magbrush::dem {
 
-// Per-particle records for the pair kernel: the twelve values it reads, 16 doubles (128 bytes,
-// two whole cache lines) a particle, the first record 64-byte aligned.
-class PairParticleRecords
-{
-public:
-  static constexpr std::size_t stride = 16;
-  enum Field : std::size_t { x, y, z, vx, vy, vz, wx, wy, wz, radius, mass, inv_inertia };
-
-  // Room for n particles; allocates only when n exceeds every earlier size. The contents are
-  // undefined afterwards: write every record before the kernel reads it.
-  void resize(std::size_t n)
-  {
-    storage_.resize(stride * n + 8); // + 8: room to align the first record
-    base_ = storage_.data();
-    while (reinterpret_cast<std::uintptr_t>(base_) % 64 != 0)
-      ++base_;
-  }
-  const double *data() const { return base_; }
-  // Copies particle i's current values into its record.
-  void write(std::size_t i, const ParticleState &s)
-  {
-    double *r = base_ + stride * i;
-    r[x] = s.x[i];
-    r[y] = s.y[i];
-    r[z] = s.z[i];
-    r[vx] = s.vx[i];
-    r[vy] = s.vy[i];
-    r[vz] = s.vz[i];
-    r[wx] = s.wx[i];
-    r[wy] = s.wy[i];
-    r[wz] = s.wz[i];
-    r[radius] = s.radius[i];
-    r[mass] = s.mass[i];
-    r[inv_inertia] = s.inv_inertia[i];
-  }
-  std::size_t memory_bytes() const { return storage_.capacity() * sizeof(double); }
-
-private:
-  std::vector<double> storage_;
-  double *base_ = nullptr;
-};
-
 struct PairKernelData
 {
-  // Particles (read): their records, and the species.
-  const double *particles;
+  // Particles (read).
+  const double *x, *y, *z, *vx, *vy, *vz, *wx, *wy, *wz, *radius, *mass, *inv_inertia;
   const std::int32_t *species;
   // Pairs (read).
   const std::int32_t *owner, *partner;

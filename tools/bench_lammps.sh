@@ -10,6 +10,8 @@
 #      LMP     LAMMPS binary      (default: lmp, lmp_serial or lmp_stable on PATH)
 #      WORK    scratch directory  (default: a fresh mktemp -d, removed at the end)
 #      MPI2=1  also run LAMMPS on 2 MPI ranks (the Debian package has no OPENMP package)
+#      BENCH_BASE  a second bench binary (e.g. an older build), run in every round too: its
+#              rows say "magbrush base", and "new/base" gives the same-round ratio of the two
 # The two codes run alternately, back to back, `rounds` times; the table gives the median
 # and the min–max of each rate and of the per-round ratio ours/LAMMPS.
 set -euo pipefail
@@ -42,6 +44,7 @@ grep -q GRANULAR <<<"$LMP_HELP" || { echo "$LMP_BIN lacks the GRANULAR package" 
 LMP_VERSION=$(sed -n 's/^Large-scale Atomic\/Molecular Massively Parallel Simulator - //p' <<<"$LMP_HELP")
 grep -q OPENMP <<<"$LMP_HELP" && echo "note: this LAMMPS has OPENMP; the script still compares serial (and MPI2=1)" >&2
 [[ -x "$BENCH" ]] || { echo "no bench binary at $BENCH (build target bench_dem_packing)" >&2; exit 1; }
+[[ -z "${BENCH_BASE:-}" || -x "$BENCH_BASE" ]] || { echo "no bench binary at BENCH_BASE=$BENCH_BASE" >&2; exit 1; }
 
 if [[ -n "${WORK:-}" ]]; then mkdir -p "$WORK"; else WORK=$(mktemp -d); trap 'rm -rf "$WORK"' EXIT; fi
 cd "$WORK"
@@ -203,13 +206,17 @@ run_lammps() { # n nproc -> rate, prints loop time
   "$PY" -c "print('%.4g' % ($STEPS * $n**3 / $loop))"
 }
 
-echo "LAMMPS: $LMP_BIN ($LMP_VERSION); ours: $BENCH; $ROUNDS rounds of $STEPS steps"
+echo "LAMMPS: $LMP_BIN ($LMP_VERSION); ours: $BENCH${BENCH_BASE:+ (base: $BENCH_BASE)}; $ROUNDS rounds of $STEPS steps"
 : > results.txt
 : > loads.txt
 for ((round = 1; round <= ROUNDS; ++round)); do
   # ours: both sizes, 1 and 2 threads in one process; rate and out% (HDF5 snapshot every 100 steps)
   OMP_NUM_THREADS=1 "$BENCH" "$STEPS" 2 > ours_$round.txt
   awk -v r="$round" '$1 ~ /^[0-9]+$/ && NF > 10 {print r, "ours", $1, $2, $3, $9, $12}' ours_$round.txt >> results.txt
+  if [[ -n "${BENCH_BASE:-}" ]]; then
+    OMP_NUM_THREADS=1 "$BENCH_BASE" "$STEPS" 2 > base_$round.txt
+    awk -v r="$round" '$1 ~ /^[0-9]+$/ && NF > 10 {print r, "base", $1, $2, $3, $9, $12}' base_$round.txt >> results.txt
+  fi
   for n in 24 38; do
     echo "$round lammps $((n*n*n)) 1 $(run_lammps $n 1) 0 -" >> results.txt
     if [[ "${MPI2:-0}" == 1 ]]; then
@@ -228,9 +235,9 @@ import collections
 rate = collections.defaultdict(list); out = {}
 for rnd, code, N, th, r, outp, cont in rows:
     rate[(int(N), code, int(th))].append(float(r))
-    if code == "ours":
-        out.setdefault((int(N), int(th)), []).append(float(outp))
-        out.setdefault(("cont", int(N)), []).append(float(cont))
+    if code in ("ours", "base"):
+        out.setdefault((code, int(N), int(th)), []).append(float(outp))
+        out.setdefault(("cont", code, int(N)), []).append(float(cont))
 def stat(v):
     v = sorted(v); return np.median(v), v[0], v[-1]
 print()
@@ -239,18 +246,25 @@ for N in sorted({k[0] for k in rate}):
     lam = rate.get((N, "lammps", 1))
     for (NN, code, th) in sorted(k for k in rate if k[0] == N):
         med, lo, hi = stat(rate[(NN, code, th)])
-        name = "magbrush" if code == "ours" else ("LAMMPS serial" if th == 1 else "LAMMPS MPI x2")
+        name = {"ours": "magbrush", "base": "magbrush base"}.get(code, "LAMMPS serial" if th == 1 else "LAMMPS MPI x2")
         ratio = ""
-        if code == "ours" and lam:
+        if code in ("ours", "base") and lam:
             ref = rate.get((N, "lammps", th), lam)  # LAMMPS on as many ranks if measured
             rr = [a / b for a, b in zip(rate[(NN, code, th)], ref)]  # same round
             m, a, b = stat(rr)
             best = max(rate[(NN, code, th)]) / max(ref)
             ratio = (f"{m:6.2f} ({a:.2f}-{b:.2f}) best/best {best:.2f} "
                      f"vs {'MPI x2' if ref is not lam else 'serial'}")
-            o = np.median(out[(N, th)])
+            o = np.median(out[(code, N, th)])
             ratio += f"   [out {o:.1f}% of ours]"
         print(f"{N:7d} {name:>16} {th:4d} {med:17.4g} {f'({lo:.3g}-{hi:.3g})':>21}  {ratio}")
+base = sorted(k for k in rate if k[1] == "base")
+if base:
+    print("\nnew/base (per-round rate of BENCH / BENCH_BASE in the same round): median (min-max)")
+    for (N, _, th) in base:
+        rr = [a / b for a, b in zip(rate[(N, "ours", th)], rate[(N, "base", th)])]
+        m, a, b = stat(rr)
+        print(f"{N:7d} {th:4d} threads  {m:.3f} ({a:.3f}-{b:.3f})")
 print("\n(ratio = per-round rate of ours / LAMMPS in the same round, same number of threads/ranks if")
 print(" measured; best/best = fastest round of each, the least disturbed by other load. Ours includes")
 print(" one HDF5 snapshot per 100 steps (out%), LAMMPS writes nothing in the timed loop)")

@@ -23,6 +23,7 @@
 #include "app/sweep_ranks.h"
 #include "app/sweep_slurm.h"
 
+#include "coupling/case_hash.h"
 #include "coupling/case_parser.h"
 #include "coupling/case_schema.h"
 #include "coupling/units.h"
@@ -63,8 +64,9 @@ const cli::CommandSpec &sweep_command_line()
               "       mpirun -np K magbrush sweep CASE --vary ...";
     s.description = R"(Runs the pipeline (check, field, dem, report; the Gmsh meshes are not needed per point) once
 for every combination of the --vary values, each point in
-<output.directory>/sweep_<NAME>/<point>/ (its own fields/, dem/, report/), then compares the
-nip profiles of all points:
+<output.directory>/sweep_<NAME>/<point>/ (its dem/ and report/; the stored fields in
+sweep_<NAME>/fields/<digests of the field inputs>/, solved once for the points that share them),
+then compares the nip profiles of all points:
   sweep_summary.csv    one row per point: the varied values (as given and in SI), the bead
                        count, every key number the point's measurements report (dem/summary.csv:
                        e.g. slip at the gap centre, normal force per length, TMA, DMA) with its
@@ -388,7 +390,14 @@ PointSetup set_up_point(const SweepPlan &plan, std::size_t n)
   }
   point.dir = plan.sweep_dir / point.label;
   point.overrides.push_back("output.directory=" + point.dir.string());
-  point.overrides.push_back("field.output_dir=" + (point.dir / "fields").string());
+  // The stored fields go where every point with the same field inputs finds them (named by
+  // the digests of those inputs): a study over a blade gap, a bias or a carrier solves the
+  // roller field once; two ranks solving the same field at once both write atomically.
+  const Case fields_of = load_case(plan.case_path, point.overrides);
+  point.overrides.push_back("field.output_dir=" + (plan.sweep_dir / "fields" /
+                                                   (field_hash(fields_of, FieldKind::magnetic) + "_" +
+                                                    field_hash(fields_of, FieldKind::electric)))
+                                                      .string());
   point.point_case = load_case(plan.case_path, point.overrides);
   return point;
 }

@@ -86,3 +86,30 @@ TEST(Sweep, TabulatesEveryPointWithItsSIValueRunTimeAndMeasuredComparison)
     << bad.output;
   fs::remove_all(dir);
 }
+
+// The stored fields are solved once for the points whose field inputs agree (a drum speed does
+// not change the roller field) and once per point where they differ (a pole's strength does):
+// one folder per digest under sweep_<NAME>/fields/, and the second point finds its field there.
+TEST(Sweep, PointsWithTheSameFieldInputsShareOneSolvedField)
+{
+  const fs::path dir = magbrush::testing::test_temp_dir("app_sweep_fields");
+  const std::string roller = std::string(MAGBRUSH_SOURCE_DIR) + "/tests/coupling/case/valid/minimal_roller.yaml";
+  auto field_folders = [](const fs::path &fields) {
+    int n = 0;
+    for (const auto &entry : fs::directory_iterator(fields))
+      n += entry.is_directory() && fs::exists(entry.path() / "minimal_roller_magnetic.h5");
+    return n;
+  };
+  const Result same = magbrush_run(dir, {"sweep", roller, "--vary", "drum.rpm=-100rpm,-120rpm", "--name", "drum",
+                                         "--skip", "mesh,dem,report", "--set",
+                                         "output.directory=" + (dir / "out").string()});
+  EXPECT_EQ(field_folders(dir / "out" / "sweep_drum" / "fields"), 1) << same.output;
+  EXPECT_NE(same.output.find("magnetic field up to date"), std::string::npos) << same.output;
+
+  const Result differ = magbrush_run(dir, {"sweep", roller, "--vary", "roller.poles.N1.strength=150kA/m,160kA/m",
+                                           "--name", "pole", "--skip", "mesh,dem,report", "--set",
+                                           "output.directory=" + (dir / "out").string()});
+  EXPECT_EQ(field_folders(dir / "out" / "sweep_pole" / "fields"), 2) << differ.output;
+  EXPECT_EQ(differ.output.find("magnetic field up to date"), std::string::npos) << differ.output;
+  fs::remove_all(dir);
+}

@@ -14,7 +14,7 @@
 //    present are those created minus those removed, and their masses agree likewise;
 //  * the table has what a user plots: standard errors, the bound, the run time, the plot.
 //
-// Cost: about 2 × 2 min on 2 cores in Release.
+// Cost: about 2 × 4 min on 2 idle cores in Release (2 × 12 min on a loaded machine).
 #include "tests/csv_columns.h"
 #include "tests/test_temp_dir.h"
 

@@ -11,6 +11,10 @@
 //   * otherwise the held forces of the last evaluation, rescaled by (s(t)/s_held)² while
 //     the applied field ramps (linear beads: p ∝ B, F ∝ B², exact).
 //
+// Particles entering or leaving (the inflow / outflow exchange) fire no evaluation of their
+// own (MagneticSettings::defer_exchange): they join the next full one; meanwhile the leavers
+// stay frozen sources and the newcomers feel the field and their held neighbours.
+//
 // The compact carrier order is the magnetics' own, fixed when the carriers are selected: the
 // engine's spatial re-sorting only changes which engine index each compact bead reads, so
 // the magnetic neighbour lists, cells and dipoles survive it. Positions are unwrapped along

@@ -193,8 +193,9 @@ void MagneticForceTerm::add_forces(const dem::ParticleState &state, dem::ForceBu
   changed_ = false;
   if (!pending_)
     newcomers_.clear();
-  else if (carrier_.size() == left_) // nothing held to wait with (e.g. the first carriers of an inflow)
-    apply_pending(state);
+  else if (carrier_.size() == left_ || newcomers_.size() > kMaxWaiting)
+    apply_pending(state); // nothing held to wait with (the first carriers of an inflow), or
+                          // so many newcomers that their per-step sums would cost more
   const std::size_t n = carrier_.size();
   if (n == 0)
     return;

@@ -134,6 +134,9 @@ private:
   static constexpr std::uint32_t kLeft = 0xffffffffu;
   std::size_t left_ = 0;
   bool pending_ = false;
+  // More newcomers than this are admitted at once (each waiting one costs a sum over all
+  // carriers per step).
+  static constexpr std::size_t kMaxWaiting = 64;
   // Meanwhile each waiting carrier is induced by the applied field and its neighbours' held
   // dipoles and feels their pair forces (and they its), every step (add_waiting_forces);
   // the engine indices and forces added at the last step (for last_forces).

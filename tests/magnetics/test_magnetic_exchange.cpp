@@ -245,3 +245,29 @@ TEST(MagneticForceTerm, DeferredExchangeSurvivesARestartBitIdentically)
     s->advance(1200); // past the refresh interval: the waiting exchange is admitted
   EXPECT_EQ(state_in_id_order(*a), state_in_id_order(*b));
 }
+
+// Many newcomers at once (more than the term lets wait: each waiting one costs a sum over all
+// carriers per step) are admitted at the next step, by a full evaluation.
+TEST(MagneticForceTerm, DeferredExchangeAdmitsALargeBatchAtOnce)
+{
+  omp_set_num_threads(2);
+  const Case c = parse_case_text(scene, "magnetic_exchange.yaml");
+  dem::DemSystem system(c);
+  auto owned = std::make_unique<MagneticForceTerm>(c, MagneticSettings::from_case(c.dem),
+                                                   AppliedMagneticField::uniform({0, 0, 1}, 0.13), system.box().length);
+  const MagneticForceTerm *term = owned.get();
+  system.add_force_term(std::move(owned));
+  system.insert_particles();
+  system.initialize();
+  system.advance(20);
+  const long evaluations = term->evaluations();
+  dem::ParticleState enter;
+  for (int k = 0; k < 70; ++k)
+    enter.add({0.1e-3 * (k % 10) + 0.05e-3, 0.14e-3 * (k / 10) + 0.05e-3, 0.45e-3}, 30e-6, 2200.0, 0, 0.0);
+  system.exchange_particles({}, enter);
+  system.step();
+  EXPECT_EQ(term->evaluations(), evaluations + 1);
+  EXPECT_EQ(term->dipoles().dipoles().size(), 3u * 570u);
+  int fresh_sweeps = 0;
+  EXPECT_LT(difference_to_fresh_solve(c, system, *term, fresh_sweeps), 1e-5);
+}

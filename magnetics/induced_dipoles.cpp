@@ -543,14 +543,21 @@ bool InducedDipoles::refresh_locally(const BeadArrays &beads, const AppliedField
 {
   (void)time; // the refresh interval counts from the last full compute()
   stats = MagneticStats();
+  local_fallback_ = LocalFallback::none;
   const double t_start = omp_get_wtime();
   if (!can_refresh_locally(beads))
+  {
+    local_fallback_ = LocalFallback::lists;
     return false;
+  }
   if (!local_.select_moved(beads, staleness_, settings_))
     return true;
   local_.grow_region(beads, near_, settings_.local_region_radius);
   if (local_.region_too_large(beads.n, settings_.local_region_limit))
+  {
+    local_fallback_ = LocalFallback::region;
     return false;
+  }
   reevaluate_moved_beads(beads, field);
 
   const double t_sweeps = omp_get_wtime();
@@ -633,7 +640,8 @@ std::string settings_fingerprint(const MagneticSettings &s)
                    s.relative_check_radius, s.absolute_factor, s.switch_begin, s.switch_end,
                    static_cast<double>(s.slab_tail_correction), static_cast<double>(s.far_field),
                    s.far_cell_diameters, static_cast<double>(s.far_order), static_cast<double>(s.far_near_reach),
-                   static_cast<double>(s.far_passes), static_cast<double>(s.far_single_precision)})
+                   static_cast<double>(s.far_passes), static_cast<double>(s.far_single_precision),
+                   static_cast<double>(s.defer_exchange)})
     add(v);
   return f;
 }

@@ -112,6 +112,12 @@ public:
   // caller then calls compute(). With no moved bead it does nothing and returns true.
   bool refresh_locally(const BeadArrays &beads, const AppliedFieldFunction &field, double time,
                        MagneticStats &stats);
+  // Why the last refresh_locally() returned false (a full evaluation is due): the lists
+  // expired (a bead moved half the skin; or no local version: slab tail, nothing held), or
+  // the region grew past local_region_limit of the beads. For the profile of what fires the
+  // full evaluations.
+  enum class LocalFallback { none, lists, region };
+  LocalFallback local_fallback() const { return local_fallback_; }
 
   // Linear beads only (no saturation): the applied field was scaled by `ratio` (a ramp):
   // scales the held dipoles, fields and forces accordingly (p ∝ B, F ∝ B²: exact), so that a
@@ -175,6 +181,7 @@ private:
   std::vector<double> force_, torque_;
   std::vector<std::uint32_t> fresh_; // beads that entered since the last compute (particles_changed)
   bool computed_ = false;
+  LocalFallback local_fallback_ = LocalFallback::none;
   bool zero_field_ = false; // the last compute() found no applied field at any bead
   double skin_ = 0.0;       // Verlet skin of the last compute [m]
   double far_cell_size_ = 0.0; // fine cell size of the last far-field build [m]

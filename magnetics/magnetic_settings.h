@@ -122,6 +122,15 @@ struct MagneticSettings
   double relative_check_radius = 4.0;
   double absolute_factor = 5.0;
 
+  // Particles entering or leaving (the inflow / outflow exchange, DemSystem::
+  // exchange_particles): true = an exchange forces no evaluation of its own: an empty one
+  // changes nothing, the leavers stay as frozen sources and the newcomers wait (no magnetic
+  // force) until the next full evaluation (the interval, a list expiry, a large region),
+  // which admits them — at most magnetic_refresh later. false = a full evaluation with new
+  // lists at every exchange, even an empty one (the behaviour before; docs/magnetics.md
+  // "Particle exchange").
+  bool defer_exchange = true;
+
   // `corrected`: the exact-minus-dipole pair correction is applied fully for centre
   // distances below switch_begin (in mean pair radii, 2 = touching) and blended smoothly to
   // zero at switch_end (C¹ smoothstep). Tables extend to switch_end.

@@ -1,6 +1,7 @@
 #include "dem/force_terms/magnetic_force_term.h"
 
 #include "dem/periodic_unwrap.h"
+#include "magnetics/dipole_physics.h"
 
 #include "dem/checkpoint_file.h"
 #include "dem/dem_system.h"
@@ -31,8 +32,10 @@ MagneticSettings with_slab_tail(MagneticSettings s, const std::array<double, 3> 
 MagneticForceTerm::MagneticForceTerm(const Case &c, MagneticSettings settings,
                                      const AppliedMagneticField &field,
                                      const std::array<double, 3> &box, bool slab_tail)
-  : dipoles_(with_slab_tail(settings, box, slab_tail), box), field_(field), box_(box)
+  : dipoles_(with_slab_tail(settings, box, slab_tail), box), field_(field), box_(box),
+    waiting_correction_(dipoles_.settings(), box)
 {
+  std::vector<double> carrier_beta;
   for (const Population &pop : c.populations)
   {
     Species s;
@@ -42,9 +45,12 @@ MagneticForceTerm::MagneticForceTerm(const Case &c, MagneticSettings settings,
       const Material &m = c.material(pop.material);
       s.mu_r = m.mu_r;
       s.saturation_magnetisation = m.saturation_magnetisation;
+      carrier_beta.push_back(clausius_mossotti(m.mu_r));
     }
     species_.push_back(s);
   }
+  if (dipoles_.settings().model == DipoleModel::corrected && !carrier_beta.empty())
+    waiting_correction_.prepare_tables(carrier_beta);
 }
 
 void MagneticForceTerm::select_carriers(const dem::ParticleState &state)
@@ -82,12 +88,39 @@ void MagneticForceTerm::select_carriers(const dem::ParticleState &state)
   for (auto *v : {&fx_, &fy_, &fz_, &tx_, &ty_, &tz_})
     v->assign(n, 0.0);
   dipoles_.reset_dipoles();
+  newcomers_.clear();
+  left_ = 0;
+  pending_ = false;
 }
 
 void MagneticForceTerm::gather_positions(const dem::ParticleState &state)
 {
   std::vector<double> *const mine[3] = {&x_, &y_, &z_};
-  dem::follow_unwrapped(state, carrier_, box_, mine); // dem/periodic_unwrap.h
+  if (left_ == 0)
+  {
+    dem::follow_unwrapped(state, carrier_, box_, mine); // dem/periodic_unwrap.h
+    return;
+  }
+  // As follow_unwrapped, the carriers that left keeping their last position.
+  const std::vector<double> *engine[3] = {&state.x, &state.y, &state.z};
+  for (int d = 0; d < 3; ++d)
+  {
+    const double L = box_[static_cast<std::size_t>(d)];
+    std::vector<double> &to = *mine[d];
+    for (std::size_t k = 0; k < carrier_.size(); ++k)
+    {
+      if (carrier_[k] == kLeft)
+        continue;
+      const double raw = (*engine[d])[carrier_[k]];
+      const double jump = to[k] - raw;
+      to[k] = (L > 0.0 && std::abs(jump) > 0.5 * L) ? raw + L * std::round(jump / L) : raw;
+    }
+  }
+}
+
+BeadArrays MagneticForceTerm::bead_arrays() const
+{
+  return {carrier_.size(), x_.data(), y_.data(), z_.data(), radius_.data(), mu_r_.data(), Ms_.data()};
 }
 
 AppliedFieldFunction MagneticForceTerm::lookup_at(double t) const
@@ -146,6 +179,7 @@ void MagneticForceTerm::add_forces(const dem::ParticleState &state, dem::ForceBu
 {
   if (!enabled_)
     return;
+  const bool set_changed = changed_ && !must_refresh_;
   if (must_refresh_ || state.size() != state_size_)
   {
     select_carriers(state);
@@ -157,13 +191,27 @@ void MagneticForceTerm::add_forces(const dem::ParticleState &state, dem::ForceBu
     must_refresh_ = true; // a full (warm-started) evaluation of the new set
   }
   changed_ = false;
-  newcomers_.clear();
+  if (!pending_)
+    newcomers_.clear();
+  else if (carrier_.size() == left_ || newcomers_.size() > kMaxWaiting)
+    apply_pending(state); // nothing held to wait with (the first carriers of an inflow), or
+                          // so many newcomers that their per-step sums would cost more
   const std::size_t n = carrier_.size();
   if (n == 0)
     return;
   gather_positions(state);
-  const BeadArrays beads{n, x_.data(), y_.data(), z_.data(), radius_.data(), mu_r_.data(), Ms_.data()};
+  BeadArrays beads = bead_arrays();
   const double ramp = field_.ramp(t);
+  // A full evaluation is due: the exchanges held back since the last one join it first.
+  auto full = [&]() {
+    if (pending_)
+    {
+      ++counts_.set_changed;
+      apply_pending(state);
+      beads = bead_arrays();
+    }
+    full_refresh(beads, t, ramp);
+  };
   StalenessCheck check;
   if (must_refresh_)
     check.reason = RefreshReason::first;
@@ -184,15 +232,16 @@ void MagneticForceTerm::add_forces(const dem::ParticleState &state, dem::ForceBu
   case RefreshReason::first:
   case RefreshReason::bead_count:
     ++counts_.first;
-    full_refresh(beads, t, ramp);
+    counts_.set_changed += set_changed;
+    full();
     break;
   case RefreshReason::interval:
     ++counts_.interval;
-    full_refresh(beads, t, ramp);
+    full();
     break;
   case RefreshReason::moved:
   {
-    bool local = false;
+    bool local = false, tried = false;
     // (Saturating beads while the field ramps: the held state cannot be rescaled exactly.)
     if (dipoles_.settings().staleness_mode != StalenessMode::absolute && held_ramp_ > 0.0 &&
         (ramp == held_ramp_ || dipoles_.linear()))
@@ -203,6 +252,7 @@ void MagneticForceTerm::add_forces(const dem::ParticleState &state, dem::ForceBu
         dipoles_.scale_applied_field(ramp / held_ramp_);
       held_ramp_ = ramp;
       const double t0 = omp_get_wtime();
+      tried = true;
       local = dipoles_.refresh_locally(beads, lookup_at(t), t, local_stats_);
       counts_.local_s += omp_get_wtime() - t0;
       counts_.region_beads += local ? static_cast<long>(local_stats_.local_region) : 0;
@@ -215,7 +265,9 @@ void MagneticForceTerm::add_forces(const dem::ParticleState &state, dem::ForceBu
     else
     {
       ++counts_.moved;
-      full_refresh(beads, t, ramp);
+      counts_.moved_lists += tried && dipoles_.local_fallback() == InducedDipoles::LocalFallback::lists;
+      counts_.moved_region += tried && dipoles_.local_fallback() == InducedDipoles::LocalFallback::region;
+      full();
     }
     break;
   }
@@ -226,21 +278,135 @@ void MagneticForceTerm::add_forces(const dem::ParticleState &state, dem::ForceBu
   const double scale = (held_ramp_ > 0.0 && ramp != held_ramp_ && dipoles_.linear())
                          ? (ramp / held_ramp_) * (ramp / held_ramp_) : 1.0;
   last_scale_ = scale;
-  for (std::size_t k = 0; k < n; ++k)
+  add_waiting_forces(state, forces, t);
+  const std::size_t m = carrier_.size(); // (the held-back exchanges may just have joined)
+  for (std::size_t k = 0; k < m; ++k)
   {
     const std::size_t i = carrier_[k];
+    if (i == kLeft)
+      continue;
     forces.fx[i] += scale * fx_[k];
     forces.fy[i] += scale * fy_[k];
     forces.fz[i] += scale * fz_[k];
   }
   if (dipoles_.settings().torque == TorqueModel::paper) // (otherwise no magnetic torque)
-    for (std::size_t k = 0; k < n; ++k)
+    for (std::size_t k = 0; k < m; ++k)
     {
       const std::size_t i = carrier_[k];
+      if (i == kLeft)
+        continue;
       forces.tx[i] += scale * tx_[k];
       forces.ty[i] += scale * ty_[k];
       forces.tz[i] += scale * tz_[k];
     }
+}
+
+// The carriers waiting for admission (defer_exchange), every step: each one's dipole induced
+// by the applied field and the held dipoles of the beads within `reach` of it (one Jacobi
+// step: the held dipoles do not answer it), its force (p·∇)B0 plus the point-dipole pair
+// forces, and the reactions on those beads (Newton's third law). The two-sphere correction
+// and the far field are left to the admission at the next full evaluation.
+void MagneticForceTerm::add_waiting_forces(const dem::ParticleState &state, dem::ForceBuffers &forces, double t)
+{
+  waiting_.clear();
+  waiting_f_.clear();
+  if (!pending_)
+    return;
+  const AppliedFieldFunction field = lookup_at(t);
+  const std::vector<double> &held = dipoles_.dipoles();
+  const std::size_t n = carrier_.size();
+  const bool have_held = held.size() == 3 * n;
+  // The held dipoles follow a ramping field (p ∝ B for linear beads).
+  const double s = (held_ramp_ > 0.0 && dipoles_.linear()) ? field_.ramp(t) / held_ramp_ : 1.0;
+  for (const std::uint32_t i : newcomers_)
+  {
+    const std::size_t species = static_cast<std::size_t>(state.species[i]);
+    if (species >= species_.size() || !species_[species].carrier)
+      continue;
+    const double x[3] = {state.x[i], state.y[i], state.z[i]};
+    const double reach = 8.0 * state.radius[i]; // 4 diameters (the papers' cutoff)
+    double B[3], g[3][3], p[3];
+    field(x, B, g);
+    neighbours_.clear();
+    for (std::size_t k = 0; have_held && k < n; ++k)
+    {
+      double r[3] = {x[0] - x_[k], x[1] - y_[k], x[2] - z_[k]};
+      for (int d = 0; d < 3; ++d)
+        if (box_[d] > 0.0)
+          r[d] -= box_[d] * std::round(r[d] / box_[d]);
+      const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+      if (r2 >= reach * reach || r2 == 0.0)
+        continue;
+      const double pk[3] = {s * held[3 * k], s * held[3 * k + 1], s * held[3 * k + 2]};
+      DipoleTensor::at(r).add_field(pk, B);
+      neighbours_.push_back(static_cast<std::uint32_t>(k));
+    }
+    induced_moment(state.radius[i], clausius_mossotti(species_[species].mu_r),
+                   species_[species].saturation_magnetisation, B, p);
+    double F[3]; // (p·∇)B0: F_a = Σ_c p_c ∂B_a/∂x_c
+    for (int a = 0; a < 3; ++a)
+      F[a] = p[0] * g[a][0] + p[1] * g[a][1] + p[2] * g[a][2];
+    for (const std::uint32_t k : neighbours_)
+    {
+      double r[3] = {x[0] - x_[k], x[1] - y_[k], x[2] - z_[k]};
+      for (int d = 0; d < 3; ++d)
+        if (box_[d] > 0.0)
+          r[d] -= box_[d] * std::round(r[d] / box_[d]);
+      const double pk[3] = {s * held[3 * k], s * held[3 * k + 1], s * held[3 * k + 2]};
+      double Fp[3];
+      dipole_pair_force(r, p, pk, Fp);
+      if (dipoles_.settings().model == DipoleModel::corrected)
+        add_waiting_correction(k, s, x, state.radius[i], clausius_mossotti(species_[species].mu_r), B, p, r, Fp);
+      for (int d = 0; d < 3; ++d)
+        F[d] += Fp[d];
+      if (carrier_[k] == kLeft)
+        continue;
+      add_waiting(forces, carrier_[k], -Fp[0], -Fp[1], -Fp[2]);
+    }
+    add_waiting(forces, i, F[0], F[1], F[2]);
+  }
+}
+
+// The two-sphere correction of the pair (held bead k, waiting bead at x), r = x − x_k, added
+// to F (the force on the waiting bead): the held bead's local field gains the newcomer's
+// field (the correction takes each partner's own contribution out again).
+void MagneticForceTerm::add_waiting_correction(std::size_t k, double s, const double x[3], double radius,
+                                               double beta, const double B[3], const double p[3],
+                                               const double r[3], double F[3])
+{
+  (void)x;
+  const std::vector<double> &held_p = dipoles_.dipoles();
+  const std::vector<double> &held_B = dipoles_.local_fields();
+  if (held_B.size() != held_p.size())
+    return;
+  const DipoleTensor T = DipoleTensor::at(r);
+  pair_radius_[0] = radius_[k];
+  pair_radius_[1] = radius;
+  pair_beta_[0] = clausius_mossotti(mu_r_[k]);
+  pair_beta_[1] = beta;
+  double Bk[3] = {s * held_B[3 * k], s * held_B[3 * k + 1], s * held_B[3 * k + 2]};
+  T.add_field(p, Bk);
+  for (int d = 0; d < 3; ++d)
+  {
+    pair_field_[d] = Bk[d];
+    pair_field_[3 + d] = B[d];
+    pair_p_[d] = s * held_p[3 * k + d];
+    pair_p_[3 + d] = p[d];
+  }
+  const double zero[2] = {0.0, 0.0};
+  const BeadArrays pair{2, zero, zero, zero, pair_radius_.data(), zero, zero};
+  waiting_correction_.add({pair, pair_beta_, pair_field_, pair_p_}, 0, 1, r, T, F);
+}
+
+void MagneticForceTerm::add_waiting(dem::ForceBuffers &forces, std::uint32_t i, double fx, double fy, double fz)
+{
+  forces.fx[i] += fx;
+  forces.fy[i] += fy;
+  forces.fz[i] += fz;
+  waiting_.push_back(i);
+  waiting_f_.push_back(fx);
+  waiting_f_.push_back(fy);
+  waiting_f_.push_back(fz);
 }
 
 void MagneticForceTerm::last_forces(std::vector<double> &fx, std::vector<double> &fy,
@@ -251,9 +417,17 @@ void MagneticForceTerm::last_forces(std::vector<double> &fx, std::vector<double>
   fz.assign(state_size_, 0.0);
   for (std::size_t k = 0; k < carrier_.size(); ++k)
   {
+    if (carrier_[k] == kLeft)
+      continue;
     fx[carrier_[k]] = last_scale_ * fx_[k];
     fy[carrier_[k]] = last_scale_ * fy_[k];
     fz[carrier_[k]] = last_scale_ * fz_[k];
+  }
+  for (std::size_t w = 0; w < waiting_.size(); ++w)
+  {
+    fx[waiting_[w]] += waiting_f_[3 * w];
+    fy[waiting_[w]] += waiting_f_[3 * w + 1];
+    fz[waiting_[w]] += waiting_f_[3 * w + 2];
   }
 }
 
@@ -272,13 +446,25 @@ void MagneticForceTerm::particles_reordered(const std::vector<std::int32_t> &ord
   for (std::size_t k = 0; k < order.size(); ++k)
     new_index[static_cast<std::size_t>(order[k])] = static_cast<std::uint32_t>(k);
   for (auto &i : carrier_)
-    i = new_index[i];
+    if (i != kLeft)
+      i = new_index[i];
   for (auto &i : newcomers_)
     i = new_index[i];
 }
 
 void MagneticForceTerm::particles_changed(const std::vector<std::int32_t> &origin)
 {
+  if (must_refresh_) // select_carriers() takes the whole set at the next step
+  {
+    state_size_ = origin.size();
+    newcomers_.clear();
+    return;
+  }
+  if (dipoles_.settings().defer_exchange && !changed_)
+  {
+    defer_change(origin);
+    return;
+  }
   // Old engine index → new (−1: left). The compact beads whose particle left are dropped;
   // the others keep their compact order.
   new_index_.assign(state_size_, -1);
@@ -329,6 +515,74 @@ void MagneticForceTerm::particles_changed(const std::vector<std::int32_t> &origi
   changed_ = true;
 }
 
+// MagneticSettings::defer_exchange. An exchange changes only which engine index each compact
+// bead reads: a bead whose particle left becomes a frozen source (kLeft), the newcomers are
+// remembered (through re-sorts and further exchanges) until apply_pending(). An exchange
+// that moved nothing in or out changes nothing at all.
+void MagneticForceTerm::defer_change(const std::vector<std::int32_t> &origin)
+{
+  bool identity = origin.size() == state_size_;
+  for (std::size_t k = 0; identity && k < origin.size(); ++k)
+    identity = origin[k] == static_cast<std::int32_t>(k);
+  if (identity)
+    return;
+  new_index_.assign(state_size_, -1);
+  for (std::size_t k = 0; k < origin.size(); ++k)
+    if (origin[k] >= 0)
+    {
+      if (static_cast<std::size_t>(origin[k]) >= state_size_)
+      { // the term has not seen this particle set: select afresh at the next step
+        must_refresh_ = true;
+        state_size_ = origin.size();
+        return;
+      }
+      new_index_[static_cast<std::size_t>(origin[k])] = static_cast<std::int32_t>(k);
+    }
+  std::size_t still = 0;
+  for (std::uint32_t i : newcomers_)
+    if (new_index_[i] >= 0)
+      newcomers_[still++] = static_cast<std::uint32_t>(new_index_[i]);
+  newcomers_.resize(still);
+  for (std::size_t k = 0; k < origin.size(); ++k)
+    if (origin[k] < 0)
+      newcomers_.push_back(static_cast<std::uint32_t>(k));
+  for (auto &i : carrier_)
+    if (i != kLeft)
+    {
+      const std::int32_t to = new_index_[i];
+      left_ += to < 0;
+      i = to < 0 ? kLeft : static_cast<std::uint32_t>(to);
+    }
+  state_size_ = origin.size();
+  pending_ = left_ > 0 || !newcomers_.empty();
+}
+
+// Before a full evaluation: the frozen sources go, the newcomers join (as particles_changed
+// does at once without the deferral), the solver learns the new set.
+void MagneticForceTerm::apply_pending(const dem::ParticleState &state)
+{
+  compact_origin_.resize(carrier_.size());
+  std::size_t kept = 0;
+  for (std::size_t c = 0; c < carrier_.size(); ++c)
+  {
+    if (carrier_[c] == kLeft)
+      continue;
+    carrier_[kept] = carrier_[c];
+    for (auto *v : {&x_, &y_, &z_, &radius_, &mu_r_, &Ms_})
+      (*v)[kept] = (*v)[c];
+    compact_origin_[kept] = static_cast<std::int32_t>(c);
+    ++kept;
+  }
+  carrier_.resize(kept);
+  compact_origin_.resize(kept);
+  for (auto *v : {&x_, &y_, &z_, &radius_, &mu_r_, &Ms_})
+    v->resize(kept);
+  left_ = 0;
+  pending_ = false;
+  admit_newcomers(state);
+  newcomers_.clear();
+}
+
 // The carriers among the particles that entered, in ascending engine index, appended to the
 // compact order; then the dipole solver learns the new set (kept dipoles as the initial guess).
 void MagneticForceTerm::admit_newcomers(const dem::ParticleState &state)
@@ -371,10 +625,17 @@ void MagneticForceTerm::write_state(dem::CheckpointWriter &out) const
   block.put(last_scale_);
   block.put(evaluations_);
   block.put(local_refreshes_);
-  block.put(counts_);
+  block.put(static_cast<const RefreshCountsStored &>(counts_));
   block.put(stats_);
   block.put(local_stats_);
   dipoles_.write_state(block);
+  // Appended later (a block without them, from before, reads as nothing pending): the
+  // exchanges held back (defer_exchange) and the counters of the causes.
+  block.put_array(newcomers_);
+  block.put<std::uint8_t>(pending_);
+  block.put(counts_.moved_lists);
+  block.put(counts_.moved_region);
+  block.put(counts_.set_changed);
   out.put_string(block.bytes());
 }
 
@@ -391,13 +652,17 @@ void MagneticForceTerm::read_state(dem::CheckpointReader &in)
   for (const auto &a : v)
     if (a.size() != carrier.size())
       block.fail("is corrupt (per-carrier arrays of different lengths)");
+  std::size_t left = 0;
   for (const std::uint32_t i : carrier)
-    if (i >= state_size)
+    if (i == kLeft)
+      ++left;
+    else if (i >= state_size)
       block.fail("is corrupt (a carrier index beyond the particle count)");
   const bool must_refresh = block.get<std::uint8_t>() != 0;
   const double held_ramp = block.get<double>(), last_scale = block.get<double>();
   const long evaluations = block.get<long>(), local_refreshes = block.get<long>();
-  const auto counts = block.get<RefreshCounts>();
+  RefreshCounts counts;
+  static_cast<RefreshCountsStored &>(counts) = block.get<RefreshCountsStored>();
   const auto stats = block.get<MagneticStats>(), local_stats = block.get<MagneticStats>();
   if (!dipoles_.read_state(block))
   {
@@ -406,8 +671,24 @@ void MagneticForceTerm::read_state(dem::CheckpointReader &in)
     must_refresh_ = true;
     return;
   }
+  std::vector<std::uint32_t> newcomers;
+  bool pending = false;
+  if (block.remaining() > 0)
+  {
+    block.get_array(newcomers);
+    for (const std::uint32_t i : newcomers)
+      if (i >= state_size)
+        block.fail("is corrupt (a newcomer index beyond the particle count)");
+    pending = block.get<std::uint8_t>() != 0;
+    counts.moved_lists = block.get<long>();
+    counts.moved_region = block.get<long>();
+    counts.set_changed = block.get<long>();
+  }
   state_size_ = static_cast<std::size_t>(state_size);
   carrier_ = std::move(carrier);
+  newcomers_ = std::move(newcomers);
+  left_ = left;
+  pending_ = pending;
   std::vector<double> *mine[12] = {&x_, &y_, &z_, &radius_, &mu_r_, &Ms_, &fx_, &fy_, &fz_, &tx_, &ty_, &tz_};
   for (int k = 0; k < 12; ++k)
     *mine[k] = std::move(v[k]);

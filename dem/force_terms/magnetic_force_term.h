@@ -11,6 +11,10 @@
 //   * otherwise the held forces of the last evaluation, rescaled by (s(t)/s_held)² while
 //     the applied field ramps (linear beads: p ∝ B, F ∝ B², exact).
 //
+// Particles entering or leaving (the inflow / outflow exchange) fire no evaluation of their
+// own (MagneticSettings::defer_exchange): they join the next full one; meanwhile the leavers
+// stay frozen sources and the newcomers feel the field and their held neighbours.
+//
 // The compact carrier order is the magnetics' own, fixed when the carriers are selected: the
 // engine's spatial re-sorting only changes which engine index each compact bead reads, so
 // the magnetic neighbour lists, cells and dipoles survive it. Positions are unwrapped along
@@ -20,6 +24,7 @@
 
 #include "dem/force_term.h"
 #include "magnetics/induced_dipoles.h"
+#include "magnetics/two_sphere_correction.h"
 
 #include "coupling/applied_magnetic_field.h"
 #include "coupling/case_model.h"
@@ -52,7 +57,9 @@ public:
   bool restored_state() const { return restored_; }
   // Carriers left or entered: the leavers are dropped from the compact order (the others
   // keep their place, dipoles and unwrapped positions), the newcomers that are carriers are
-  // appended at the next step, which then solves in full (warm-started).
+  // appended — at the next step, which then solves in full (warm-started), or with
+  // MagneticSettings::defer_exchange (the default) at the next full evaluation, the leavers
+  // staying frozen sources until then; an exchange that moved nothing changes nothing.
   void particles_changed(const std::vector<std::int32_t> &origin) override;
 
   // Statistics of the last full evaluation, and of the last local refresh.
@@ -67,7 +74,7 @@ public:
   // elapsed, beads moved
   // (absolute mode, or a local refresh that could not stand in for a full one), and how
   // many of those found no applied field (nothing solved).
-  struct RefreshCounts
+  struct RefreshCountsStored // (the checkpoint's layout)
   {
     long first = 0, interval = 0, moved = 0, zero_field = 0;
     // Wall time [s] in full evaluations, in local refreshes (including attempts that fell
@@ -80,6 +87,15 @@ public:
     // tensors, far field, sweeps, forces; and how many rebuilt the lists.
     double lists_s = 0.0, tensors_s = 0.0, far_s = 0.0, sweeps_s = 0.0, forces_s = 0.0;
     long rebuilds = 0;
+  };
+  struct RefreshCounts : RefreshCountsStored // (the rest is written at the block's end)
+  {
+    // Of `moved`: the local refresh fell back to a full evaluation because the lists expired
+    // / because the region exceeded local_region_limit of the beads.
+    long moved_lists = 0, moved_region = 0;
+    // Full evaluations that took in particles entered or left (inflow, outflow): of `first`
+    // without MagneticSettings::defer_exchange (one per exchange), of any cause with it.
+    long set_changed = 0;
   };
   const RefreshCounts &refresh_counts() const { return counts_; }
   const InducedDipoles &dipoles() const { return dipoles_; }
@@ -112,6 +128,27 @@ private:
   // through re-sorting; the carriers among them join the compact order at the next step.
   std::vector<std::uint32_t> newcomers_;
   bool changed_ = false;
+  // MagneticSettings::defer_exchange: a compact bead whose particle left keeps its place, its
+  // last position and its dipole (a frozen source, carrier_ = kLeft) until the next full
+  // evaluation compacts the set and admits the newcomers (`pending_`).
+  static constexpr std::uint32_t kLeft = 0xffffffffu;
+  std::size_t left_ = 0;
+  bool pending_ = false;
+  // More newcomers than this are admitted at once (each waiting one costs a sum over all
+  // carriers per step).
+  static constexpr std::size_t kMaxWaiting = 64;
+  // Meanwhile each waiting carrier is induced by the applied field and its neighbours' held
+  // dipoles and feels their pair forces (and they its), every step (add_waiting_forces);
+  // the engine indices and forces added at the last step (for last_forces).
+  std::vector<std::uint32_t> waiting_, neighbours_;
+  std::vector<double> waiting_f_;
+  // `corrected`: the two-sphere correction of a waiting carrier's close pairs, through a
+  // two-bead state (the neighbour, the newcomer) reused every time.
+  TwoSphereCorrection waiting_correction_;
+  std::vector<double> pair_radius_ = std::vector<double>(2), pair_beta_ = std::vector<double>(2),
+                      pair_field_ = std::vector<double>(6), pair_p_ = std::vector<double>(6);
+  void add_waiting_correction(std::size_t k, double s, const double x[3], double radius, double beta,
+                              const double B[3], const double p[3], const double r[3], double F[3]);
   std::vector<std::int32_t> compact_origin_, new_index_;
   bool enabled_ = true;
   bool restored_ = false; // read_state() found state for these settings
@@ -121,6 +158,11 @@ private:
 
   void select_carriers(const dem::ParticleState &state);
   void admit_newcomers(const dem::ParticleState &state);
+  void defer_change(const std::vector<std::int32_t> &origin);
+  void add_waiting_forces(const dem::ParticleState &state, dem::ForceBuffers &forces, double t);
+  void add_waiting(dem::ForceBuffers &forces, std::uint32_t i, double fx, double fy, double fz);
+  void apply_pending(const dem::ParticleState &state);
+  BeadArrays bead_arrays() const;
   void gather_positions(const dem::ParticleState &state);
   AppliedFieldFunction lookup_at(double t) const;
   void full_refresh(const BeadArrays &beads, double t, double ramp);

@@ -25,7 +25,11 @@
 //   nip_quick:   the same on tools/run's quick default (cases/kawamoto_nip.yaml, 4,300 beads,
 //                1 mm slab, 40 ns steps).
 //
-//   bench_magnetic_staleness [nip|nip_quick|compression|both] [flow_us (nip, 300)] [until_us (compression, 500)]
+//   regulation:  cases/kweon_regulation.yaml (the sump inflow, the doctor blade, the outflow):
+//                run to `until` once, then every mode runs the same `flow` window (function
+//                regulation() below: a state of `magbrush run` can be reused).
+//
+//   bench_magnetic_staleness [nip|nip_quick|compression|both|regulation] [flow_us (nip, 300)] [until_us (compression, 500)]
 //                            [sample_us (2)] [modes (absolute,local,relative)] [refresh_us (the case's: 5)]
 //                            [descent_at_us (2500)] [descent_us (300; 0 = skip)]
 // Environment (knobs without a case key): MAGBRUSH_LOCAL_REGION_LIMIT, MAGBRUSH_LOCAL_BATCH,
@@ -49,6 +53,7 @@
 #include <filesystem>
 #include <memory>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -89,13 +94,12 @@ public:
     if (hx.size() != s.size())
       return;
     // The carriers by stable id (the engine re-sorts; the reference keeps its warm start).
-    std::vector<std::size_t> index_of_id(s.size());
-    for (std::size_t k = 0; k < s.size(); ++k)
-      index_of_id[static_cast<std::size_t>(s.id[k])] = k;
+    // (Ids need not be 0 … n−1: the inflow and outflow exchange particles.)
     order_.clear();
-    for (std::size_t id = 0; id < s.size(); ++id)
-      if (carrier_species_[static_cast<std::size_t>(s.species[index_of_id[id]])])
-        order_.push_back(index_of_id[id]);
+    for (std::size_t k = 0; k < s.size(); ++k)
+      if (carrier_species_[static_cast<std::size_t>(s.species[k])])
+        order_.push_back(k);
+    std::sort(order_.begin(), order_.end(), [&s](std::size_t a, std::size_t b) { return s.id[a] < s.id[b]; });
     const std::size_t n = order_.size();
     for (auto *v : {&x_, &y_, &z_, &r_, &mu_r_, &fx_, &fy_, &fz_})
       v->assign(n, 0.0);
@@ -172,6 +176,15 @@ private:
   std::vector<double> x_, y_, z_, r_, mu_r_, fx_, fy_, fz_;
 };
 
+std::vector<std::string> split(const std::string &list, char separator = ',')
+{
+  std::vector<std::string> out;
+  std::stringstream ss(list);
+  for (std::string item; std::getline(ss, item, separator);)
+    out.push_back(item);
+  return out;
+}
+
 struct ModeResult
 {
   std::string mode;
@@ -187,7 +200,11 @@ struct ModeResult
 ModeResult run_mode(Case c, const std::string &mode, const std::string &restart, const fs::path &dir,
                     std::size_t wall, double sample, double t0)
 {
-  c.dem.magnetic_staleness_mode = mode;
+  // A mode may carry variants of knobs without a case key, side by side in the same run:
+  // "relative+R1+S0.6" = relative with local_region_limit 1 and the magnetic lists' skin 0.6
+  // diameters; "+X0" = defer_exchange off (a full evaluation at every particle exchange).
+  const std::vector<std::string> parts = split(mode, '+');
+  c.dem.magnetic_staleness_mode = parts[0];
   dem::RunOptions options;
   options.restart_file = restart;
   // Every mode turns from the same checkpoint, written under another mode on purpose: its
@@ -212,6 +229,18 @@ ModeResult run_mode(Case c, const std::string &mode, const std::string &restart,
     settings.absolute_factor = std::atof(v);
   if (const char *v = std::getenv("MAGBRUSH_MAGNETIC_SKIN"))
     settings.skin_fraction = std::atof(v);
+  for (std::size_t k = 1; k < parts.size(); ++k)
+  {
+    const double v = std::atof(parts[k].c_str() + 1);
+    if (parts[k][0] == 'R')
+      settings.local_region_limit = v;
+    else if (parts[k][0] == 'S')
+      settings.skin_fraction = v;
+    else if (parts[k][0] == 'X')
+      settings.defer_exchange = v != 0.0;
+    else
+      throw std::runtime_error("unknown mode variant " + parts[k]);
+  }
   auto owned = std::make_unique<MagneticForceTerm>(c, settings, field, system.box().length);
   const MagneticForceTerm *term = owned.get();
   system.replace_force_term("magnetic dipoles", std::move(owned));
@@ -256,24 +285,16 @@ void print(const char *title, const char *wall_name, const std::vector<ModeResul
                 r.local / r.simulated_ms, r.local ? double(r.counts.region_beads) / r.local : 0.0, r.mean_rms,
                 r.max_rms, r.mean_max, r.max_max, r.mean_wall, r.max_wall, r.counts.full_s, r.counts.local_s,
                 r.counts.check_s, r.magnetic_s, r.rest_s, 100.0 * (r.magnetic_s - r.counts.cold_s) / r.rest_s);
-  std::printf("\nFull evaluations, phases summed [s]:\n\n| staleness mode | evaluations | list rebuilds | the cold first one | lists/cells | "
-              "applied field + tensors | far field | sweeps | forces |\n|---|---|---|---|---|---|---|---|---|\n");
+  std::printf("\nFull evaluations, phases summed [s]:\n\n| staleness mode | evaluations | list rebuilds | exchanges joined | moved: lists expired / region too large | the cold first one | lists/cells | "
+              "applied field + tensors | far field | sweeps | forces |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const ModeResult &r : results)
-    std::printf("| %s | %ld | %ld | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f |\n", r.mode.c_str(), r.full, r.counts.rebuilds,
-                r.counts.cold_s, r.counts.lists_s, r.counts.tensors_s, r.counts.far_s, r.counts.sweeps_s, r.counts.forces_s);
+    std::printf("| %s | %ld | %ld | %ld | %ld / %ld | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f |\n", r.mode.c_str(), r.full, r.counts.rebuilds,
+                r.counts.set_changed, r.counts.moved_lists, r.counts.moved_region, r.counts.cold_s, r.counts.lists_s, r.counts.tensors_s, r.counts.far_s, r.counts.sweeps_s, r.counts.forces_s);
   std::printf("\n(%ld samples per mode over %.3g ms)\n", results.empty() ? 0L : results[0].samples,
               results.empty() ? 0.0 : results[0].simulated_ms);
   std::fflush(stdout);
 }
 
-std::vector<std::string> split(const std::string &list)
-{
-  std::vector<std::string> out;
-  std::stringstream ss(list);
-  for (std::string item; std::getline(ss, item, ',');)
-    out.push_back(item);
-  return out;
-}
 
 double refresh_override_us = 0.0; // > 0: dem.magnetic_refresh for every run
 
@@ -371,6 +392,61 @@ void compression(const fs::path &dir, double until_us, double sample_us, const s
   print(title, "plate", results);
 }
 
+// The doctor-blade regulation cell (cases/kweon_regulation.yaml: developer fed by the sump
+// inflow every 2 us onto the turning sleeve, piled in front of the blade, sheared through its
+// gap, removed by the outflow): run (or take) the state at `until`, then every mode runs the
+// same `flow` window from it; the wall force is the sleeve's. Environment, to reuse a state
+// written by `magbrush run cases/kweon_regulation.yaml --set dem.duration=...`:
+// MAGBRUSH_BENCH_REGULATION_RESTART (its dem/checkpoint.bin; `until` must be its time) and
+// MAGBRUSH_BENCH_REGULATION_FIELDS (its field.output_dir).
+void regulation(const fs::path &dir, double until_us, double flow_us, double sample_us,
+                const std::vector<std::string> &modes)
+{
+  const std::string file = std::string(MAGBRUSH_SOURCE_DIR) + "/cases/kweon_regulation.yaml";
+  const char *fields = std::getenv("MAGBRUSH_BENCH_REGULATION_FIELDS");
+  const char *restart = std::getenv("MAGBRUSH_BENCH_REGULATION_RESTART");
+  std::vector<std::string> overrides = {
+    "field.output_dir=" + (fields ? std::string(fields) : (dir / "fields").string()),
+    "output.directory=" + dir.string(), "dem.output_interval=0 s"};
+  if (!fields)
+  {
+    std::string cmd = "cd '" + dir.string() + "' && OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 '" +
+                      std::string(MAGBRUSH_BINARY_DIR) + "/bin/magbrush' field '" + file + "'";
+    for (const auto &o : overrides)
+      cmd += " --set '" + o + "'";
+    if (std::system((cmd + " > field.log 2>&1").c_str()) != 0)
+    {
+      std::printf("regulation: `magbrush field` failed (see %s/field.log)\n", dir.c_str());
+      return;
+    }
+  }
+  Case c = load_case(file, overrides);
+  if (refresh_override_us > 0.0)
+    c.dem.magnetic_refresh = refresh_override_us * 1e-6;
+  const double start = until_us * 1e-6;
+  std::string checkpoint = restart ? std::string(restart) : std::string();
+  if (checkpoint.empty())
+  {
+    Case first = c;
+    first.dem.duration = start;
+    const double t_wall = omp_get_wtime();
+    run_mode(first, "relative", "", dir / "first", 0, 1e9, 0.0);
+    checkpoint = (dir / "first" / "run_relative" / "checkpoint.bin").string();
+    std::printf("regulation: ran to %.3g ms in %.0f s\n", start * 1e3, omp_get_wtime() - t_wall);
+  }
+  c.dem.duration = start + flow_us * 1e-6;
+  std::vector<ModeResult> results;
+  for (const auto &mode : modes)
+    results.push_back(run_mode(c, mode, checkpoint, dir, 0, sample_us * 1e-6, start));
+  char title[512];
+  std::snprintf(title, sizeof title,
+                "Regulation cell (cases/kweon_regulation.yaml): %.3g ... %.3g ms, step %.3g ns, refresh %.3g us, "
+                "staleness %.3g, inflow every %.3g us",
+                start * 1e3, c.dem.duration * 1e3, c.dem.time_step * 1e9, c.dem.magnetic_refresh * 1e6,
+                c.dem.magnetic_staleness, c.flow.interval * 1e6);
+  print(title, "sleeve", results);
+}
+
 } // namespace
 
 int main(int argc, char **argv)
@@ -394,6 +470,8 @@ int main(int argc, char **argv)
       nip(dir, flow_us, sample_us, modes, true);
     if (scene == "compression" || scene == "both")
       compression(dir, until_us, sample_us, modes);
+    if (scene == "regulation")
+      regulation(dir, until_us, flow_us, sample_us, modes);
   }
   catch (const std::exception &e)
   {

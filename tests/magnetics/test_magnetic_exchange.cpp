@@ -14,6 +14,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <unistd.h>
 
 using namespace magbrush;
 using namespace magbrush::magnetics;
@@ -36,9 +38,9 @@ dem: {time_step: 5 ns, periodic_length_x: 1 mm, periodic_length_y: 1 mm, magneti
 )";
 
 // The largest difference between the term's last forces and a fresh solve of the same state,
-// relative to the largest magnetic force.
+// relative to the largest magnetic force (`only`: of these engine indices; empty = all).
 double difference_to_fresh_solve(const Case &c, const dem::DemSystem &system, const MagneticForceTerm &term,
-                                 int &fresh_sweeps)
+                                 int &fresh_sweeps, const std::vector<std::size_t> &only = {})
 {
   std::vector<double> fx, fy, fz;
   term.last_forces(fx, fy, fz);
@@ -50,10 +52,15 @@ double difference_to_fresh_solve(const Case &c, const dem::DemSystem &system, co
   fresh_sweeps = fresh.last_stats().sweeps;
   double worst = 0.0, largest = 0.0;
   for (std::size_t i = 0; i < fx.size(); ++i)
-  {
     largest = std::max(largest, std::hypot(f.fx[i], f.fy[i], f.fz[i]));
+  auto differ = [&](std::size_t i) {
     worst = std::max(worst, std::hypot(fx[i] - f.fx[i], fy[i] - f.fy[i], fz[i] - f.fz[i]));
-  }
+  };
+  if (only.empty())
+    for (std::size_t i = 0; i < fx.size(); ++i)
+      differ(i);
+  for (std::size_t i : only)
+    differ(i);
   EXPECT_GT(largest, 0.0);
   return worst / largest;
 }
@@ -64,8 +71,10 @@ TEST(MagneticForceTerm, CarriersLeavingAndEnteringKeepTheSolverConsistent)
   omp_set_num_threads(2);
   const Case c = parse_case_text(scene, "magnetic_exchange.yaml");
   dem::DemSystem system(c);
-  auto owned = std::make_unique<MagneticForceTerm>(c, MagneticSettings::from_case(c.dem),
-                                                   AppliedMagneticField::uniform({0, 0, 1}, 0.13), system.box().length);
+  MagneticSettings settings = MagneticSettings::from_case(c.dem);
+  settings.defer_exchange = false; // the full evaluation at the exchange (see the test below)
+  auto owned = std::make_unique<MagneticForceTerm>(c, settings, AppliedMagneticField::uniform({0, 0, 1}, 0.13),
+                                                   system.box().length);
   const MagneticForceTerm *term = owned.get();
   system.add_force_term(std::move(owned));
   system.insert_particles();
@@ -117,4 +126,148 @@ TEST(MagneticForceTerm, CarriersLeavingAndEnteringKeepTheSolverConsistent)
   std::printf("removals only: max |F - F_fresh| / max |F| = %.2e; sweeps warm %d, fresh %d\n", after_removal,
               term->last_stats().sweeps, fresh_sweeps);
   EXPECT_LT(after_removal, 1e-5);
+}
+
+// MagneticSettings::defer_exchange (the default): an exchange forces no evaluation. An empty
+// one changes nothing; after a real one the newcomers feel the applied field and their
+// neighbours' held dipoles (bounded error) until the next full evaluation, which admits them
+// and equals a fresh solve again.
+TEST(MagneticForceTerm, DeferredExchangeJoinsTheNextFullEvaluation)
+{
+  omp_set_num_threads(2);
+  const Case c = parse_case_text(scene, "magnetic_exchange.yaml");
+  dem::DemSystem system(c);
+  const MagneticSettings settings = MagneticSettings::from_case(c.dem);
+  ASSERT_TRUE(settings.defer_exchange);
+  auto owned = std::make_unique<MagneticForceTerm>(c, settings, AppliedMagneticField::uniform({0, 0, 1}, 0.13),
+                                                   system.box().length);
+  const MagneticForceTerm *term = owned.get();
+  system.add_force_term(std::move(owned));
+  system.insert_particles();
+  system.initialize();
+  system.advance(40);
+  const long evaluations = term->evaluations();
+  const std::size_t dipoles_before = term->dipoles().dipoles().size();
+
+  system.exchange_particles({}, dem::ParticleState{}); // nothing in, nothing out
+  system.step();
+  EXPECT_EQ(term->evaluations(), evaluations) << "an empty exchange changes nothing";
+
+  std::vector<std::int32_t> leave;
+  for (std::size_t i = 0; i < system.particles().size(); ++i)
+    if (system.particles().id[i] % 7 == 3)
+      leave.push_back(static_cast<std::int32_t>(i));
+  dem::ParticleState enter;
+  for (int k = 0; k < 10; ++k) // ten carriers on the bed's top (0.3 mm)
+    enter.add({0.1e-3 * k + 0.05e-3, 0.5e-3, 0.33e-3}, 30e-6, 2200.0, 0, 0.0);
+  system.exchange_particles(leave, enter);
+  system.step();
+  EXPECT_EQ(term->evaluations(), evaluations) << "the exchange waits for the next full evaluation";
+  EXPECT_EQ(term->dipoles().dipoles().size(), dipoles_before) << "nobody admitted yet";
+  std::vector<std::size_t> newcomers;
+  for (std::size_t i = 0; i < system.particles().size(); ++i)
+    if (system.particles().id[i] >= 600)
+      newcomers.push_back(i);
+  ASSERT_EQ(newcomers.size(), 10u);
+  int fresh_sweeps = 0;
+  const double waiting = difference_to_fresh_solve(c, system, *term, fresh_sweeps, newcomers);
+  std::printf("deferred exchange: newcomers' forces before admission: max |F - F_fresh| / max |F| = %.2e\n", waiting);
+  EXPECT_LT(waiting, 0.5) << "the newcomers feel the field and their neighbours meanwhile";
+
+  int steps = 0;
+  while (term->evaluations() == evaluations && steps < 1100) // the refresh interval: 1000 steps
+  {
+    system.step();
+    ++steps;
+  }
+  long carriers_after = 0;
+  for (int s : system.particles().species)
+    carriers_after += s == 0;
+  EXPECT_EQ(term->dipoles().dipoles().size(), 3 * static_cast<std::size_t>(carriers_after));
+  const double admitted = difference_to_fresh_solve(c, system, *term, fresh_sweeps);
+  std::printf("admitted after %d steps: max |F - F_fresh| / max |F| = %.2e\n", steps, admitted);
+  EXPECT_LT(admitted, 1e-5);
+}
+
+namespace {
+// Positions, velocities and forces of every particle in id order (ids are not dense after an
+// exchange), as raw doubles.
+std::vector<double> state_in_id_order(const dem::DemSystem &s)
+{
+  const auto &p = s.particles();
+  const auto &f = s.forces();
+  std::vector<std::size_t> order(p.size());
+  for (std::size_t i = 0; i < order.size(); ++i)
+    order[i] = i;
+  std::sort(order.begin(), order.end(), [&p](std::size_t a, std::size_t b) { return p.id[a] < p.id[b]; });
+  std::vector<double> out;
+  for (std::size_t i : order)
+    for (double v : {p.x[i], p.y[i], p.z[i], p.vx[i], p.vy[i], p.vz[i], f.fx[i], f.fy[i], f.fz[i]})
+      out.push_back(v);
+  return out;
+}
+} // namespace
+
+// A checkpoint written while an exchange waits (leavers frozen, newcomers not admitted)
+// continues bit for bit: the waiting set is part of the magnetic state.
+TEST(MagneticForceTerm, DeferredExchangeSurvivesARestartBitIdentically)
+{
+  omp_set_num_threads(2);
+  const Case c = parse_case_text(scene, "magnetic_exchange.yaml");
+  auto make = [&c]() {
+    auto system = std::make_unique<dem::DemSystem>(c);
+    system->add_force_term(std::make_unique<MagneticForceTerm>(
+      c, MagneticSettings::from_case(c.dem), AppliedMagneticField::uniform({0, 0, 1}, 0.13), system->box().length));
+    return system;
+  };
+  auto a = make();
+  a->insert_particles();
+  a->initialize();
+  a->advance(40);
+  std::vector<std::int32_t> leave;
+  for (std::size_t i = 0; i < a->particles().size(); i += 13)
+    leave.push_back(static_cast<std::int32_t>(i));
+  dem::ParticleState enter;
+  for (int k = 0; k < 6; ++k)
+    enter.add({0.15e-3 * k + 0.05e-3, 0.3e-3, 0.33e-3}, 30e-6, 2200.0, 0, 0.0);
+  a->exchange_particles(leave, enter);
+  a->advance(5);
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("magnetic_exchange_restart_" + std::to_string(::getpid()) + ".bin")).string();
+  a->write_checkpoint(path);
+  auto b = make();
+  b->read_checkpoint(path);
+  std::filesystem::remove(path);
+  for (const auto &t : b->force_terms())
+    if (const auto *m = dynamic_cast<const MagneticForceTerm *>(t.get()))
+      EXPECT_TRUE(m->restored_state());
+  for (auto *s : {a.get(), b.get()})
+    s->advance(1200); // past the refresh interval: the waiting exchange is admitted
+  EXPECT_EQ(state_in_id_order(*a), state_in_id_order(*b));
+}
+
+// Many newcomers at once (more than the term lets wait: each waiting one costs a sum over all
+// carriers per step) are admitted at the next step, by a full evaluation.
+TEST(MagneticForceTerm, DeferredExchangeAdmitsALargeBatchAtOnce)
+{
+  omp_set_num_threads(2);
+  const Case c = parse_case_text(scene, "magnetic_exchange.yaml");
+  dem::DemSystem system(c);
+  auto owned = std::make_unique<MagneticForceTerm>(c, MagneticSettings::from_case(c.dem),
+                                                   AppliedMagneticField::uniform({0, 0, 1}, 0.13), system.box().length);
+  const MagneticForceTerm *term = owned.get();
+  system.add_force_term(std::move(owned));
+  system.insert_particles();
+  system.initialize();
+  system.advance(20);
+  const long evaluations = term->evaluations();
+  dem::ParticleState enter;
+  for (int k = 0; k < 70; ++k)
+    enter.add({0.1e-3 * (k % 10) + 0.05e-3, 0.14e-3 * (k / 10) + 0.05e-3, 0.45e-3}, 30e-6, 2200.0, 0, 0.0);
+  system.exchange_particles({}, enter);
+  system.step();
+  EXPECT_EQ(term->evaluations(), evaluations + 1);
+  EXPECT_EQ(term->dipoles().dipoles().size(), 3u * 570u);
+  int fresh_sweeps = 0;
+  EXPECT_LT(difference_to_fresh_solve(c, system, *term, fresh_sweeps), 1e-5);
 }

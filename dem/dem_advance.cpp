@@ -104,7 +104,6 @@ void DemSystem::advance(long steps)
       if (next >= 1 && next % every == 0)
       {
         exchange_pending_ = true;
-        force_rebuild_ = true;
         run = 1;
       }
       else
@@ -140,13 +139,14 @@ void DemSystem::advance_steps(long steps)
     case Pause::done:
       return;
     case Pause::rebuild: // the step has begun (kick and drift done); its contacts follow
-      if (exchange_pending_)
-      {
-        exchange_pending_ = false;
-        run_scheduled_exchange(); // rebuilds the list
-      }
-      else
+    {
+      const bool exchange_step = exchange_pending_;
+      exchange_pending_ = false;
+      const bool exchanged = exchange_step && run_scheduled_exchange(); // rebuilds the list itself
+      // An empty exchange on a step whose list is still good leaves the list as it is.
+      if (!exchanged && list_is_stale(pause_drift2_))
         rebuild_neighbour_list();
+    }
       from = Resume::contacts;
       break;
     case Pause::force_terms: // contacts and team terms done; the others add theirs, then the final kick
@@ -199,8 +199,11 @@ DemSystem::Pause DemSystem::run_team(long &steps_left, Resume from)
         }
 #pragma omp master
         begin_step(); // read by the wall phase, after barrier P
-        if (list_is_stale(max_drift2_of_team()))
+        const double drift2 = max_drift2_of_team();
+        if (must_pause_before_contacts(drift2))
         {
+#pragma omp master
+          pause_drift2_ = drift2; // read after the team, where the threads' flags are out of reach
           stop = Pause::rebuild;
           break;
         }

@@ -215,13 +215,19 @@ void DemSystem::exchange_particles(const std::vector<std::int32_t> &leave, const
   rebuild_neighbour_list(&origin_);
 }
 
-// The exchange of the step in progress (after its drift, before its forces).
-void DemSystem::run_scheduled_exchange()
+// The exchange of the step in progress (after its drift, before its forces). False when
+// nobody left or entered: then the particles, their order and the lists are as they were, and
+// nothing (neither the engine's list nor a force term's) has to be rebuilt for it — a fed
+// scene exchanges every few µs, mostly with nobody at its doors.
+bool DemSystem::run_scheduled_exchange()
 {
   leave_plan_.clear();
   enter_plan_.resize(0);
   exchange_->plan(particles_, time_, leave_plan_, enter_plan_);
+  if (leave_plan_.empty() && enter_plan_.size() == 0)
+    return false;
   exchange_particles(leave_plan_, enter_plan_);
+  return true;
 }
 
 // Velocity Verlet's half step of the velocities: v += (h/m) F, ω += (h/I) T.

@@ -191,10 +191,14 @@ private:
   // advance() without the exchange schedule (the team's loop; dem_advance.cpp).
   void advance_steps(long steps);
   bool exchange_pending_ = false; // exchange at the rebuild of the step in progress
-  void run_scheduled_exchange();
+  double pause_drift2_ = 0.0;     // the team's largest squared drift when it paused to rebuild
+  bool run_scheduled_exchange();
   void permute_particles(const std::vector<std::int32_t> &order);
   bool parallel() const { return particles_.size() > 512; } // below: one thread is faster
+  // The team pauses for serial work before the contacts when the list has expired, a rebuild
+  // was requested, or the step is an exchange step (the exchange happens in that pause).
   bool list_is_stale(double max_drift2) const { return force_rebuild_ || max_drift2 > 0.25 * skin_ * skin_; }
+  bool must_pause_before_contacts(double max_drift2) const { return exchange_pending_ || list_is_stale(max_drift2); }
   // The phases of a step. Each is called by every thread of an enclosing parallel region
   // (work-shared loops inside, reporting into the calling thread's StepFlags); see
   // dem_advance.cpp for their order and barriers.

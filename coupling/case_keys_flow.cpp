@@ -30,6 +30,12 @@ std::vector<KeySpec> flow_keys()
              "sump: the inflow stands for a sump that offers areal_mass, and what finds no room in the entry arc "
              "(a pile backed up from a doctor blade) stays in the sump: the mass picked up is then measured, not set.")
           .def("fixed"),
+      quantity("inflow.prefill_arc", D::angle,
+               "At the start the sleeve already carries the fed layer (areal_mass, placed as the inflow places it) "
+               "over this arc downstream of inflow.angle, as if it had turned for a while: the run does not spend "
+               "a transit time bringing the first developer to the nip or the blade (0 = the sleeve starts bare). "
+               "These particles are part of the initial state; at rest when the scene settles first.")
+          .def("0 deg").non_negative().max(2.0 * pi),
       quantity("inflow.interval", D::time, "Time between exchanges: insertions and removals happen every interval.")
           .def("1 us").positive(),
 

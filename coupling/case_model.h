@@ -325,6 +325,7 @@ struct FlowSettings
   // "fixed": exactly areal_mass is fed (an error when it finds no room); "sump": areal_mass is
   // offered, and what finds no room in the entry arc stays in the sump (the pick-up is measured).
   std::string inflow_supply = "fixed";
+  double inflow_prefill_arc = 0.0;   // the sleeve carries the layer over this arc downstream of the entry at the start [rad]
   double interval = 1e-6;            // time between exchanges [s]
   double outflow_angle = 0.0;        // start of the removal sector [rad]
   double outflow_width = 0.0;        // its angular extent [rad] (0 = no outflow sector)

@@ -1024,6 +1024,7 @@ private:
     f.inflow_angle = q(in, "angle");
     f.inflow_layer_height = q(in, "layer_height");
     f.inflow_supply = str(in, "supply");
+    f.inflow_prefill_arc = q(in, "prefill_arc");
     f.interval = q(in, "interval");
     f.outflow_angle = q(out, "angle");
     f.outflow_width = q(out, "width");

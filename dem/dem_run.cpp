@@ -136,6 +136,14 @@ void DemRun::log_setup() const
                     flow->interval_steps(),
                     f.inflow_areal_mass * case_.sleeve->surface_speed() * s.box().length[2]);
       log_ << line;
+      if (flow->source()->prefilled_count() > 0)
+      {
+        std::snprintf(line, sizeof line,
+                      "  prefilled: %ld particles (%.4g kg) of that layer over %.4g deg downstream of the entry at the start\n",
+                      flow->source()->prefilled_count(), flow->source()->prefilled_mass(),
+                      f.inflow_prefill_arc * 180.0 / M_PI);
+        log_ << line;
+      }
     }
     if (flow->sink())
     {

@@ -31,6 +31,13 @@ DemSystem::DemSystem(const Case &c, const WallSet &walls)
 void DemSystem::insert_particles()
 {
   insert_populations(case_, walls_, box_, particles_);
+  if (exchange_)
+  {
+    ParticleState add;
+    exchange_->initial_particles(particles_, add);
+    for (std::size_t k = 0; k < add.size(); ++k)
+      particles_.append_from(add, k);
+  }
 }
 
 void DemSystem::add_force_term(std::unique_ptr<ForceTerm> term)

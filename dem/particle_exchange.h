@@ -41,6 +41,10 @@ public:
   // The smallest particles the exchange may ever bring in (one or a few per population), so
   // that the engine's stable time step covers them before they exist; may stay empty.
   virtual void smallest_particles(ParticleState & /*out*/) const {}
+  // The particles the exchange puts into the scene before the run starts (after the case's
+  // own insertion, `present`; e.g. the layer the sleeve brought before t = 0). They are part
+  // of the initial state, not of what entered; may stay empty.
+  virtual void initial_particles(const ParticleState & /*present*/, ParticleState & /*add*/) {}
   virtual void write_state(CheckpointWriter & /*out*/) const {}
   virtual void read_state(CheckpointReader & /*in*/) {}
 };

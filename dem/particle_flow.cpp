@@ -37,6 +37,12 @@ void ParticleFlow::smallest_particles(ParticleState &out) const
     source_->smallest_particles(out);
 }
 
+void ParticleFlow::initial_particles(const ParticleState &present, ParticleState &add)
+{
+  if (source_)
+    source_->prefill(present, add);
+}
+
 void ParticleFlow::write_state(CheckpointWriter &out) const
 {
   if (source_)

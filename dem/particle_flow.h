@@ -29,6 +29,7 @@ public:
   long interval_steps() const override;
   void plan(const ParticleState &state, double t, std::vector<std::int32_t> &leave, ParticleState &enter) override;
   void smallest_particles(ParticleState &out) const override;
+  void initial_particles(const ParticleState &present, ParticleState &add) override;
   void write_state(CheckpointWriter &out) const override;
   void read_state(CheckpointReader &in) override;
 

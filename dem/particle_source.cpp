@@ -65,6 +65,8 @@ ParticleSource::ParticleSource(const Case &c, const DemWalls &walls, const Perio
   spin_up_ = c.sleeve->spin_up_time;
   areal_mass_ = f.inflow_areal_mass;
   sump_ = f.inflow_supply == "sump";
+  prefill_arc_ = f.inflow_prefill_arc;
+  prefill_at_rest_ = c.dem.settle_time > 0.0;
   carrier_share_ = 1.0 / (1.0 + tc);
   // Random insertion jams near 30-40 % solid; refuse a layer that would need more.
   const double free_height = height_ - carrier_.d_mean;
@@ -114,6 +116,12 @@ void ParticleSource::gather_near(const ParticleState &s, double theta0, double d
 {
   near_x_.clear();
   near_r_.clear();
+  add_near(s, theta0, dphi);
+}
+
+// Adds the particles of `s` within reach of the arc to those gathered.
+void ParticleSource::add_near(const ParticleState &s, double theta0, double dphi)
+{
   double d_big = carrier_.d_max;
   for (const Feed &t : toner_)
     d_big = std::max(d_big, carrier_.d_max + 2.0 * t.d_max);
@@ -225,6 +233,14 @@ void ParticleSource::create(const ParticleState &state, double t, ParticleState 
   // (an exchange every few steps sweeps far less than a bead; what does not fit waits).
   const double span = std::copysign(std::max(std::abs(dphi), 2.0 * carrier_.d_max / R_), dphi);
   gather_near(state, theta_in_, span);
+  fill_owed(t, theta_in_, span, enter);
+  check_owed();
+}
+
+// Places the carriers owed (with their toner) into the arc θ0 … θ0 + span; a sump declines
+// what finds no room. False when a fixed supply found no room for a carrier.
+bool ParticleSource::fill_owed(double t, double theta0, double span, ParticleState &enter)
+{
   for (;;)
   {
     const double d = pending_d_ > 0.0 ? pending_d_ : draw_diameter(carrier_);
@@ -232,18 +248,72 @@ void ParticleSource::create(const ParticleState &state, double t, ParticleState 
     // Whole particles; what is owed below half a particle waits for the next exchange.
     if (owed_carrier_ < 0.5 * sphere_mass(d, carrier_.density))
       break;
-    if (!place_carrier(d, theta_in_, span, t, enter))
+    if (!place_carrier(d, theta0, span, t, enter))
     {
-      if (sump_) // no room: the rest stays in the sump
-      {
-        declined_mass_ += owed_carrier_;
-        owed_carrier_ = 0.0;
-      }
+      if (!sump_)
+        return false;
+      declined_mass_ += owed_carrier_; // no room: the rest stays in the sump
+      owed_carrier_ = 0.0;
       break;
     }
     owed_carrier_ -= sphere_mass(d, carrier_.density);
     pending_d_ = 0.0;
   }
+  return true;
+}
+
+// The layer over the prefill arc, walked downstream in pieces two diameters long, each given
+// the mass the layer holds over it. What a piece has no room for moves on to the next (as in
+// the run's inflow); a backlog of ten carriers means the layer does not fit there.
+void ParticleSource::prefill(const ParticleState &present, ParticleState &add)
+{
+  if (prefill_arc_ <= 0.0)
+    return;
+  const auto created_count = count_;
+  const auto created_mass = mass_;
+  const bool sump = sump_;
+  sump_ = false; // nothing is declined: the layer is given
+  const std::size_t first = add.size();
+  const double sense = omega_ < 0.0 ? -1.0 : 1.0;
+  const double piece = 2.0 * carrier_.d_max / R_;
+  const int pieces = std::max(1, static_cast<int>(std::ceil(prefill_arc_ / piece)));
+  const double span = sense * prefill_arc_ / pieces;
+  const double backlog = 10.0 * sphere_mass(carrier_.d_mean, carrier_.density);
+  for (int k = 0; k < pieces; ++k)
+  {
+    const double theta0 = theta_in_ + k * span;
+    owed_carrier_ += carrier_share_ * areal_mass_ * R_ * std::abs(span) * Lz_;
+    gather_near(present, theta0, span);
+    add_near(add, theta0, span);
+    fill_owed(0.0, theta0, span, add);
+    if (owed_carrier_ > backlog)
+    {
+      sump_ = sump;
+      throw std::invalid_argument(
+          "inflow.prefill_arc: the layer of inflow.areal_mass does not fit between the sleeve and the walls at " +
+          std::to_string((theta0 + 0.5 * span) * 180.0 / M_PI) + " deg (within inflow.layer_height of the sleeve): "
+          "end the prefill arc before it, or lower inflow.layer_height or inflow.areal_mass");
+    }
+  }
+  sump_ = sump;
+  // What is left (below half a particle) is not carried over into the run's inflow.
+  owed_carrier_ = 0.0;
+  pending_d_ = 0.0;
+  std::fill(owed_toner_.begin(), owed_toner_.end(), 0.0);
+  count_ = created_count;
+  mass_ = created_mass;
+  for (std::size_t i = first; i < add.size(); ++i)
+  {
+    ++prefilled_count_;
+    prefilled_mass_ += add.mass[i];
+    if (prefill_at_rest_) // the scene settles with the walls at rest first
+      add.vx[i] = add.vy[i] = add.vz[i] = add.wx[i] = add.wy[i] = add.wz[i] = 0.0;
+  }
+}
+
+// After create()'s placement: a fixed supply that has fallen far behind what it owes stops.
+void ParticleSource::check_owed() const
+{
   const double mean_mass = sphere_mass(carrier_.d_mean, carrier_.density);
   if (owed_carrier_ > 50.0 * mean_mass)
     throw std::runtime_error("inflow: the developer owed (" + std::to_string(owed_carrier_ / mean_mass) +

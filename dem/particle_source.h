@@ -22,8 +22,14 @@
 // With inflow.supply: sump the inflow stands for a sump that OFFERS Γ: when the entry arc has
 // no room (the pile in front of a doctor blade has backed up to it), what is owed beyond the
 // fraction of a particle is declined and counted (declined_mass), and the mass picked up is
-// what the flow report measures. The
-// random stream, the mass owed and the counts are written into checkpoints.
+// what the flow report measures. The random stream, the mass owed and the counts are written
+// into checkpoints.
+//
+// With inflow.prefill_arc the sleeve already carries the layer at the start: the same areal
+// mass, placed the same way over the arc θ_in … θ_in ± prefill_arc (downstream), so that the
+// run does not spend a transit time bringing the first developer to where it is measured.
+// Those particles are part of the initial state (not counted as created), at rest when the
+// scene settles first (dem.settle_time) and moving with the sleeve otherwise.
 #pragma once
 
 #include "dem/neighbour_list.h"
@@ -50,6 +56,15 @@ public:
   // Appends to `enter` the particles owed for the arc the sleeve swept since the last call
   // (the first call counts from t = 0); `state` is the scene now (for the overlap test).
   void create(const ParticleState &state, double t, ParticleState &enter);
+
+  // Appends to `add` the layer over the prefill arc (nothing without one); `present` is the
+  // scene as inserted. Throws std::invalid_argument naming inflow.prefill_arc and the angle
+  // where the layer does not fit (a wall nearer the sleeve than the layer allows).
+  void prefill(const ParticleState &present, ParticleState &add);
+
+  // Prefilled at the start: number and mass of carriers and toner together.
+  long prefilled_count() const { return prefilled_count_; }
+  double prefilled_mass() const { return prefilled_mass_; }
 
   // One particle per fed population at its smallest diameter (for the stable time step).
   void smallest_particles(ParticleState &out) const;
@@ -82,6 +97,10 @@ private:
   double R_ = 0.0, Lz_ = 0.0, height_ = 0.0, theta_in_ = 0.0, omega_ = 0.0, spin_up_ = 0.0;
   double areal_mass_ = 0.0, carrier_share_ = 1.0;
   bool sump_ = false; // inflow.supply: sump
+  double prefill_arc_ = 0.0;
+  bool prefill_at_rest_ = false;
+  long prefilled_count_ = 0;
+  double prefilled_mass_ = 0.0;
 
   // State (checkpointed).
   std::mt19937_64 rng_;
@@ -101,6 +120,9 @@ private:
   bool clear_of_everything(const Vector3 &p, double r) const;
   void gather_near(const ParticleState &state, double theta0, double dphi);
   bool place_carrier(double d, double theta0, double dphi, double t, ParticleState &enter);
+  void add_near(const ParticleState &state, double theta0, double dphi);
+  bool fill_owed(double t, double theta0, double span, ParticleState &enter);
+  void check_owed() const;
   void attach_toner(const Vector3 &centre, double rc, double t, ParticleState &enter);
   void append(const Feed &f, const Vector3 &p, double d, double t, ParticleState &enter);
 };

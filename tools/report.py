@@ -57,6 +57,52 @@ def read_summary(path):
     return {k: (v, u) for k, v, u in zip(table["key"], table["value"], table["unit"])}
 
 
+def read_run_summary(path):
+    """dem/summary.csv (every measurement's key numbers) as a list of row dicts; [] if absent."""
+    if not os.path.exists(path):
+        return []
+    with open(path, newline="") as f:
+        lines = [line for line in f if not line.startswith("#")]
+    return list(csv.DictReader(lines))
+
+
+def steady_state_rows(run_summary):
+    """The steady-state verdict (the run's own: every tested mean drifts less than
+    statistics.steady_drift between the halves of its averaging window) and the drift of each
+    tested mean, worst first."""
+    if not run_summary:
+        return []
+    verdict = next((r for r in run_summary if r["key"] == "steady_state"), None)
+    tested = []
+    for r in run_summary:
+        try:
+            drift = float(r["drift"])
+        except ValueError:
+            continue
+        if math.isfinite(drift):
+            tested.append((drift, r["key"]))
+    if verdict is None or not tested:
+        return []
+    tested.sort(reverse=True)
+    reached = verdict["value"] == "1"
+    worst = ", ".join(f"{k} {100 * d:.1f} %" for d, k in tested[:4])
+    return [("steady state", "reached" if reached else "NOT reached",
+             verdict["meaning"], f"drift: {worst}")]
+
+
+def budget_row(flow):
+    """Particles in, out and present for a fed scene (flow_report.csv): present = initial + in − out."""
+    if not flow or not flow.get("time_s"):
+        return None
+    first, last = 0, len(flow["time_s"]) - 1
+    initial = int(flow["present"][first]) - int(flow["in"][first]) + int(flow["out"][first])
+    closes = int(flow["present"][last]) == initial + int(flow["in"][last]) - int(flow["out"][last])
+    return ("particles: initial, in, out, present",
+            f"{initial}, +{int(flow['in'][last])}, −{int(flow['out'][last])}, {int(flow['present'][last])}",
+            "present = initial + in − out (inflow and outflow, flow_report.csv)",
+            "conserved" if closes else "NOT conserved")
+
+
 def read_phase_times(log_path):
     """The engine's 'time per phase' table from the DEM log: [(name, seconds, percent)]."""
     if not log_path or not os.path.exists(log_path):
@@ -295,9 +341,9 @@ def series_plot(plt, series, nip_series, out):
 # ------------------------------------------------------------------------------------------
 # Key numbers and the index
 
-def key_numbers(summary, nip_series, series, flux):
+def key_numbers(summary, nip_series, series, flux, run_summary=None, flow=None):
     """[(what, value, reference, verdict)] for the summary table."""
-    rows = []
+    rows = steady_state_rows(run_summary)
 
     def val(key):
         v = summary.get(key, (float("nan"), ""))[0]
@@ -328,13 +374,17 @@ def key_numbers(summary, nip_series, series, flux):
         rows.append(("normal force on the drum per length", f"{fmt(val('normal_force_per_length'))} N/m", "", ""))
         rows.append(("averaged over", f"{int(val('samples'))} samples, t = {fmt(val('t_from') * 1e3)} .. "
                      f"{fmt(val('t_to') * 1e3)} ms", "", ""))
+    fed = budget_row(flow)
+    if fed:
+        rows.append(fed)
     if nip_series and nip_series["time_s"]:
         first, last = 0, len(nip_series["time_s"]) - 1
         beads0, beads1 = int(nip_series["beads"][first]), int(nip_series["beads"][last])
         lost = int(nip_series["lost"][last])
-        rows.append(("beads in the slab, start / end", f"{beads0} / {beads1}, lost {lost}",
-                     "mass conservation: equal, none lost",
-                     "conserved" if beads0 == beads1 and lost == 0 else "NOT conserved"))
+        if not fed:  # a closed scene: every bead stays
+            rows.append(("beads in the slab, start / end", f"{beads0} / {beads1}, lost {lost}",
+                         "mass conservation: equal, none lost",
+                         "conserved" if beads0 == beads1 and lost == 0 else "NOT conserved"))
         rows.append(("beads through the nip window", f"entered {int(nip_series['entered'][last])}, left "
                      f"{int(nip_series['left'][last])}, inside {int(nip_series['in_window'][first])} → "
                      f"{int(nip_series['in_window'][last])}", "inside(end) = inside(start) + entered − left", ""))
@@ -479,7 +529,9 @@ def main():
     log = os.path.join(args.dem_dir, "dem.log")
     phases = read_phase_times(log)
     dem_done = read_log_line(log, "done:")
-    rows = key_numbers(summary, nip_series, series, flux)
+    run_summary = read_run_summary(os.path.join(args.dem_dir, "summary.csv"))
+    flow = read_csv(os.path.join(args.dem_dir, "flow_report.csv"))
+    rows = key_numbers(summary, nip_series, series, flux, run_summary, flow)
     build_index(args, images, rows, run_times, phases, snapshot_time, dem_done)
     for a, b, c, d in rows:
         print(f"  {a:42s} {b}  {('[' + c + ']') if c else ''} {d}")

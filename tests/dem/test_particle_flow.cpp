@@ -365,3 +365,82 @@ TEST(DemParticleFlow, ASumpLeavesWhatFindsNoRoomAndAFixedSupplyStops)
     EXPECT_NE(message.find("does not fit into the entry arc"), std::string::npos) << message;
   }
 }
+
+// inflow.prefill_arc: the sleeve starts carrying the layer over 40° past the entry (90° … 130°),
+// Γ per sleeve area to within one bead, within the layer height, moving with the sleeve; those
+// beads are the initial state (nothing "entered"), and the first of them reach the outflow at
+// 150° after the 20° of the gap, where a bare sleeve's first beads need the whole 60°.
+TEST(DemParticleFlow, APrefilledArcCarriesTheLayerFromTheStart)
+{
+  omp_set_num_threads(2);
+  const double slab = 2e-3, arc = 40 * deg;
+  Case c = conveyor_case(slab);
+  c.flow.inflow_prefill_arc = arc;
+  auto sys = std::make_unique<DemSystem>(c);
+  sys->add_force_term(std::make_unique<RadialPull>(1000.0));
+  sys->set_particle_exchange(std::make_unique<ParticleFlow>(c, *sys));
+  sys->insert_particles();
+  sys->initialize();
+  const ParticleState &p = sys->particles();
+  const auto *flow = dynamic_cast<const ParticleFlow *>(sys->particle_exchange());
+  double mass = 0.0, worst_speed = 0.0;
+  int outside = 0;
+  for (std::size_t i = 0; i < p.size(); ++i)
+  {
+    mass += p.mass[i];
+    const double r = std::hypot(p.x[i], p.y[i]), th = std::atan2(p.y[i], p.x[i]);
+    if (th < 90 * deg || th > 130 * deg || r - p.radius[i] < sleeve_radius - 1e-12 ||
+        r + p.radius[i] > sleeve_radius + c.flow.inflow_layer_height + 1e-12)
+      ++outside;
+    worst_speed = std::max(worst_speed, std::hypot(p.vx[i] + omega * p.y[i], p.vy[i] - omega * p.x[i]));
+  }
+  const double due = areal_mass * sleeve_radius * arc * slab;
+  const double bead_max = 2200 * M_PI / 6.0 * std::pow(130e-6, 3);
+  std::printf("prefilled %zu beads, %.5g kg against Γ R Δφ L_z = %.5g kg\n", p.size(), mass, due);
+  EXPECT_GT(p.size(), 100u);
+  EXPECT_NEAR(mass, due, bead_max);
+  EXPECT_EQ(outside, 0);
+  EXPECT_LT(worst_speed, 1e-12);
+  EXPECT_EQ(flow->source()->prefilled_count(), static_cast<long>(p.size()));
+  EXPECT_DOUBLE_EQ(flow->source()->prefilled_mass(), mass);
+  // 5 ms later (the sleeve turns 29°): the prefilled beads of the last ~9° have crossed into the
+  // outflow; a bare sleeve's first beads (60° upstream of it) are still on their way.
+  sys->advance(std::lround(5e-3 / sys->time_step()));
+  auto bare = make_conveyor(conveyor_case(slab));
+  bare->advance(std::lround(5e-3 / bare->time_step()));
+  std::printf("after 5 ms: %ld prefilled beads left through the outflow, %ld of the bare sleeve's\n",
+              sys->particles_left(), bare->particles_left());
+  EXPECT_GT(sys->particles_left(), 15);
+  EXPECT_EQ(bare->particles_left(), 0);
+  // The run's inflow is its own: what it created follows Γ R φ(t) L_z, the prefill apart.
+  EXPECT_EQ(flow->source()->created_count()[0], sys->particles_entered());
+  EXPECT_NEAR(flow->source()->created_mass()[0], flow->source()->mass_due(sys->time()), bead_max);
+}
+
+// A layer that has no room (the arc already packed with beads) is refused naming the key.
+TEST(DemParticleFlow, APrefillWithNoRoomIsRefusedNamingTheKey)
+{
+  Case c = conveyor_case(1e-3);
+  c.flow.inflow_prefill_arc = 20 * deg;
+  DemSystem sys(c);
+  ParticleSource source(c, sys.walls(), sys.box());
+  // A cubic lattice of 100 µm beads at 95 µm spacing (its holes smaller than the smallest bead
+  // the source draws) filling the layer from 92° to 112°.
+  ParticleState packed;
+  for (double r = sleeve_radius + 50e-6; r < sleeve_radius + 0.3e-3; r += 95e-6)
+    for (double th = 92 * deg; th < 112 * deg; th += 95e-6 / r)
+      for (double z = 0.0; z < 1e-3 - 1e-9; z += 1e-3 / 10)
+        packed.add({r * std::cos(th), r * std::sin(th), z}, 50e-6, 2200, 0, 0.0);
+  ParticleState add;
+  try
+  {
+    source.prefill(packed, add);
+    FAIL() << "a prefill into a packed arc was accepted";
+  }
+  catch (const std::invalid_argument &e)
+  {
+    std::printf("%s\n", e.what());
+    EXPECT_NE(std::string(e.what()).find("inflow.prefill_arc"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("deg"), std::string::npos);
+  }
+}

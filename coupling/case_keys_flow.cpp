@@ -36,6 +36,12 @@ std::vector<KeySpec> flow_keys()
                "a transit time bringing the first developer to the nip or the blade (0 = the sleeve starts bare). "
                "These particles are part of the initial state; at rest when the scene settles first.")
           .def("0 deg").non_negative().max(2.0 * pi),
+      quantity("inflow.sump_mass", D::linear_mass,
+               "With supply: sump, the developer in the sump per length along the roller axis (0 = unlimited). "
+               "The inflow draws on it (carriers and toner, each from its own stock) and everything the outflow "
+               "removes returns to it, so the developer in the scene and in the sump together stays constant over "
+               "any number of revolutions.")
+          .def("0 kg/m").non_negative(),
       quantity("inflow.interval", D::time, "Time between exchanges: insertions and removals happen every interval.")
           .def("1 us").positive(),
 

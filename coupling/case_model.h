@@ -326,6 +326,9 @@ struct FlowSettings
   // offered, and what finds no room in the entry arc stays in the sump (the pick-up is measured).
   std::string inflow_supply = "fixed";
   double inflow_prefill_arc = 0.0;   // the sleeve carries the layer over this arc downstream of the entry at the start [rad]
+  // A finite sump (supply "sump" only): the developer in it per length along the roller axis
+  // [kg/m] (0 = unlimited). The inflow draws on it, the outflow returns to it.
+  double inflow_sump_mass = 0.0;
   double interval = 1e-6;            // time between exchanges [s]
   double outflow_angle = 0.0;        // start of the removal sector [rad]
   double outflow_width = 0.0;        // its angular extent [rad] (0 = no outflow sector)

@@ -1025,6 +1025,7 @@ private:
     f.inflow_layer_height = q(in, "layer_height");
     f.inflow_supply = str(in, "supply");
     f.inflow_prefill_arc = q(in, "prefill_arc");
+    f.inflow_sump_mass = q(in, "sump_mass");
     f.interval = q(in, "interval");
     f.outflow_angle = q(out, "angle");
     f.outflow_width = q(out, "width");

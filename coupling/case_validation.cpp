@@ -342,6 +342,16 @@ void check_dem(const Case &c, std::vector<CaseIssue> &out)
                                               " is shorter than the time step " + T(d.time_step)});
 }
 
+void check_flow(const Case &c, std::vector<CaseIssue> &out)
+{
+  const FlowSettings &f = c.flow;
+  if (f.inflow_sump_mass > 0.0 && f.inflow_supply != "sump")
+    out.push_back({"inflow.sump_mass", "a finite sump needs inflow.supply: sump (a fixed supply feeds exactly "
+                                       "inflow.areal_mass and has no stock to run out of)"});
+  if (f.inflow_prefill_arc > 0.0 && !f.inflow())
+    out.push_back({"inflow.prefill_arc", "the prefill is the inflow's layer: set inflow.areal_mass"});
+}
+
 void check_measurements(const Case &c, std::vector<CaseIssue> &out)
 {
   const auto L = [](double x) { return format_quantity(x, Dimension::length); };
@@ -416,6 +426,7 @@ std::vector<CaseIssue> validate_case(const Case &c)
   check_populations(c, out);
   check_fields(c, out);
   check_dem(c, out);
+  check_flow(c, out);
   check_measurements(c, out);
   return out;
 }

@@ -118,6 +118,7 @@ const std::vector<DimensionInfo> &dimension_table()
       {Dimension::electric_field, {1, 1, -3, -1, 0}, "an electric field", "2 kV/mm", "V/m"},
       {Dimension::inverse_angle_squared, {0, 0, 0, 0, -2}, "a shape factor per radian squared", "10 rad^-2", "rad^-2"},
       {Dimension::areal_mass, {-2, 1, 0, 0, 0}, "a mass per area", "0.4 kg/m^2", "kg/m^2"},
+      {Dimension::linear_mass, {-1, 1, 0, 0, 0}, "a mass per length", "0.5 kg/m", "kg/m"},
   };
   return table;
 }
@@ -363,6 +364,7 @@ DisplayChoice display_units(Dimension d)
   case Dimension::electric_field: return {{{"MV/m", 1e6}, {"kV/m", 1e3}, {"V/m", 1.0}}, 2};
   case Dimension::inverse_angle_squared: return {{{"rad^-2", 1.0}}};
   case Dimension::areal_mass: return {{{"kg/m^2", 1.0}}};
+  case Dimension::linear_mass: return {{{"kg/m", 1.0}}};
   }
   return {{{"", 1.0}}};
 }

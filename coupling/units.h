@@ -44,6 +44,7 @@ enum class Dimension
   electric_field,        // V/m, kV/mm
   inverse_angle_squared, // 1/rad^2 (Gaussian pole shape factor)
   areal_mass,            // kg/m^2, mg/cm^2 (developer mass per sleeve area, DMA)
+  linear_mass,           // kg/m, g/mm (mass per length along the roller axis: the sump)
 };
 
 // Converts "25 mm" to 0.025 (SI). Throws UnitError naming what was expected and found,

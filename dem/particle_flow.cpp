@@ -28,7 +28,12 @@ void ParticleFlow::plan(const ParticleState &state, double t, std::vector<std::i
   if (sink_)
     sink_->select(state, leave);
   if (source_)
+  {
+    // A finite sump gets back what leaves (before it feeds, so that it can feed it again).
+    for (std::int32_t i : leave)
+      source_->return_to_sump(state.species[static_cast<std::size_t>(i)], state.mass[static_cast<std::size_t>(i)]);
     source_->create(state, t, enter);
+  }
 }
 
 void ParticleFlow::smallest_particles(ParticleState &out) const

@@ -80,6 +80,36 @@ ParticleSource::ParticleSource(const Case &c, const DemWalls &walls, const Perio
   owed_toner_.assign(toner_.size(), 0.0);
   count_.assign(c.populations.size(), 0);
   mass_.assign(c.populations.size(), 0.0);
+  finite_sump_ = sump_ && f.inflow_sump_mass > 0.0;
+  if (finite_sump_)
+  {
+    // The sump's developer in the feed's proportions: carriers 1/(1 + ΣTC), each toner TC/(1 + ΣTC).
+    const double total = f.inflow_sump_mass * Lz_;
+    stock_.assign(c.populations.size(), 0.0);
+    stock_[static_cast<std::size_t>(carrier_.species)] = carrier_share_ * total;
+    for (const Feed &t : toner_)
+      stock_[static_cast<std::size_t>(t.species)] = carrier_share_ * t.concentration * total;
+  }
+}
+
+double ParticleSource::sump_stock() const
+{
+  double s = 0.0;
+  for (double m : stock_)
+    s += m;
+  return s;
+}
+
+void ParticleSource::return_to_sump(int species, double m)
+{
+  if (finite_sump_ && species >= 0 && static_cast<std::size_t>(species) < stock_.size())
+    stock_[static_cast<std::size_t>(species)] += m;
+}
+
+// Whether a finite sump still holds a particle of mass m of this feed (always, without one).
+bool ParticleSource::in_stock(const Feed &f, double m) const
+{
+  return !finite_sump_ || !drawing_ || stock_[static_cast<std::size_t>(f.species)] >= m;
 }
 
 double ParticleSource::sleeve_rotation(double t) const
@@ -167,6 +197,8 @@ void ParticleSource::append(const Feed &f, const Vector3 &p, double d, double t,
   enter.wz.back() = w;
   near_x_.push_back(p);
   near_r_.push_back(0.5 * d);
+  if (finite_sump_ && drawing_)
+    stock_[static_cast<std::size_t>(f.species)] -= enter.mass.back();
   count_[static_cast<std::size_t>(f.species)] += 1;
   mass_[static_cast<std::size_t>(f.species)] += enter.mass.back();
 }
@@ -200,7 +232,7 @@ void ParticleSource::attach_toner(const Vector3 &c, double rc, double t, Particl
     for (;;)
     {
       const double d = draw_diameter(f), m = sphere_mass(d, f.density);
-      if (owed_toner_[k] < 0.5 * m)
+      if (owed_toner_[k] < 0.5 * m || !in_stock(f, m))
         break;
       bool placed = false;
       for (int attempt = 0; attempt < toner_attempts && !placed; ++attempt)
@@ -233,7 +265,9 @@ void ParticleSource::create(const ParticleState &state, double t, ParticleState 
   // (an exchange every few steps sweeps far less than a bead; what does not fit waits).
   const double span = std::copysign(std::max(std::abs(dphi), 2.0 * carrier_.d_max / R_), dphi);
   gather_near(state, theta_in_, span);
+  drawing_ = true;
   fill_owed(t, theta_in_, span, enter);
+  drawing_ = false;
   check_owed();
 }
 
@@ -248,6 +282,11 @@ bool ParticleSource::fill_owed(double t, double theta0, double span, ParticleSta
     // Whole particles; what is owed below half a particle waits for the next exchange.
     if (owed_carrier_ < 0.5 * sphere_mass(d, carrier_.density))
       break;
+    if (!in_stock(carrier_, sphere_mass(d, carrier_.density)))
+    {
+      owed_carrier_ = 0.0; // an empty sump offers nothing: not declined, not owed
+      break;
+    }
     if (!place_carrier(d, theta0, span, t, enter))
     {
       if (!sump_)
@@ -334,6 +373,8 @@ void ParticleSource::write_state(CheckpointWriter &out) const
   out.put_array(owed_toner_);
   out.put_array(count_);
   out.put_array(mass_);
+  if (finite_sump_) // only then: checkpoints of cases without one read as before
+    out.put_array(stock_);
 }
 
 void ParticleSource::read_state(CheckpointReader &in)
@@ -348,6 +389,8 @@ void ParticleSource::read_state(CheckpointReader &in)
   in.get_array(owed_toner_);
   in.get_array(count_);
   in.get_array(mass_);
+  if (finite_sump_)
+    in.get_array(stock_);
 }
 
 } // namespace magbrush::dem

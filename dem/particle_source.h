@@ -25,6 +25,12 @@
 // what the flow report measures. The random stream, the mass owed and the counts are written
 // into checkpoints.
 //
+// With inflow.sump_mass the sump is finite and closed: it holds that developer per slab length
+// at the start (carriers and each toner in the feed's proportions, each a stock of its own),
+// the inflow draws on it — a carrier or toner particle is only created while its stock holds
+// its mass — and everything the outflow removes goes back into it (return_to_sump). Mass in
+// the scene plus mass in the sump is then constant over any number of revolutions.
+//
 // With inflow.prefill_arc the sleeve already carries the layer at the start: the same areal
 // mass, placed the same way over the arc θ_in … θ_in ± prefill_arc (downstream), so that the
 // run does not spend a transit time bringing the first developer to where it is measured.
@@ -72,6 +78,12 @@ public:
   // Offered by a sump (inflow.supply: sump) and left there for want of room so far [kg].
   double declined_mass() const { return declined_mass_; }
 
+  // A finite sump (inflow.sump_mass): whether there is one, the mass it holds now [kg], and
+  // the return of a removed particle of population `species` and mass m to it.
+  bool finite_sump() const { return finite_sump_; }
+  double sump_stock() const;
+  void return_to_sump(int species, double m);
+
   // Created so far, per population index: number and mass [kg].
   const std::vector<long> &created_count() const { return count_; }
   const std::vector<double> &created_mass() const { return mass_; }
@@ -98,6 +110,8 @@ private:
   double areal_mass_ = 0.0, carrier_share_ = 1.0;
   bool sump_ = false; // inflow.supply: sump
   double prefill_arc_ = 0.0;
+  bool finite_sump_ = false;
+  bool drawing_ = false; // creating the run's inflow (not the prefill): draws on a finite sump
   bool prefill_at_rest_ = false;
   long prefilled_count_ = 0;
   double prefilled_mass_ = 0.0;
@@ -109,6 +123,7 @@ private:
   std::vector<double> owed_toner_;
   double pending_d_ = 0.0; // a carrier diameter drawn and not yet placed (0: none)
   double declined_mass_ = 0.0;
+  std::vector<double> stock_; // a finite sump's stock per population index [kg]
   std::vector<long> count_;
   std::vector<double> mass_;
 
@@ -125,6 +140,7 @@ private:
   void check_owed() const;
   void attach_toner(const Vector3 &centre, double rc, double t, ParticleState &enter);
   void append(const Feed &f, const Vector3 &p, double d, double t, ParticleState &enter);
+  bool in_stock(const Feed &f, double m) const;
 };
 
 } // namespace magbrush::dem

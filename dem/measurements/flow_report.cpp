@@ -44,6 +44,7 @@ void FlowReport::sample(const DemSystem &system)
       row.in_mass = sum(in->created_mass());
       row.due_mass = in->mass_due(system.time());
       row.declined_mass = in->declined_mass();
+      row.sump_mass = in->finite_sump() ? in->sump_stock() : std::nan("");
     }
     if (const ParticleSink *out = flow->sink())
     {
@@ -73,14 +74,15 @@ std::string FlowReport::csv() const
                 "sleeve speed %.6g m/s, slab %.6g m\n",
                 settings_.flux_angle * 180.0 / M_PI, 0.5 * settings_.density_window * 180.0 / M_PI, sleeve_speed_, slab_);
   o << line;
-  o << "# budget: in - out = present - present(first row); due_mass = areal_mass(inflow) x R x sleeve rotation x slab\n";
+  o << "# budget: in - out = present - present(first row); due_mass = areal_mass(inflow) x R x sleeve rotation x slab; "
+       "with a finite sump (inflow.sump_mass) present_mass + sump_mass is constant\n";
   o << "time_s,in,in_mass_kg,due_mass_kg,out,out_mass_kg,present,present_mass_kg,crossed,crossed_mass_kg,flux_kg_s,"
-       "areal_mass_kg_m2,declined_mass_kg\n";
+       "areal_mass_kg_m2,declined_mass_kg,sump_mass_kg\n";
   for (const auto &r : rows_)
   {
-    std::snprintf(line, sizeof line, "%.9g,%ld,%.9g,%.9g,%ld,%.9g,%ld,%.9g,%ld,%.9g,%.9g,%.9g,%.9g\n", r.time, r.in,
+    std::snprintf(line, sizeof line, "%.9g,%ld,%.9g,%.9g,%ld,%.9g,%ld,%.9g,%ld,%.9g,%.9g,%.9g,%.9g,%.9g\n", r.time, r.in,
                   r.in_mass, r.due_mass, r.out, r.out_mass, r.present, r.present_mass, r.crossed, r.crossed_mass,
-                  r.flux, r.areal_mass, r.declined_mass);
+                  r.flux, r.areal_mass, r.declined_mass, r.sump_mass);
     o << line;
   }
   return o.str();

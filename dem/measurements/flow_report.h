@@ -33,6 +33,7 @@ struct FlowReportRow
   double flux = 0.0;         // crossed_mass / time since the previous row [kg/s]
   double areal_mass = 0.0;   // around the flux line [kg/m²]
   double declined_mass = 0.0; // offered by a sump inflow and left there for want of room so far [kg]
+  double sump_mass = 0.0;     // a finite sump's stock [kg] (NaN: the sump is unlimited)
 };
 
 class FlowReport : public Measurement

@@ -249,6 +249,11 @@ TEST(CaseParser, GeometryNonsenseIsCaughtInProcess)
   EXPECT_NE(error_of(base, {"field.probe_radius=8mm"}).find("inside the magnet"), std::string::npos);
   EXPECT_NE(error_of(base, {"dem.time_step=1us", "dem.duration=0.5us"}).find("shorter than one time step"),
             std::string::npos);
+  // The flow keys' combinations.
+  const std::string sump = error_of(base, {"inflow.areal_mass=0.4kg/m^2", "inflow.sump_mass=0.5kg/m"});
+  EXPECT_NE(sump.find("inflow.sump_mass"), std::string::npos) << sump;
+  EXPECT_NE(sump.find("needs inflow.supply: sump"), std::string::npos) << sump;
+  EXPECT_NE(error_of(base, {"inflow.prefill_arc=10deg"}).find("set inflow.areal_mass"), std::string::npos);
   // Geometry errors are collected too.
   const std::string two = error_of(base, {"drum.gap=-1mm", "roller.shaft_radius=9.5mm"});
   EXPECT_NE(two.find("(2 errors)"), std::string::npos) << two;

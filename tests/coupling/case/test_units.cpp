@@ -84,6 +84,7 @@ TEST(Units, Electromagnetic)
   expect_si("-100 uC/m^2", Dimension::surface_charge, -1e-4);
   expect_si("1e-4 C/m^2", Dimension::surface_charge, 1e-4);
   expect_si("40 mg/cm^2", Dimension::areal_mass, 0.4);
+  expect_si("500 g/m", Dimension::linear_mass, 0.5);
   expect_si("-5 fC", Dimension::charge, -5e-15);
   expect_si("2 kV/mm", Dimension::electric_field, 2e6);
   expect_si("3 MV/m", Dimension::electric_field, 3e6);
@@ -183,7 +184,8 @@ TEST(Units, FormatThenParseRoundTrips)
                            Dimension::density, Dimension::charge_to_mass, Dimension::surface_charge,
                            Dimension::viscosity, Dimension::energy, Dimension::velocity, Dimension::mass,
                            Dimension::acceleration, Dimension::frequency, Dimension::charge, Dimension::force,
-                           Dimension::electric_field, Dimension::inverse_angle_squared, Dimension::areal_mass};
+                           Dimension::electric_field, Dimension::inverse_angle_squared, Dimension::areal_mass,
+                           Dimension::linear_mass};
   for (Dimension d : all)
     for (double v : {1.234567e-12, -3.3e-7, 4.2e-4, 0.5, 1.0, 73.21, -2.5e3, 6.02e5, 1.7e9, 0.0})
     {

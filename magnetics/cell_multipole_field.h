@@ -92,6 +92,13 @@ public:
   // Pairs of beads (and periodic images) in adjacent fine cells, each once, in a fixed order;
   // r = x_j − x_i + shift with the raw positions given to build().
   const std::vector<MagneticNeighbourList::Pair> &near_pairs() const { return near_pairs_; }
+  // Hands the near pairs over without a copy: swaps them with `into`, whose (emptied) buffer
+  // the next build() fills; near_pairs() is empty afterwards.
+  void take_near_pairs(std::vector<MagneticNeighbourList::Pair> &into)
+  {
+    near_pairs_.swap(into);
+    near_pairs_.clear();
+  }
 
   // Dipoles: B_far [T] (3 per bead) and ∇B_far [T/m] (9 per bead, gradB[9b + 3a + c] =
   // ∂B_a/∂x_c) of the dipoles p (3 per bead, A m²), excluding the near pairs. Overwrites B

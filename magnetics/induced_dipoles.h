@@ -179,6 +179,7 @@ private:
   // field and gradient, and the held force and torque.
   std::vector<double> beta_, Ms_, B0_, gradB0_, p_, p_next_, B_local_, B_far_, gradB_far_;
   std::vector<double> force_, torque_;
+  std::vector<MagneticNeighbourList::Pair> spare_pairs_; // an empty pair buffer (update_cells)
   std::vector<std::uint32_t> fresh_; // beads that entered since the last compute (particles_changed)
   bool computed_ = false;
   LocalFallback local_fallback_ = LocalFallback::none;

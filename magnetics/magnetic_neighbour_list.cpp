@@ -177,13 +177,26 @@ void MagneticNeighbourList::build(std::size_t n, const double *x, const double *
 
 void MagneticNeighbourList::set_pairs(std::size_t n, const double *x, const double *y,
                                       const double *z, const std::array<double, 3> &box,
-                                      double list_radius, std::vector<Pair> pairs)
+                                      double list_radius, std::vector<Pair> &pairs)
 {
   list_radius_ = list_radius;
   box_ = box;
-  pairs_ = std::move(pairs);
+  pairs_.swap(pairs);
+  pairs.clear();
   const double *coord[3] = {x, y, z};
   build_incidence(n, coord);
+}
+
+void MagneticNeighbourList::clear()
+{
+  built_ = false;
+  list_radius_ = 0.0;
+  box_ = {0.0, 0.0, 0.0};
+  x_ref_.clear();
+  pairs_.clear();
+  incident_begin_.clear();
+  incident_pair_.clear();
+  incident_first_.clear();
 }
 
 void MagneticNeighbourList::build_incidence(std::size_t n, const double *const coord[3])

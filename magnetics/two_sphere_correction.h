@@ -73,7 +73,7 @@ public:
   // The applied field was scaled by `ratio`: forces by ratio².
   void scale_forces(double ratio2);
   // Forget the list (the caller re-sorted its beads).
-  void forget_list() { list_ = MagneticNeighbourList(); }
+  void forget_list() { list_.clear(); } // (keeps the buffers for the next build)
 
   // Restart (common/state_stream.h): the own list and its stored forces; the tables are
   // prepared again from β (they depend on nothing else).

@@ -46,7 +46,7 @@ double wrap(double v, const Axis &a)
 
 void MagneticNeighbourList::build(std::size_t n, const double *x, const double *y,
                                   const double *z, const std::array<double, 3> &box,
-                                  double list_radius)
+                                  double list_radius, const PairReach &reach)
 {
   if (!(list_radius > 0.0))
     throw std::invalid_argument("magnetic neighbour list: expected a positive list radius, "
@@ -116,6 +116,10 @@ void MagneticNeighbourList::build(std::size_t n, const double *x, const double *
   }
 
   const double r2max = list_radius * list_radius;
+  auto pair_reach2 = [&reach](std::size_t i, std::size_t j) {
+    const double r = reach.factor * 0.5 * (reach.radius[i] + reach.radius[j]) + reach.skin;
+    return r * r;
+  };
   // Visits every (neighbour j ≥ i, image) of bead i within the list radius, in a fixed
   // order; `emit(j, shift)` receives the shift in wrapped coordinates.
   auto for_each_neighbour = [&](std::size_t i, auto &&emit) {
@@ -164,7 +168,7 @@ void MagneticNeighbourList::build(std::size_t n, const double *x, const double *
               const double r = xw[3 * j + d] + shift[d] - xw[3 * i + d];
               r2 += r * r;
             }
-            if (r2 < r2max)
+            if (r2 < r2max && (!reach.radius || r2 < pair_reach2(i, j)))
               emit(j, shift);
           }
         }

@@ -37,9 +37,25 @@ public:
     double shift[3];    // r = x_j − x_i + shift
   };
 
-  // Builds the list of pairs closer than list_radius; box[d] = periodic length (0 = open).
+  // A per-pair reach, for a short-range pair law whose range scales with the pair's size:
+  // a pair is listed only when |r| < factor × ½(a_i + a_j) + skin (a_b = radius[b]), which
+  // must not exceed the list radius (the cell size of the search).
+  struct PairReach
+  {
+    const double *radius = nullptr; // none: every pair within the list radius
+    double factor = 0.0;
+    double skin = 0.0;
+  };
+
+  // Builds the list of pairs closer than list_radius (and within `reach`, if given);
+  // box[d] = periodic length (0 = open).
   void build(std::size_t n, const double *x, const double *y, const double *z,
-             const std::array<double, 3> &box, double list_radius);
+             const std::array<double, 3> &box, double list_radius, const PairReach &reach);
+  void build(std::size_t n, const double *x, const double *y, const double *z,
+             const std::array<double, 3> &box, double list_radius)
+  {
+    build(n, x, y, z, box, list_radius, PairReach());
+  }
 
   // Takes a ready pair set (e.g. the near pairs of the cell-multipole far field) and builds
   // the incidence; positions are kept as the reference for max_displacement. The pairs are

@@ -16,7 +16,8 @@
 //
 // With a hard cutoff the corrected pairs are among the near pairs. With the cell-multipole
 // far field a pair within switch_end may sit in fine cells two apart, so the correction then
-// keeps a short Verlet list of its own (switch_end × the largest radius + skin) and stores
+// keeps a short Verlet list of its own (every pair within switch_end × its mean radius +
+// skin, searched on cells of switch_end × the largest radius + skin) and stores
 // its pair forces like the near pairs: once per pair, applied ± (Newton's third law exact).
 #pragma once
 

@@ -43,6 +43,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <map>
+#include <utility>
 #include <vector>
 
 namespace magbrush::magnetics {
@@ -161,6 +162,10 @@ private:
   std::vector<std::vector<float>> offset_Df_;
   std::map<LatticeKey, std::vector<float>> lattice_f_;
   bool single_precision_ = true;
+  // build_interaction_lists(): the lattice-summed matrices of one level by offset D
+  // (|D_d| ≤ memo_width / 2), so that each is looked up in the maps once per level.
+  static constexpr long memo_width = 17;
+  std::vector<std::pair<const double *, const float *>> lattice_memo_;
   int column_level_ = 0; // first level whose cells span the whole period (m + 1)
   std::array<double, 3> cached_h_{0, 0, 0};
   std::size_t cached_levels_ = 0;

@@ -148,6 +148,7 @@ private:
   std::vector<std::uint32_t> bead_begin_;  // per fine cell, into bead_order_
   std::vector<std::uint32_t> bead_cell_;   // fine cell of every bead
   std::vector<MagneticNeighbourList::Pair> near_pairs_;
+  std::vector<std::int32_t> neighbour_cell_, neighbour_image_; // build_near_pairs(): per fine cell
   std::size_t near_targets_ = static_cast<std::size_t>(-1);
 
   // Translation matrices A[γ][β] = D_(β+γ)(−Δ h_ℓ) for the 7³ offsets of every lower

@@ -157,10 +157,14 @@ void MagneticNeighbourList::build(std::size_t n, const double *x, const double *
           // A bead's own image counts once per ± pair: keep the lexicographically positive.
           const bool positive_shift =
             shift[0] > 0.0 || (shift[0] == 0.0 && (shift[1] > 0.0 || (shift[1] == 0.0 && shift[2] > 0.0)));
-          for (std::size_t k = cell_begin[c]; k < cell_begin[c + 1]; ++k)
+          // A cell's beads are in ascending index: start at the first j ≥ i.
+          const std::uint32_t *first = cell_beads.data() + cell_begin[c], *last = cell_beads.data() + cell_begin[c + 1];
+          for (const std::uint32_t *k = std::lower_bound(first, last,
+                                                         static_cast<std::uint32_t>(i));
+               k < last; ++k)
           {
-            const std::uint32_t j = cell_beads[k];
-            if (j < i || (j == i && (zero_shift || !positive_shift)))
+            const std::uint32_t j = *k;
+            if (j == i && (zero_shift || !positive_shift))
               continue;
             double r2 = 0.0;
             for (int d = 0; d < 3; ++d)

@@ -19,7 +19,8 @@
 //                      F_j = (p_j·∇)(B0 + B_far)_j + tail + Σ ± pair forces, in a fixed order.
 // Every parallel loop writes only its own entries and sums in a fixed order, so the result is
 // bit-identical for any number of OpenMP threads. Between neighbour-list rebuilds no memory
-// is allocated (a rebuild uses temporary cell arrays; a new β builds its table once).
+// is allocated; a rebuild refills the pair, incidence and row buffers of the last one (only
+// per-bead and per-cell temporaries are allocated; a new β builds its table once).
 //
 // The DEM may hold the magnetic forces between evaluations: check_staleness() says when and
 // why they are stale (staleness_tracker.h), refresh_locally() renews them around what moved

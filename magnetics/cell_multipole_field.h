@@ -43,6 +43,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <map>
+#include <utility>
 #include <vector>
 
 namespace magbrush::magnetics {
@@ -92,6 +93,13 @@ public:
   // Pairs of beads (and periodic images) in adjacent fine cells, each once, in a fixed order;
   // r = x_j − x_i + shift with the raw positions given to build().
   const std::vector<MagneticNeighbourList::Pair> &near_pairs() const { return near_pairs_; }
+  // Hands the near pairs over without a copy: swaps them with `into`, whose (emptied) buffer
+  // the next build() fills; near_pairs() is empty afterwards.
+  void take_near_pairs(std::vector<MagneticNeighbourList::Pair> &into)
+  {
+    near_pairs_.swap(into);
+    near_pairs_.clear();
+  }
 
   // Dipoles: B_far [T] (3 per bead) and ∇B_far [T/m] (9 per bead, gradB[9b + 3a + c] =
   // ∂B_a/∂x_c) of the dipoles p (3 per bead, A m²), excluding the near pairs. Overwrites B
@@ -140,6 +148,7 @@ private:
   std::vector<std::uint32_t> bead_begin_;  // per fine cell, into bead_order_
   std::vector<std::uint32_t> bead_cell_;   // fine cell of every bead
   std::vector<MagneticNeighbourList::Pair> near_pairs_;
+  std::vector<std::int32_t> neighbour_cell_, neighbour_image_; // build_near_pairs(): per fine cell
   std::size_t near_targets_ = static_cast<std::size_t>(-1);
 
   // Translation matrices A[γ][β] = D_(β+γ)(−Δ h_ℓ) for the 7³ offsets of every lower
@@ -154,6 +163,10 @@ private:
   std::vector<std::vector<float>> offset_Df_;
   std::map<LatticeKey, std::vector<float>> lattice_f_;
   bool single_precision_ = true;
+  // build_interaction_lists(): the lattice-summed matrices of one level by offset D
+  // (|D_d| ≤ memo_width / 2), so that each is looked up in the maps once per level.
+  static constexpr long memo_width = 17;
+  std::vector<std::pair<const double *, const float *>> lattice_memo_;
   int column_level_ = 0; // first level whose cells span the whole period (m + 1)
   std::array<double, 3> cached_h_{0, 0, 0};
   std::size_t cached_levels_ = 0;

@@ -189,8 +189,10 @@ void InducedDipoles::update_cells(const BeadArrays &beads, double radius_sum, Ma
   {
     far_cell_size_ = settings_.far_cell_diameters * mean_diameter;
     far_->build(n, beads.x, beads.y, beads.z, far_cell_size_);
-    list.set_pairs(n, beads.x, beads.y, beads.z, box_, 0.0,
-                   std::vector<MagneticNeighbourList::Pair>(far_->near_pairs()));
+    // The pairs change hands by swaps (far field → spare → list → spare): no copy, and
+    // every buffer keeps its capacity for the next rebuild.
+    far_->take_near_pairs(spare_pairs_);
+    list.set_pairs(n, beads.x, beads.y, beads.z, box_, 0.0, spare_pairs_);
     stats.list_rebuilt = true;
   }
   else

@@ -19,7 +19,8 @@
 //                      F_j = (p_j·∇)(B0 + B_far)_j + tail + Σ ± pair forces, in a fixed order.
 // Every parallel loop writes only its own entries and sums in a fixed order, so the result is
 // bit-identical for any number of OpenMP threads. Between neighbour-list rebuilds no memory
-// is allocated (a rebuild uses temporary cell arrays; a new β builds its table once).
+// is allocated; a rebuild refills the pair, incidence and row buffers of the last one (only
+// per-bead and per-cell temporaries are allocated; a new β builds its table once).
 //
 // The DEM may hold the magnetic forces between evaluations: check_staleness() says when and
 // why they are stale (staleness_tracker.h), refresh_locally() renews them around what moved
@@ -179,6 +180,7 @@ private:
   // field and gradient, and the held force and torque.
   std::vector<double> beta_, Ms_, B0_, gradB0_, p_, p_next_, B_local_, B_far_, gradB_far_;
   std::vector<double> force_, torque_;
+  std::vector<MagneticNeighbourList::Pair> spare_pairs_; // an empty pair buffer (update_cells)
   std::vector<std::uint32_t> fresh_; // beads that entered since the last compute (particles_changed)
   bool computed_ = false;
   LocalFallback local_fallback_ = LocalFallback::none;

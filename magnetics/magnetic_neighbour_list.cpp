@@ -46,7 +46,7 @@ double wrap(double v, const Axis &a)
 
 void MagneticNeighbourList::build(std::size_t n, const double *x, const double *y,
                                   const double *z, const std::array<double, 3> &box,
-                                  double list_radius)
+                                  double list_radius, const PairReach &reach)
 {
   if (!(list_radius > 0.0))
     throw std::invalid_argument("magnetic neighbour list: expected a positive list radius, "
@@ -116,6 +116,10 @@ void MagneticNeighbourList::build(std::size_t n, const double *x, const double *
   }
 
   const double r2max = list_radius * list_radius;
+  auto pair_reach2 = [&reach](std::size_t i, std::size_t j) {
+    const double r = reach.factor * 0.5 * (reach.radius[i] + reach.radius[j]) + reach.skin;
+    return r * r;
+  };
   // Visits every (neighbour j ≥ i, image) of bead i within the list radius, in a fixed
   // order; `emit(j, shift)` receives the shift in wrapped coordinates.
   auto for_each_neighbour = [&](std::size_t i, auto &&emit) {
@@ -153,10 +157,14 @@ void MagneticNeighbourList::build(std::size_t n, const double *x, const double *
           // A bead's own image counts once per ± pair: keep the lexicographically positive.
           const bool positive_shift =
             shift[0] > 0.0 || (shift[0] == 0.0 && (shift[1] > 0.0 || (shift[1] == 0.0 && shift[2] > 0.0)));
-          for (std::size_t k = cell_begin[c]; k < cell_begin[c + 1]; ++k)
+          // A cell's beads are in ascending index: start at the first j ≥ i.
+          const std::uint32_t *first = cell_beads.data() + cell_begin[c], *last = cell_beads.data() + cell_begin[c + 1];
+          for (const std::uint32_t *k = std::lower_bound(first, last,
+                                                         static_cast<std::uint32_t>(i));
+               k < last; ++k)
           {
-            const std::uint32_t j = cell_beads[k];
-            if (j < i || (j == i && (zero_shift || !positive_shift)))
+            const std::uint32_t j = *k;
+            if (j == i && (zero_shift || !positive_shift))
               continue;
             double r2 = 0.0;
             for (int d = 0; d < 3; ++d)
@@ -164,7 +172,7 @@ void MagneticNeighbourList::build(std::size_t n, const double *x, const double *
               const double r = xw[3 * j + d] + shift[d] - xw[3 * i + d];
               r2 += r * r;
             }
-            if (r2 < r2max)
+            if (r2 < r2max && (!reach.radius || r2 < pair_reach2(i, j)))
               emit(j, shift);
           }
         }
@@ -177,13 +185,26 @@ void MagneticNeighbourList::build(std::size_t n, const double *x, const double *
 
 void MagneticNeighbourList::set_pairs(std::size_t n, const double *x, const double *y,
                                       const double *z, const std::array<double, 3> &box,
-                                      double list_radius, std::vector<Pair> pairs)
+                                      double list_radius, std::vector<Pair> &pairs)
 {
   list_radius_ = list_radius;
   box_ = box;
-  pairs_ = std::move(pairs);
+  pairs_.swap(pairs);
+  pairs.clear();
   const double *coord[3] = {x, y, z};
   build_incidence(n, coord);
+}
+
+void MagneticNeighbourList::clear()
+{
+  built_ = false;
+  list_radius_ = 0.0;
+  box_ = {0.0, 0.0, 0.0};
+  x_ref_.clear();
+  pairs_.clear();
+  incident_begin_.clear();
+  incident_pair_.clear();
+  incident_first_.clear();
 }
 
 void MagneticNeighbourList::build_incidence(std::size_t n, const double *const coord[3])

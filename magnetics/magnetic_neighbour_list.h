@@ -19,6 +19,8 @@
 
 #include "common/state_stream.h"
 
+#include <omp.h>
+
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -35,27 +37,67 @@ public:
     double shift[3];    // r = x_j − x_i + shift
   };
 
-  // Builds the list of pairs closer than list_radius; box[d] = periodic length (0 = open).
+  // A per-pair reach, for a short-range pair law whose range scales with the pair's size:
+  // a pair is listed only when |r| < factor × ½(a_i + a_j) + skin (a_b = radius[b]), which
+  // must not exceed the list radius (the cell size of the search).
+  struct PairReach
+  {
+    const double *radius = nullptr; // none: every pair within the list radius
+    double factor = 0.0;
+    double skin = 0.0;
+  };
+
+  // Builds the list of pairs closer than list_radius (and within `reach`, if given);
+  // box[d] = periodic length (0 = open).
   void build(std::size_t n, const double *x, const double *y, const double *z,
-             const std::array<double, 3> &box, double list_radius);
+             const std::array<double, 3> &box, double list_radius, const PairReach &reach);
+  void build(std::size_t n, const double *x, const double *y, const double *z,
+             const std::array<double, 3> &box, double list_radius)
+  {
+    build(n, x, y, z, box, list_radius, PairReach());
+  }
 
   // Takes a ready pair set (e.g. the near pairs of the cell-multipole far field) and builds
-  // the incidence; positions are kept as the reference for max_displacement.
+  // the incidence; positions are kept as the reference for max_displacement. The pairs are
+  // taken by swapping, not copied: `pairs` receives the list's previous buffer, emptied, so
+  // that its capacity serves the next build (a copy of the ~10⁵–10⁶ pairs and a fresh
+  // allocation — page faults on every touch — per rebuild were a third of a rebuild).
   void set_pairs(std::size_t n, const double *x, const double *y, const double *z,
-                 const std::array<double, 3> &box, double list_radius, std::vector<Pair> pairs);
+                 const std::array<double, 3> &box, double list_radius, std::vector<Pair> &pairs);
 
-  // Fills `pairs` in bead order from a neighbour enumerator in two parallel passes (count,
-  // then fill at the prefix offsets): the same pairs in the same order on any number of
-  // threads. for_each_neighbour(i, emit) calls emit(j, shift) for each partner j of bead i,
-  // `shift` (3 doubles) referring to the wrapped coordinates xw (x, y, z interleaved); the
-  // stored shift refers to the raw coordinates coord[d][·]: r = x_j − x_i + shift.
+  // Forgets the pairs (the bead indices they refer to changed) but keeps the memory: the
+  // next build fills the same buffers. built() is false afterwards.
+  void clear();
+
+  // Fills `pairs` in bead order from a neighbour enumerator: the same pairs in the same order
+  // on any number of threads. for_each_neighbour(i, emit) calls emit(j, shift) for each
+  // partner j of bead i, `shift` (3 doubles) referring to the wrapped coordinates xw (x, y, z
+  // interleaved); the stored shift refers to the raw coordinates coord[d][·]:
+  // r = x_j − x_i + shift. On one thread a single pass appends the pairs; on several, two
+  // parallel passes (count, then fill at the prefix offsets) — the enumeration (cell lookups,
+  // distances) then runs twice, which on one thread was half the cost of a list build.
   template <typename ForEachNeighbour>
   static void collect_pairs(std::size_t n, ForEachNeighbour &&for_each_neighbour, const double *xw,
                             const double *const coord[3], std::size_t parallel_threshold,
                             std::vector<Pair> &pairs)
   {
+    auto make_pair = [&](std::size_t i, std::uint32_t j, const double *shift) {
+      Pair p;
+      p.i = static_cast<std::uint32_t>(i);
+      p.j = j;
+      for (int d = 0; d < 3; ++d)
+        p.shift[d] = shift[d] + (xw[3 * j + d] - coord[d][j]) - (xw[3 * i + d] - coord[d][i]);
+      return p;
+    };
+    if (n < parallel_threshold || omp_get_max_threads() == 1)
+    {
+      pairs.clear(); // (keeps the capacity of the last build)
+      for (std::size_t i = 0; i < n; ++i)
+        for_each_neighbour(i, [&](std::uint32_t j, const double *shift) { pairs.push_back(make_pair(i, j, shift)); });
+      return;
+    }
     std::vector<std::size_t> begin(n + 1, 0);
-#pragma omp parallel for schedule(dynamic, 64) if (n >= parallel_threshold)
+#pragma omp parallel for schedule(dynamic, 64)
     for (long i = 0; i < static_cast<long>(n); ++i)
     {
       std::size_t count = 0;
@@ -65,17 +107,11 @@ public:
     for (std::size_t i = 0; i < n; ++i)
       begin[i + 1] += begin[i];
     pairs.resize(begin[n]);
-#pragma omp parallel for schedule(dynamic, 64) if (n >= parallel_threshold)
+#pragma omp parallel for schedule(dynamic, 64)
     for (long i = 0; i < static_cast<long>(n); ++i)
     {
       std::size_t k = begin[i];
-      for_each_neighbour(i, [&](std::uint32_t j, const double *shift) {
-        Pair &p = pairs[k++];
-        p.i = static_cast<std::uint32_t>(i);
-        p.j = j;
-        for (int d = 0; d < 3; ++d)
-          p.shift[d] = shift[d] + (xw[3 * j + d] - coord[d][j]) - (xw[3 * i + d] - coord[d][i]);
-      });
+      for_each_neighbour(i, [&](std::uint32_t j, const double *shift) { pairs[k++] = make_pair(i, j, shift); });
     }
   }
 

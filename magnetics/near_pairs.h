@@ -51,8 +51,9 @@ public:
   void add_row_field(std::size_t b, const std::vector<double> &p, double s[3]) const;
   void add_list_field(std::size_t b, const std::vector<double> &p, double B[3]) const;
 
-  // Forget the pairs (the caller re-sorted its beads: pair indices refer to the old order).
-  void forget() { list_ = MagneticNeighbourList(); }
+  // Forget the pairs (the caller re-sorted its beads: pair indices refer to the old order);
+  // the buffers are kept for the next build.
+  void forget() { list_.clear(); }
 
   // Restart (common/state_stream.h): the list, the tensors and flags; the rows are rebuilt
   // from the tensors (copies of them).

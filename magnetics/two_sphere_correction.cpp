@@ -126,8 +126,12 @@ void TwoSphereCorrection::refresh_list(const BeadArrays &beads)
   const bool stale = !list_.built() || list_.particle_count() != beads.n || list_.box() != box_ ||
                      std::abs(list_.list_radius() - radius) > 1e-12 * radius ||
                      list_.max_displacement(beads.n, beads.x, beads.y, beads.z) > 0.5 * skin;
+  // Each pair is listed only within its own reach, switch_end × its mean radius + skin: with
+  // ±10 % beads the largest radius sets a search radius whose sphere holds ~3× the pairs
+  // that can ever be corrected (the rest cost a force evaluation, a gather and a local
+  // refresh's attention each, for a zero force).
   if (stale)
-    list_.build(beads.n, beads.x, beads.y, beads.z, box_, radius);
+    list_.build(beads.n, beads.x, beads.y, beads.z, box_, radius, {beads.radius, settings_.switch_end, skin});
 }
 
 bool TwoSphereCorrection::list_current(const BeadArrays &beads, double skin) const
@@ -155,7 +159,11 @@ bool TwoSphereCorrection::evaluate_list_force(const InducedState &s, std::size_t
   const double r[3] = {s.beads.x[pair.j] - s.beads.x[pair.i] + pair.shift[0],
                        s.beads.y[pair.j] - s.beads.y[pair.i] + pair.shift[1],
                        s.beads.z[pair.j] - s.beads.z[pair.i] + pair.shift[2]};
-  if (r[0] * r[0] + r[1] * r[1] + r[2] * r[2] == 0.0)
+  const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+  if (r2 == 0.0)
+    return false;
+  // Beyond switch_end (as add() decides it) no correction: skip the pair's dipole tensor.
+  if (std::sqrt(r2) / (0.5 * (s.beads.radius[pair.i] + s.beads.radius[pair.j])) >= settings_.switch_end)
     return false;
   return add(s, pair.i, pair.j, r, DipoleTensor::at(r), F);
 }

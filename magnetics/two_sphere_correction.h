@@ -16,7 +16,8 @@
 //
 // With a hard cutoff the corrected pairs are among the near pairs. With the cell-multipole
 // far field a pair within switch_end may sit in fine cells two apart, so the correction then
-// keeps a short Verlet list of its own (switch_end × the largest radius + skin) and stores
+// keeps a short Verlet list of its own (every pair within switch_end × its mean radius +
+// skin, searched on cells of switch_end × the largest radius + skin) and stores
 // its pair forces like the near pairs: once per pair, applied ± (Newton's third law exact).
 #pragma once
 
@@ -73,7 +74,7 @@ public:
   // The applied field was scaled by `ratio`: forces by ratio².
   void scale_forces(double ratio2);
   // Forget the list (the caller re-sorted its beads).
-  void forget_list() { list_ = MagneticNeighbourList(); }
+  void forget_list() { list_.clear(); } // (keeps the buffers for the next build)
 
   // Restart (common/state_stream.h): the own list and its stored forces; the tables are
   // prepared again from β (they depend on nothing else).

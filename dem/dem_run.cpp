@@ -46,11 +46,14 @@ void DemRun::check_restart_case() const
 {
   const CheckpointIdentity written = CheckpointReader(options_.restart_file).identity();
   const std::vector<CaseDifference> differences = case_differences(written, identity_);
-  std::vector<CaseDifference> scene, control;
+  std::vector<CaseDifference> scene, control, added;
   for (const CaseDifference &d : differences)
-    (d.run_control ? control : scene).push_back(d);
+    (d.run_control ? control : d.added_at_default ? added : scene).push_back(d);
   if (!control.empty())
     log_ << "restart: run control changed since the checkpoint (the state continues):\n" << describe(control);
+  if (!added.empty())
+    log_ << "restart: keys newer than the checkpoint, at their defaults (what the program that wrote it did):\n"
+         << describe(added);
   if (scene.empty())
     return;
   if (!options_.restart_anyway)

@@ -1,5 +1,7 @@
 #include "dem/restart_check.h"
 
+#include "coupling/case_hash.h"
+
 #include <map>
 
 namespace magbrush::dem {
@@ -34,9 +36,18 @@ std::vector<CaseDifference> case_differences(const CheckpointIdentity &checkpoin
     else if (it->second != value)
       add(key, value, it->second);
   }
+  // The resolved keys of a case that sets nothing: every key's default.
+  static const std::map<std::string, std::string> defaults = [] {
+    const auto inputs = case_inputs(Case{});
+    return std::map<std::string, std::string>(inputs.begin(), inputs.end());
+  }();
   for (const auto &[key, value] : now.inputs)
     if (!seen.count(key))
+    {
       add(key, "(absent)", value);
+      const auto d = defaults.find(key);
+      out.back().added_at_default = d != defaults.end() && d->second == value;
+    }
   return out;
 }
 

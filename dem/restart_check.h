@@ -22,6 +22,9 @@ struct CaseDifference
   std::string in_checkpoint;  // "(absent)" when only the case has it
   std::string in_case;        // "(absent)" when only the checkpoint has it
   bool run_control = false;   // may differ in a restart
+  // Only this case has the key, at its default value: a key the schema gained after the
+  // checkpoint was written (its default is what the older program did), not a change.
+  bool added_at_default = false;
 };
 
 // Run-control keys: dem.duration, the output, sample and checkpoint intervals, threads,
@@ -29,7 +32,7 @@ struct CaseDifference
 bool is_run_control_key(const std::string &key);
 
 // The keys whose values differ between the checkpoint's case and this one, in the order of
-// the checkpoint's keys (then those only this case has).
+// the checkpoint's keys (then those only this case has, flagged when at their defaults).
 std::vector<CaseDifference> case_differences(const CheckpointIdentity &checkpoint, const CheckpointIdentity &now);
 
 // "  key: checkpoint value -> case value" lines.

@@ -3,6 +3,7 @@
 // its format version, its case identity, the checkpoint kept before the last one, a
 // checkpoint that leaves the run which writes it bit for bit alone, and the snapshots'
 // Fletcher-32 checksums.
+#include "coupling/case_hash.h"
 #include "dem/checkpoint_file.h"
 #include "dem/dem_system.h"
 #include "dem/force_terms/gravity.h"
@@ -228,6 +229,24 @@ TEST(RestartCheck, RunControlMayDifferTheSceneMayNot)
   EXPECT_EQ(d[4].in_checkpoint, "(absent)");
   EXPECT_TRUE(contains(describe(d), "  populations.carrier.count: 2000 (checkpoint) -> 3000 (this case)\n"));
   EXPECT_TRUE(case_differences(written, written).empty());
+  EXPECT_FALSE(d[4].added_at_default); // a default case has no toner material
+
+  // A key the schema gained after the checkpoint was written: at its default it is flagged
+  // (the restart goes on), at another value it is a difference of the scene.
+  std::string sump_default;
+  for (const auto &[key, value] : case_inputs(Case{}))
+    if (key == "inflow.sump_mass")
+      sump_default = value;
+  ASSERT_FALSE(sump_default.empty());
+  CheckpointIdentity newer = written;
+  newer.inputs.emplace_back("inflow.sump_mass", sump_default);
+  const auto at_default = case_differences(written, newer);
+  ASSERT_EQ(at_default.size(), 1u);
+  EXPECT_TRUE(at_default[0].added_at_default);
+  newer.inputs.back().second = "0.5";
+  const auto changed = case_differences(written, newer);
+  ASSERT_EQ(changed.size(), 1u);
+  EXPECT_FALSE(changed[0].added_at_default);
 }
 
 // A snapshot value damaged on disk (its lowest mantissa byte) fails HDF5's read through the

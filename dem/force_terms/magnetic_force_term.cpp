@@ -35,7 +35,6 @@ MagneticForceTerm::MagneticForceTerm(const Case &c, MagneticSettings settings,
   : dipoles_(with_slab_tail(settings, box, slab_tail), box), field_(field), box_(box),
     waiting_correction_(dipoles_.settings(), box)
 {
-  std::vector<double> carrier_beta;
   for (const Population &pop : c.populations)
   {
     Species s;
@@ -45,12 +44,13 @@ MagneticForceTerm::MagneticForceTerm(const Case &c, MagneticSettings settings,
       const Material &m = c.material(pop.material);
       s.mu_r = m.mu_r;
       s.saturation_magnetisation = m.saturation_magnetisation;
-      carrier_beta.push_back(clausius_mossotti(m.mu_r));
+      carrier_beta_.push_back(clausius_mossotti(m.mu_r));
     }
     species_.push_back(s);
   }
-  if (dipoles_.settings().model == DipoleModel::corrected && !carrier_beta.empty())
-    waiting_correction_.prepare_tables(carrier_beta);
+  // The waiting carriers' correction tables are prepared when the first one waits: by then the
+  // solver has tabulated the same β at its first evaluation, and a μr it cannot tabulate has
+  // stopped the run there, in initialize(), with the key named.
 }
 
 void MagneticForceTerm::select_carriers(const dem::ParticleState &state)
@@ -312,6 +312,8 @@ void MagneticForceTerm::add_waiting_forces(const dem::ParticleState &state, dem:
   waiting_f_.clear();
   if (!pending_)
     return;
+  if (dipoles_.settings().model == DipoleModel::corrected && !waiting_correction_.has_tables() && !carrier_beta_.empty())
+    waiting_correction_.prepare_tables(carrier_beta_);
   const AppliedFieldFunction field = lookup_at(t);
   const std::vector<double> &held = dipoles_.dipoles();
   const std::size_t n = carrier_.size();
@@ -465,29 +467,9 @@ void MagneticForceTerm::particles_changed(const std::vector<std::int32_t> &origi
     defer_change(origin);
     return;
   }
-  // Old engine index → new (−1: left). The compact beads whose particle left are dropped;
-  // the others keep their compact order.
-  new_index_.assign(state_size_, -1);
-  for (std::size_t k = 0; k < origin.size(); ++k)
-    if (origin[k] >= 0)
-    {
-      if (static_cast<std::size_t>(origin[k]) >= state_size_)
-      { // the term has not seen this particle set: select afresh at the next step
-        must_refresh_ = true;
-        state_size_ = origin.size();
-        return;
-      }
-      new_index_[static_cast<std::size_t>(origin[k])] = static_cast<std::int32_t>(k);
-    }
-  // Newcomers of an earlier change not yet admitted (two changes between steps) follow too.
-  std::size_t still = 0;
-  for (std::uint32_t i : newcomers_)
-    if (new_index_[i] >= 0)
-      newcomers_[still++] = static_cast<std::uint32_t>(new_index_[i]);
-  newcomers_.resize(still);
-  for (std::size_t k = 0; k < origin.size(); ++k)
-    if (origin[k] < 0)
-      newcomers_.push_back(static_cast<std::uint32_t>(k));
+  // The compact beads whose particle left are dropped; the others keep their compact order.
+  if (!follow_exchange(origin))
+    return;
   // compact_origin_ maps the compact order to the one the dipole solver last saw.
   if (!changed_)
   {
@@ -515,26 +497,21 @@ void MagneticForceTerm::particles_changed(const std::vector<std::int32_t> &origi
   changed_ = true;
 }
 
-// MagneticSettings::defer_exchange. An exchange changes only which engine index each compact
-// bead reads: a bead whose particle left becomes a frozen source (kLeft), the newcomers are
-// remembered (through re-sorts and further exchanges) until apply_pending(). An exchange
-// that moved nothing in or out changes nothing at all.
-void MagneticForceTerm::defer_change(const std::vector<std::int32_t> &origin)
+// An exchange's map from the new engine index to the old (origin, −1: entered) turned around
+// into new_index_ (old → new, −1: left), and the newcomers — those of an earlier change not
+// yet admitted (two changes between steps), then this change's — renamed into the new order.
+// False when the term has not seen this particle set: it selects afresh at the next step.
+bool MagneticForceTerm::follow_exchange(const std::vector<std::int32_t> &origin)
 {
-  bool identity = origin.size() == state_size_;
-  for (std::size_t k = 0; identity && k < origin.size(); ++k)
-    identity = origin[k] == static_cast<std::int32_t>(k);
-  if (identity)
-    return;
   new_index_.assign(state_size_, -1);
   for (std::size_t k = 0; k < origin.size(); ++k)
     if (origin[k] >= 0)
     {
       if (static_cast<std::size_t>(origin[k]) >= state_size_)
-      { // the term has not seen this particle set: select afresh at the next step
+      {
         must_refresh_ = true;
         state_size_ = origin.size();
-        return;
+        return false;
       }
       new_index_[static_cast<std::size_t>(origin[k])] = static_cast<std::int32_t>(k);
     }
@@ -546,6 +523,22 @@ void MagneticForceTerm::defer_change(const std::vector<std::int32_t> &origin)
   for (std::size_t k = 0; k < origin.size(); ++k)
     if (origin[k] < 0)
       newcomers_.push_back(static_cast<std::uint32_t>(k));
+  return true;
+}
+
+// MagneticSettings::defer_exchange. An exchange changes only which engine index each compact
+// bead reads: a bead whose particle left becomes a frozen source (kLeft), the newcomers are
+// remembered (through re-sorts and further exchanges) until apply_pending(). An exchange
+// that moved nothing in or out changes nothing at all.
+void MagneticForceTerm::defer_change(const std::vector<std::int32_t> &origin)
+{
+  bool identity = origin.size() == state_size_;
+  for (std::size_t k = 0; identity && k < origin.size(); ++k)
+    identity = origin[k] == static_cast<std::int32_t>(k);
+  if (identity)
+    return;
+  if (!follow_exchange(origin))
+    return;
   for (auto &i : carrier_)
     if (i != kLeft)
     {

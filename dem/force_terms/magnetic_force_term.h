@@ -145,6 +145,7 @@ private:
   // `corrected`: the two-sphere correction of a waiting carrier's close pairs, through a
   // two-bead state (the neighbour, the newcomer) reused every time.
   TwoSphereCorrection waiting_correction_;
+  std::vector<double> carrier_beta_; // the carrier populations' β (the waiting correction's tables)
   std::vector<double> pair_radius_ = std::vector<double>(2), pair_beta_ = std::vector<double>(2),
                       pair_field_ = std::vector<double>(6), pair_p_ = std::vector<double>(6);
   void add_waiting_correction(std::size_t k, double s, const double x[3], double radius, double beta,
@@ -158,6 +159,7 @@ private:
 
   void select_carriers(const dem::ParticleState &state);
   void admit_newcomers(const dem::ParticleState &state);
+  bool follow_exchange(const std::vector<std::int32_t> &origin);
   void defer_change(const std::vector<std::int32_t> &origin);
   void add_waiting_forces(const dem::ParticleState &state, dem::ForceBuffers &forces, double t);
   void add_waiting(dem::ForceBuffers &forces, std::uint32_t i, double fx, double fy, double fz);

@@ -239,8 +239,10 @@ TEST(MagneticForceTerm, DeferredExchangeSurvivesARestartBitIdentically)
   b->read_checkpoint(path);
   std::filesystem::remove(path);
   for (const auto &t : b->force_terms())
+  {
     if (const auto *m = dynamic_cast<const MagneticForceTerm *>(t.get()))
       EXPECT_TRUE(m->restored_state());
+  }
   for (auto *s : {a.get(), b.get()})
     s->advance(1200); // past the refresh interval: the waiting exchange is admitted
   EXPECT_EQ(state_in_id_order(*a), state_in_id_order(*b));

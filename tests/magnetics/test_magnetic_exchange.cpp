@@ -241,7 +241,9 @@ TEST(MagneticForceTerm, DeferredExchangeSurvivesARestartBitIdentically)
   for (const auto &t : b->force_terms())
   {
     if (const auto *m = dynamic_cast<const MagneticForceTerm *>(t.get()))
+    {
       EXPECT_TRUE(m->restored_state());
+    }
   }
   for (auto *s : {a.get(), b.get()})
     s->advance(1200); // past the refresh interval: the waiting exchange is admitted

@@ -70,8 +70,9 @@ then compares the nip profiles of all points:
   sweep_summary.csv    one row per point: the varied values (as given and in SI), the bead
                        count, every key number the point's measurements report (dem/summary.csv:
                        e.g. slip at the gap centre, normal force per length, TMA, DMA) with its
-                       standard error, steady_state (1: every tested mean drifts < 2 %), the
-                       run time of the point, and with --measured the measured value, the
+                       standard error, steady_state (1: every tested mean drifts < 2 %),
+                       significant_drift (1: a drift beyond two of its standard errors, a
+                       trend; 0: noise) and drift_resolution, the run time of the point, and with --measured the measured value, the
                        relative error and a within-tolerance flag
   sweep_profiles.csv   every point's profile along the nip (long format), for nip scenes
   sweep_<key>.png      each key with a standard error against the (first) varied value, with

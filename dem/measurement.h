@@ -29,6 +29,9 @@ struct SummaryValue
   double drift = std::numeric_limits<double>::quiet_NaN();
   std::string unit;    // for people: "kg/m^2"
   std::string meaning; // one line
+  // Standard error of `drift` (NaN where drift is): a drift beyond two of them is a trend, one
+  // within them is noise (dem/measurements/sample_series.h).
+  double drift_standard_error = std::numeric_limits<double>::quiet_NaN();
 };
 
 class Measurement

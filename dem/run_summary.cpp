@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <sstream>
 
 namespace magbrush::dem {
@@ -33,27 +34,57 @@ std::string run_summary_csv(const std::vector<std::unique_ptr<Measurement>> &mea
 {
   std::ostringstream o;
   o << "# magbrush run summary: every measurement's key numbers; standard errors by block averaging over "
-    << statistics.blocks << " blocks; drift = |mean of 2nd half - mean of 1st half| / |mean|\n";
-  o << "key,value,standard_error,drift,unit,meaning,measurement\n";
-  int tested = 0, steady = 0;
+    << statistics.blocks << " blocks; drift = |mean of 2nd half - mean of 1st half| / |mean|, with its own "
+    << "standard error from each half's blocks\n";
+  o << "key,value,standard_error,drift,unit,meaning,measurement,drift_standard_error\n";
+  SteadyStateVerdict verdict;
   for (const auto &m : measurements)
     for (const SummaryValue &v : m->summary())
     {
       o << cell(v.key) << "," << number(v.value) << "," << number(v.standard_error) << "," << number(v.drift) << ","
-        << cell(v.unit) << "," << cell(v.meaning) << "," << cell(m->name()) << "\n";
-      if (!std::isnan(v.drift))
-      {
-        ++tested;
-        steady += v.drift < statistics.steady_drift;
-      }
+        << cell(v.unit) << "," << cell(v.meaning) << "," << cell(m->name()) << "," << number(v.drift_standard_error)
+        << "\n";
+      verdict.add(v, statistics.steady_drift);
     }
-  char meaning[128];
-  std::snprintf(meaning, sizeof meaning, "%d of %d tested means drift < %.3g %% between the halves of their window",
-                steady, tested, 100.0 * statistics.steady_drift);
-  o << "steady_state," << (tested == 0 ? "nan" : steady == tested ? "1" : "0") << ",nan,nan,1," << meaning << ",run\n";
+  o << verdict.rows(statistics.steady_drift);
   return o.str();
 }
 
+void SteadyStateVerdict::add(const SummaryValue &v, double tolerance)
+{
+  if (std::isnan(v.drift))
+    return;
+  ++tested;
+  steady += v.drift < tolerance;
+  if (std::isnan(v.drift_standard_error))
+    return;
+  ++with_error;
+  trending += v.drift > 2.0 * v.drift_standard_error;
+  resolution = std::max(resolution, 2.0 * v.drift_standard_error);
+}
+
+std::string SteadyStateVerdict::rows(double tolerance) const
+{
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  auto row = [](const char *key, double value, const std::string &meaning) {
+    return std::string(key) + "," + number(value) + ",nan,nan,1," + cell(meaning) + ",run,nan\n";
+  };
+  char text[256];
+  std::snprintf(text, sizeof text, "%d of %d tested means drift < %.3g %% between the halves of their window", steady,
+                tested, 100.0 * tolerance);
+  std::string out = row("steady_state", tested == 0 ? nan : steady == tested ? 1.0 : 0.0, text);
+  std::snprintf(text, sizeof text,
+                "%d of %d tested means drift by more than two of the drift's standard errors (a trend; the rest is "
+                "noise)",
+                trending, with_error);
+  out += row("significant_drift", with_error == 0 ? nan : trending > 0 ? 1.0 : 0.0, text);
+  std::snprintf(text, sizeof text,
+                "two standard errors of the drift of the noisiest tested mean: the smallest drift this window tells "
+                "from noise (above %.3g the steady-state test needs more samples)",
+                tolerance);
+  out += row("drift_resolution", with_error == 0 ? nan : resolution, text);
+  return out;
+}
 void write_run_summary(const std::string &directory, const std::vector<std::unique_ptr<Measurement>> &measurements,
                        const StatisticsSettings &statistics)
 {

@@ -84,8 +84,11 @@ def plot_keys(plt, directory, header, rows, requested):
         notes = []
         for x, r in zip(xs, rows):
             steady = r[col["steady_state"]] if "steady_state" in col else "nan"
+            trend = r[col["significant_drift"]] if "significant_drift" in col else "nan"
             run = r[col["run_time_s"]] if "run_time_s" in col else "?"
-            notes.append(f"{x:g}: {'steady' if steady == '1' else 'NOT steady' if steady == '0' else 'steady ?'}, {run} s")
+            verdict = ("steady" if steady == "1" else "steady ?" if steady != "0" else
+                       "undecided (noise)" if trend == "0" else "NOT steady")
+            notes.append(f"{x:g}: {verdict}, {run} s")
         ax.set_title("; ".join(notes), fontsize=7)
         ax.set_xlabel(x_name)
         ax.set_ylabel(key)

@@ -68,11 +68,13 @@ def read_run_summary(path):
 
 def steady_state_rows(run_summary):
     """The steady-state verdict (the run's own: every tested mean drifts less than
-    statistics.steady_drift between the halves of its averaging window) and the drift of each
-    tested mean, worst first."""
+    statistics.steady_drift between the halves of its averaging window), the drift of each
+    tested mean, worst first, and what a failed test means: a trend (a drift beyond two of its
+    standard errors: run longer) or a window too noisy to decide (average more samples)."""
     if not run_summary:
         return []
-    verdict = next((r for r in run_summary if r["key"] == "steady_state"), None)
+    by_key = {r["key"]: r for r in run_summary}
+    verdict = by_key.get("steady_state")
     tested = []
     for r in run_summary:
         try:
@@ -86,8 +88,21 @@ def steady_state_rows(run_summary):
     tested.sort(reverse=True)
     reached = verdict["value"] == "1"
     worst = ", ".join(f"{k} {100 * d:.1f} %" for d, k in tested[:4])
-    return [("steady state", "reached" if reached else "NOT reached",
-             verdict["meaning"], f"drift: {worst}")]
+    trend = by_key.get("significant_drift", {}).get("value")
+    try:
+        resolution = float(by_key.get("drift_resolution", {}).get("value", "nan"))
+    except ValueError:
+        resolution = float("nan")
+    if reached:
+        state = "reached"
+    elif trend == "0":
+        state = "undecided: the drifts are within their noise"
+    else:
+        state = "NOT reached: still drifting"
+    note = f"drift: {worst}"
+    if math.isfinite(resolution):
+        note += f"; this window resolves drifts down to {100 * resolution:.1f} % (2 standard errors)"
+    return [("steady state", state, verdict["meaning"], note)]
 
 
 def budget_row(flow):

@@ -166,7 +166,7 @@ std::vector<SummaryValue> DeveloperMassPerArea::summary() const
 {
   const auto blocks = static_cast<std::size_t>(statistics_.blocks);
   auto sampled = [&](const char *key, const SampleSeries &s, bool steady_test, const char *unit, const char *meaning) {
-    return SummaryValue{key, s.mean(), s.standard_error(blocks), steady_test ? s.drift() : nan, unit, meaning};
+    return summarise(s, blocks, steady_test, key, unit, meaning);
   };
   SummaryValue bound{"dma_kg_per_m2_bound", dma_bound(), nan, nan, "kg/m^2",
                      "bulk density x blade gap: 0.64 rho_carrier (1 + TC) x gap"};

@@ -334,7 +334,7 @@ std::vector<SummaryValue> NipProfile::summary() const
 {
   const auto blocks = static_cast<std::size_t>(statistics_.blocks);
   auto sampled = [&](const char *key, const SampleSeries &s, const char *unit, const char *meaning) {
-    return SummaryValue{key, s.mean(), s.standard_error(blocks), s.drift(), unit, meaning};
+    return summarise(s, blocks, true, key, unit, meaning);
   };
   auto plain = [](const char *key, double value, const char *unit, const char *meaning) {
     SummaryValue v;
@@ -349,7 +349,7 @@ std::vector<SummaryValue> NipProfile::summary() const
   SummaryValue slip = sampled("slip_at_gap_centre_m_s", centre_slip_, "m/s",
                               "slip of the beads touching the drum in the centre bin");
   slip.value = slip_at_gap_centre();
-  slip.drift = std::numeric_limits<double>::quiet_NaN();
+  slip.drift = slip.drift_standard_error = std::numeric_limits<double>::quiet_NaN();
   return {
       slip,
       plain("relative_surface_speed_m_s", frame_.relative_surface_speed(), "m/s", "sleeve minus drum surface speed"),

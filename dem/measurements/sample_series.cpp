@@ -3,16 +3,49 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <utility>
 
 namespace magbrush::dem {
 
 namespace {
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
-double mean_of(std::vector<double>::const_iterator first, std::vector<double>::const_iterator last)
+using Iterator = std::vector<double>::const_iterator;
+
+double mean_of(Iterator first, Iterator last)
 {
   const auto n = std::distance(first, last);
   return n > 0 ? std::accumulate(first, last, 0.0) / static_cast<double>(n) : nan;
+}
+
+// The block means of the newest blocks × length samples of [first, last), length = n / blocks.
+// Empty when a block would hold fewer than two samples.
+std::vector<double> block_means(Iterator first, Iterator last, std::size_t blocks)
+{
+  const auto n = static_cast<std::size_t>(std::distance(first, last));
+  const std::size_t length = blocks > 0 ? n / blocks : 0;
+  if (length < 2)
+    return {};
+  // The newest blocks × length samples: the oldest ones are nearest the transient.
+  const auto start = last - static_cast<std::ptrdiff_t>(blocks * length);
+  std::vector<double> means(blocks);
+  for (std::size_t b = 0; b < blocks; ++b)
+  {
+    const auto from = start + static_cast<std::ptrdiff_t>(b * length);
+    means[b] = mean_of(from, from + static_cast<std::ptrdiff_t>(length));
+  }
+  return means;
+}
+
+// The squared standard error of the mean of nearly independent block means.
+double squared_error_of_mean(const std::vector<double> &means)
+{
+  const double m = mean_of(means.begin(), means.end());
+  double ss = 0.0;
+  for (double v : means)
+    ss += (v - m) * (v - m);
+  const auto b = static_cast<double>(means.size());
+  return ss / (b - 1.0) / b;
 }
 } // namespace
 
@@ -22,23 +55,8 @@ double SampleSeries::standard_error(std::size_t blocks) const
 {
   if (blocks < 2)
     return nan;
-  const std::size_t length = values_.size() / blocks;
-  if (length < 2)
-    return nan;
-  // The newest blocks × length samples: the oldest ones are nearest the transient.
-  const auto start = values_.end() - static_cast<std::ptrdiff_t>(blocks * length);
-  std::vector<double> block_means(blocks);
-  for (std::size_t b = 0; b < blocks; ++b)
-  {
-    const auto first = start + static_cast<std::ptrdiff_t>(b * length);
-    block_means[b] = mean_of(first, first + static_cast<std::ptrdiff_t>(length));
-  }
-  const double m = mean_of(block_means.begin(), block_means.end());
-  double ss = 0.0;
-  for (double v : block_means)
-    ss += (v - m) * (v - m);
-  const double variance_of_block_means = ss / static_cast<double>(blocks - 1);
-  return std::sqrt(variance_of_block_means / static_cast<double>(blocks));
+  const std::vector<double> means = block_means(values_.begin(), values_.end(), blocks);
+  return means.empty() ? nan : std::sqrt(squared_error_of_mean(means));
 }
 
 double SampleSeries::drift() const
@@ -49,6 +67,37 @@ double SampleSeries::drift() const
   const double first = mean_of(values_.begin(), middle), second = mean_of(middle, values_.end());
   const double m = mean();
   return m != 0.0 ? std::abs(second - first) / std::abs(m) : nan;
+}
+
+double SampleSeries::drift_standard_error(std::size_t blocks) const
+{
+  const std::size_t per_half = blocks / 2;
+  if (per_half < 2)
+    return nan;
+  const auto middle = values_.begin() + static_cast<std::ptrdiff_t>(values_.size() / 2);
+  const std::vector<double> first = block_means(values_.begin(), middle, per_half);
+  const std::vector<double> second = block_means(middle, values_.end(), per_half);
+  const double m = mean();
+  if (first.empty() || second.empty() || m == 0.0)
+    return nan;
+  return std::sqrt(squared_error_of_mean(first) + squared_error_of_mean(second)) / std::abs(m);
+}
+
+SummaryValue summarise(const SampleSeries &series, std::size_t blocks, bool steady_test, std::string key,
+                       std::string unit, std::string meaning)
+{
+  SummaryValue v;
+  v.key = std::move(key);
+  v.value = series.mean();
+  v.standard_error = series.standard_error(blocks);
+  if (steady_test)
+  {
+    v.drift = series.drift();
+    v.drift_standard_error = series.drift_standard_error(blocks);
+  }
+  v.unit = std::move(unit);
+  v.meaning = std::move(meaning);
+  return v;
 }
 
 } // namespace magbrush::dem

@@ -9,9 +9,17 @@
 //    their spread / √B estimates the standard error of the mean.
 //  * whether it is at a STEADY STATE: the relative drift between the means of the first and
 //    the second half of the averaging window, |m₂ − m₁| / |m|, below a tolerance (2 % by
-//    default, `measurements.steady_drift`). A series still rising or draining fails it; a
+//    default, `statistics.steady_drift`). A series still rising or draining fails it; a
 //    stationary one passes once its halves' noise is below the tolerance.
+//  * whether a failed test says anything: the drift's own STANDARD ERROR, from each half's
+//    block means about that half's own mean (so that a trend between the halves does not
+//    inflate it). A drift beyond two of them is a trend; a drift within them is noise, and a
+//    window whose two standard errors exceed the tolerance cannot resolve a steady state at
+//    that tolerance at all: it needs more samples, not more patience.
 #pragma once
+
+#include "dem/measurement.h"
+
 
 #include <cstddef>
 #include <vector>
@@ -33,11 +41,20 @@ public:
   double standard_error(std::size_t blocks = default_blocks) const;
   // |mean(second half) − mean(first half)| / |mean| (NaN with fewer than 4 samples or a zero mean).
   double drift() const;
+  // Standard error of drift(): each half cut into blocks/2 blocks (the newest that fill them),
+  // the half's standard error from its block means about its own mean, the two combined, over
+  // |mean|. NaN with fewer than two blocks per half or two samples per block, or a zero mean.
+  double drift_standard_error(std::size_t blocks = default_blocks) const;
 
   static constexpr std::size_t default_blocks = 10;
 
 private:
   std::vector<double> values_;
 };
+
+// The summary row of a sampled mean: its value, block standard error and, when `steady_test`,
+// its drift and the drift's standard error (else NaN: not part of the steady-state verdict).
+SummaryValue summarise(const SampleSeries &series, std::size_t blocks, bool steady_test, std::string key,
+                       std::string unit, std::string meaning);
 
 } // namespace magbrush::dem

@@ -211,7 +211,7 @@ std::vector<SummaryValue> TonerDevelopment::summary() const
 {
   const auto blocks = static_cast<std::size_t>(statistics_.blocks);
   auto sampled = [&](const char *key, const SampleSeries &s, bool steady_test, const char *unit, const char *meaning) {
-    return SummaryValue{key, s.mean(), s.standard_error(blocks), steady_test ? s.drift() : nan, unit, meaning};
+    return summarise(s, blocks, steady_test, key, unit, meaning);
   };
   SummaryValue bound;
   bound.key = "tma_kg_per_m2_bound";

@@ -2,6 +2,7 @@
 // against exact results: the drift of a linear ramp, and the standard error of the mean of a
 // correlated AR(1) series, whose exact value the naive σ/√n misses by a factor 4.4.
 #include "dem/measurements/sample_series.h"
+#include "dem/run_summary.h"
 
 #include <gtest/gtest.h>
 
@@ -83,4 +84,96 @@ TEST(SampleSeries, BlockStandardErrorOfACorrelatedSeriesMatchesTheExactValue)
   }
   EXPECT_NEAR(mean_estimate / exact, 1.0, 0.05);
   EXPECT_NEAR(exact / mean_naive, std::sqrt((1.0 + rho) / (1.0 - rho)), 0.15);
+}
+
+TEST(SampleSeries, DriftStandardErrorOfWhiteNoiseMatchesTheExactValue)
+{
+  // Independent samples N(μ, σ²), n of them: each half's mean has the variance σ²/(n/2), so the
+  // drift |m₂ − m₁|/μ has the exact standard error 2σ/(√n μ). Over 400 series the block estimate
+  // (5 blocks per half) must match it within 6 % (its spread per series is ≈ 25 %, 1.3 % over
+  // 400; the square root of an unbiased variance with 8 degrees of freedom is ≈ 3 % low), and a
+  // drift beyond two of them must be as rare as chance makes it (≈ 8 % for a t with 8 degrees
+  // of freedom).
+  const double mu = 10.0, sigma = 1.0;
+  const std::size_t n = 2000;
+  const int series = 400;
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> sample(mu, sigma);
+  const double exact = 2.0 * sigma / (std::sqrt(double(n)) * mu);
+  double mean_estimate = 0.0;
+  int beyond_two = 0;
+  for (int r = 0; r < series; ++r)
+  {
+    SampleSeries s;
+    for (std::size_t k = 0; k < n; ++k)
+      s.add(sample(rng));
+    const double se = s.drift_standard_error();
+    mean_estimate += se / series;
+    beyond_two += s.drift() > 2.0 * se;
+  }
+  EXPECT_NEAR(mean_estimate / exact, 1.0, 0.06);
+  EXPECT_GT(beyond_two, series * 3 / 100);
+  EXPECT_LT(beyond_two, series * 14 / 100);
+}
+
+TEST(SampleSeries, ATrendStandsOutOfItsNoiseAndNoiseDoesNot)
+{
+  // A 10 % ramp under noise of 1 %: the halves differ by 5 %. The ramp also rises within each
+  // half (by 1 % per block of 100 samples), and that rise enters the half's block spread, so the
+  // drift's error is the ramp's own order, ≈ √2 × sd(0, 1, 2, 3, 4 %)/√5 ≈ 1 %: conservative —
+  // a trend is called only beyond what the halves' own spread allows — and still ≈ 5 standard
+  // errors here. The same noise without the ramp drifts within two standard errors, whose size
+  // is the noise's: 2 × 0.01 / √1000 exactly, the estimate within a factor 2.
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  SampleSeries ramp, flat;
+  const int n = 1000;
+  for (int k = 0; k < n; ++k)
+  {
+    const double e = noise(rng);
+    ramp.add(1.0 + 0.1 * k / n + e);
+    flat.add(1.0 + e);
+  }
+  EXPECT_GT(ramp.drift(), 4.0 * ramp.drift_standard_error());
+  EXPECT_NEAR(ramp.drift_standard_error(), std::sqrt(2.0 * 2.5e-4 / 5.0) / ramp.mean(), 0.3e-2);
+  EXPECT_LT(flat.drift(), 2.0 * flat.drift_standard_error());
+  const double noise_only = 2.0 * 0.01 / std::sqrt(double(n));
+  EXPECT_GT(flat.drift_standard_error(), 0.5 * noise_only);
+  EXPECT_LT(flat.drift_standard_error(), 2.0 * noise_only);
+  SampleSeries few;
+  for (int k = 0; k < 18; ++k)
+    few.add(k + 1.0);
+  EXPECT_TRUE(std::isnan(few.drift_standard_error())); // 5 blocks of 2 per half need 20 samples
+  EXPECT_FALSE(std::isnan(few.drift_standard_error(4)));
+}
+
+TEST(SteadyStateVerdict, SaysWhetherAFailedTestIsATrendOrTooLittleData)
+{
+  using magbrush::dem::SteadyStateVerdict;
+  using magbrush::dem::SummaryValue;
+  auto tested = [](double drift, double error) {
+    SummaryValue v;
+    v.key = "x", v.value = 1.0, v.drift = drift, v.drift_standard_error = error;
+    return v;
+  };
+  SteadyStateVerdict trend;
+  trend.add(tested(0.05, 0.01), 0.02); // 5 standard errors: a trend
+  trend.add(tested(0.01, 0.004), 0.02);
+  const std::string t = trend.rows(0.02);
+  EXPECT_NE(t.find("steady_state,0,"), std::string::npos) << t;
+  EXPECT_NE(t.find("significant_drift,1,"), std::string::npos) << t;
+  EXPECT_NE(t.find("drift_resolution,0.02,"), std::string::npos) << t;
+
+  SteadyStateVerdict noisy;
+  noisy.add(tested(0.05, 0.04), 0.02); // 1.25 standard errors: noise, and a window that cannot resolve 2 %
+  noisy.add(tested(0.01, std::nan("")), 0.02);
+  const std::string n = noisy.rows(0.02);
+  EXPECT_NE(n.find("steady_state,0,"), std::string::npos) << n;
+  EXPECT_NE(n.find("significant_drift,0,"), std::string::npos) << n;
+  EXPECT_NE(n.find("drift_resolution,0.08,"), std::string::npos) << n;
+  EXPECT_NE(n.find("0 of 1 tested means drift by more"), std::string::npos) << n;
+
+  SteadyStateVerdict none;
+  EXPECT_NE(none.rows(0.02).find("steady_state,nan,"), std::string::npos);
+  EXPECT_NE(none.rows(0.02).find("significant_drift,nan,"), std::string::npos);
 }

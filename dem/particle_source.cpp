@@ -266,14 +266,15 @@ void ParticleSource::create(const ParticleState &state, double t, ParticleState 
   const double span = std::copysign(std::max(std::abs(dphi), 2.0 * carrier_.d_max / R_), dphi);
   gather_near(state, theta_in_, span);
   drawing_ = true;
-  fill_owed(t, theta_in_, span, enter);
+  fill_owed(t, theta_in_, span, sump_, enter);
   drawing_ = false;
   check_owed();
 }
 
-// Places the carriers owed (with their toner) into the arc θ0 … θ0 + span; a sump declines
-// what finds no room. False when a fixed supply found no room for a carrier.
-bool ParticleSource::fill_owed(double t, double theta0, double span, ParticleState &enter)
+// Places the carriers owed (with their toner) into the arc θ0 … θ0 + span; with `may_decline`
+// (a sump) what finds no room stays in the sump. False when a carrier found no room and may
+// not be declined.
+bool ParticleSource::fill_owed(double t, double theta0, double span, bool may_decline, ParticleState &enter)
 {
   for (;;)
   {
@@ -289,7 +290,7 @@ bool ParticleSource::fill_owed(double t, double theta0, double span, ParticleSta
     }
     if (!place_carrier(d, theta0, span, t, enter))
     {
-      if (!sump_)
+      if (!may_decline)
         return false;
       declined_mass_ += owed_carrier_; // no room: the rest stays in the sump
       owed_carrier_ = 0.0;
@@ -310,8 +311,6 @@ void ParticleSource::prefill(const ParticleState &present, ParticleState &add)
     return;
   const auto created_count = count_;
   const auto created_mass = mass_;
-  const bool sump = sump_;
-  sump_ = false; // nothing is declined: the layer is given
   const std::size_t first = add.size();
   const double sense = omega_ < 0.0 ? -1.0 : 1.0;
   const double piece = 2.0 * carrier_.d_max / R_;
@@ -324,17 +323,15 @@ void ParticleSource::prefill(const ParticleState &present, ParticleState &add)
     owed_carrier_ += carrier_share_ * areal_mass_ * R_ * std::abs(span) * Lz_;
     gather_near(present, theta0, span);
     add_near(add, theta0, span);
-    fill_owed(0.0, theta0, span, add);
+    fill_owed(0.0, theta0, span, /*may_decline=*/false, add); // the layer is given, not offered
     if (owed_carrier_ > backlog)
     {
-      sump_ = sump;
       throw std::invalid_argument(
           "inflow.prefill_arc: the layer of inflow.areal_mass does not fit between the sleeve and the walls at " +
           std::to_string((theta0 + 0.5 * span) * 180.0 / M_PI) + " deg (within inflow.layer_height of the sleeve): "
           "end the prefill arc before it, or lower inflow.layer_height or inflow.areal_mass");
     }
   }
-  sump_ = sump;
   // What is left (below half a particle) is not carried over into the run's inflow.
   owed_carrier_ = 0.0;
   pending_d_ = 0.0;

@@ -136,7 +136,7 @@ private:
   void gather_near(const ParticleState &state, double theta0, double dphi);
   bool place_carrier(double d, double theta0, double dphi, double t, ParticleState &enter);
   void add_near(const ParticleState &state, double theta0, double dphi);
-  bool fill_owed(double t, double theta0, double span, ParticleState &enter);
+  bool fill_owed(double t, double theta0, double span, bool may_decline, ParticleState &enter);
   void check_owed() const;
   void attach_toner(const Vector3 &centre, double rc, double t, ParticleState &enter);
   void append(const Feed &f, const Vector3 &p, double d, double t, ParticleState &enter);

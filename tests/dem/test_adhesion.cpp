@@ -430,10 +430,10 @@ TEST(Adhesion, CaseKeysParseAndNameTheirErrors)
 
 TEST(Adhesion, TheKweonCaseGivesEveryPairItsHamakerConstant)
 {
-  // The full-roller case sets Hamaker constants for the toner and every material it meets,
+  // The development case sets Hamaker constants for the toner and every material it meets,
   // with 50 nm asperities: its contact table builds, and the toner's pull-off forces are
   // nN, not the µN of smooth 7 µm spheres.
-  const Case c = load_case(std::string(MAGBRUSH_SOURCE_DIR) + "/cases/kweon_full_roller.yaml");
+  const Case c = load_case(std::string(MAGBRUSH_SOURCE_DIR) + "/cases/kweon_development.yaml");
   std::vector<std::string> species;
   for (const auto &p : c.populations)
     species.push_back(p.material);

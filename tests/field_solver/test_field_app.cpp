@@ -28,7 +28,7 @@ std::string run_field(const std::string &extra, int &rc)
   const std::string log = out_dir + ".log";
   const std::string command =
     std::string(MAGBRUSH_BINARY_DIR) + "/bin/magbrush-field " + MAGBRUSH_SOURCE_DIR +
-    "/cases/kweon_full_roller.yaml --no-vtu --set field.output_dir=" + out_dir +
+    "/cases/kweon_development.yaml --no-vtu --set field.output_dir=" + out_dir +
     " " + extra + " > " +
     log + " 2>&1";
   rc = std::system(command.c_str());
@@ -46,11 +46,11 @@ TEST(FieldApp, StoresFieldsAndReusesThemUntilTheirInputsChange)
   int rc = 0;
   const std::string first = run_field("", rc);
   ASSERT_EQ(rc, 0) << first;
-  const std::string magnetic = out_dir + "/kweon_full_roller_magnetic.h5";
-  const std::string electric = out_dir + "/kweon_full_roller_electric.h5";
+  const std::string magnetic = out_dir + "/kweon_development_magnetic.h5";
+  const std::string electric = out_dir + "/kweon_development_electric.h5";
   ASSERT_TRUE(fs::exists(magnetic)) << first;
   ASSERT_TRUE(fs::exists(electric)) << first;
-  ASSERT_TRUE(fs::exists(out_dir + "/kweon_full_roller_profile_sleeve.csv"));
+  ASSERT_TRUE(fs::exists(out_dir + "/kweon_development_profile_sleeve.csv"));
 
   // The stored magnetic grid carries its case hash and a small error against the exact ring.
   const auto m = magbrush::read_magnetic_grid(magnetic);
@@ -98,5 +98,5 @@ TEST(FieldApp, ZeroElectricFieldIsNotSolved)
                                     rc);
   ASSERT_EQ(rc, 0) << log;
   EXPECT_NE(log.find("electric field: skipped, it is zero"), std::string::npos) << log;
-  EXPECT_FALSE(fs::exists(out_dir + "/kweon_full_roller_electric.h5"));
+  EXPECT_FALSE(fs::exists(out_dir + "/kweon_development_electric.h5"));
 }

@@ -127,25 +127,44 @@ TEST(CaseFiles, BrushCompressionAndItsCarrierVariants)
   EXPECT_NEAR(c42.populations[0].diameter_mean, 42e-6, 1e-18);
 }
 
-TEST(CaseFiles, KweonFullRoller)
+TEST(CaseFiles, KweonFullRollerIsAClosedDeveloperLoop)
 {
+  // The whole roller as the paper's flow simulations (Fig. 4-7): carriers only, fed from a
+  // finite sump at the pick-up, regulated by the guide and the doctor blade, released back to
+  // the sump; no toner, no nip field (those are the development case's).
   const Case c = load_case(source_dir + "/cases/kweon_full_roller.yaml");
-  EXPECT_TRUE(c.electric.enabled);
-  EXPECT_GE(std::abs(c.electric.bias), 500.0);
-  EXPECT_LE(std::abs(c.electric.bias), 800.0);
+  EXPECT_FALSE(c.electric.enabled);
   ASSERT_EQ(c.blades.size(), 2u);
   EXPECT_TRUE(c.blades[0].is_doctor_blade);
   EXPECT_NEAR(c.blades[0].gap, 0.5e-3, 1e-15);
   // The generated blade's polygon really is `gap` from the sleeve.
   EXPECT_NEAR(polygon_distance_to_point(c.blades[0].polygon, {0, 0}) - c.sleeve->radius, 0.5e-3, 1e-12);
   EXPECT_GT(polygon_signed_area(c.blades[1].polygon), 0.0);
-  ASSERT_EQ(c.populations.size(), 2u);
-  EXPECT_EQ(c.populations[1].kind, ParticleKind::toner);
-  EXPECT_NEAR(c.populations[1].charge_to_mass, -30e-3, 1e-15);
+  ASSERT_EQ(c.populations.size(), 1u);
+  EXPECT_EQ(c.populations[0].kind, ParticleKind::carrier);
+  EXPECT_EQ(c.populations[0].count, 0);
+  // The loop: a finite sump feeds the sleeve, everything leaving returns to it.
+  EXPECT_GT(c.flow.inflow_areal_mass, 0.0);
+  EXPECT_GT(c.flow.inflow_sump_mass, 0.0);
+  EXPECT_GT(c.flow.outflow_radius, c.sleeve->radius);
+  // The guide wall lies above the fed layer: the inflow passes under it.
+  EXPECT_LT(c.sleeve->radius + c.flow.inflow_layer_height,
+            polygon_distance_to_point(c.blades[1].polygon, {0, 0}));
   EXPECT_TRUE(fs::exists(c.measured_flux_file)) << c.measured_flux_file;
   // polarity + unsigned strength = signed strength
   EXPECT_LT(c.roller->poles[0].strength, 0.0);
   EXPECT_GT(c.roller->poles[1].strength, 0.0);
+}
+
+TEST(CaseFiles, KweonDevelopmentHasTheBiasRangeAndChargedToner)
+{
+  const Case c = load_case(source_dir + "/cases/kweon_development.yaml");
+  EXPECT_TRUE(c.electric.enabled);
+  EXPECT_GE(std::abs(c.electric.bias), 500.0);
+  EXPECT_LE(std::abs(c.electric.bias), 800.0);
+  ASSERT_EQ(c.populations.size(), 2u);
+  EXPECT_EQ(c.populations[1].kind, ParticleKind::toner);
+  EXPECT_NEAR(c.populations[1].charge_to_mass, -30e-3, 1e-15);
 }
 
 TEST(CaseParser, DefaultsAgreeWithTheContractStruct)

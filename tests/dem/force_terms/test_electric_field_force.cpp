@@ -175,7 +175,7 @@ TEST(ElectricFieldForce, ChargeInAMovingCosineImageFieldMatchesThePlanarSolution
 // and the new phase-sampling key are field inputs.
 TEST(ElectricFieldForce, StaleGridIsRefusedNamingTheKey)
 {
-  const std::string yaml = std::string(MAGBRUSH_SOURCE_DIR) + "/cases/kweon_full_roller.yaml";
+  const std::string yaml = std::string(MAGBRUSH_SOURCE_DIR) + "/cases/kweon_development.yaml";
   const fs::path dir = magbrush::testing::test_temp_dir("electric_stale_grid"); // this process's own
   const Case c = load_case(yaml, {"field.output_dir=" + dir.string()});
   ASSERT_TRUE(c.electric.enabled);
@@ -206,7 +206,7 @@ TEST(ElectricFieldForce, StaleGridIsRefusedNamingTheKey)
 // On with an enabled electric section and a charged population; the log's reason otherwise.
 TEST(ElectricFieldForce, RuleNamesWhyItIsOff)
 {
-  const std::string yaml = std::string(MAGBRUSH_SOURCE_DIR) + "/cases/kweon_full_roller.yaml";
+  const std::string yaml = std::string(MAGBRUSH_SOURCE_DIR) + "/cases/kweon_development.yaml";
   const dem::ForceTermFactory *qE = nullptr;
   const auto factories = dem::force_term_factories();
   for (const auto &f : factories)

@@ -304,7 +304,10 @@ bool ParticleSource::fill_owed(double t, double theta0, double span, bool may_de
 
 // The layer over the prefill arc, walked downstream in pieces two diameters long, each given
 // the mass the layer holds over it. What a piece has no room for moves on to the next (as in
-// the run's inflow); a backlog of ten carriers means the layer does not fit there.
+// the run's inflow). A backlog of a whole piece's mass (at least ten carriers) means the layer
+// does not fit there: a wall in the way leaves most of a piece unplaced at once, while random
+// placement near its packing limit only falls behind by a fraction of a carrier per piece,
+// which the pieces downstream take up.
 void ParticleSource::prefill(const ParticleState &present, ParticleState &add)
 {
   if (prefill_arc_ <= 0.0)
@@ -316,11 +319,12 @@ void ParticleSource::prefill(const ParticleState &present, ParticleState &add)
   const double piece = 2.0 * carrier_.d_max / R_;
   const int pieces = std::max(1, static_cast<int>(std::ceil(prefill_arc_ / piece)));
   const double span = sense * prefill_arc_ / pieces;
-  const double backlog = 10.0 * sphere_mass(carrier_.d_mean, carrier_.density);
+  const double per_piece = carrier_share_ * areal_mass_ * R_ * std::abs(span) * Lz_;
+  const double backlog = std::max(per_piece, 10.0 * sphere_mass(carrier_.d_mean, carrier_.density));
   for (int k = 0; k < pieces; ++k)
   {
     const double theta0 = theta_in_ + k * span;
-    owed_carrier_ += carrier_share_ * areal_mass_ * R_ * std::abs(span) * Lz_;
+    owed_carrier_ += per_piece;
     gather_near(present, theta0, span);
     add_near(add, theta0, span);
     fill_owed(0.0, theta0, span, /*may_decline=*/false, add); // the layer is given, not offered

@@ -372,6 +372,166 @@ void CellMultipoleField::update_positions(const double *x, const double *y, cons
       xw_[3 * b + d] = coord[d][b] + wrap_shift_[3 * b + d];
 }
 
+bool CellMultipoleField::fine_index(const double xw[3], std::array<long, 3> &I) const
+{
+  const Level &fine = levels_[0];
+  for (int d = 0; d < 3; ++d)
+  {
+    if (box_[d] <= 0.0 && xw[d] < origin_[d])
+      return false;
+    I[d] = static_cast<long>(std::floor((xw[d] - origin_[d]) / h_[d]));
+    if (box_[d] > 0.0)
+      I[d] = std::clamp(I[d], 0L, fine.cells[d] - 1);
+    I[d] = std::max(I[d], 0L);
+  }
+  return true;
+}
+
+bool CellMultipoleField::can_add(const double x[3]) const
+{
+  if (levels_.empty())
+    return false;
+  double w[3];
+  for (int d = 0; d < 3; ++d)
+  {
+    w[d] = x[d];
+    if (box_[d] > 0.0)
+    {
+      w[d] = x[d] - box_[d] * std::floor(x[d] / box_[d]);
+      if (w[d] >= box_[d])
+        w[d] -= box_[d];
+    }
+  }
+  std::array<long, 3> I;
+  return fine_index(w, I) && find_fine(I) >= 0;
+}
+
+bool CellMultipoleField::add_beads(std::size_t n, const double *x, const double *y, const double *z)
+{
+  if (levels_.empty() || n < n_ || near_targets_ < n)
+    return false;
+  const double *coord[3] = {x, y, z};
+  // First the cells (as build() wraps and sorts): all must be occupied, or nothing changes.
+  const std::size_t first = n_;
+  std::vector<double> xw(3 * (n - first));
+  std::vector<std::uint32_t> cell(n - first);
+  for (std::size_t b = first; b < n; ++b)
+  {
+    double *w = &xw[3 * (b - first)];
+    for (int d = 0; d < 3; ++d)
+    {
+      w[d] = coord[d][b];
+      if (box_[d] > 0.0)
+      {
+        w[d] = coord[d][b] - box_[d] * std::floor(coord[d][b] / box_[d]);
+        if (w[d] >= box_[d])
+          w[d] -= box_[d];
+      }
+    }
+    std::array<long, 3> I;
+    if (!fine_index(w, I))
+      return false;
+    const long c = find_fine(I);
+    if (c < 0)
+      return false;
+    cell[b - first] = static_cast<std::uint32_t>(c);
+  }
+  n_ = n;
+  xw_.insert(xw_.end(), xw.begin(), xw.end());
+  wrap_shift_.resize(3 * n);
+  bead_cell_.resize(n);
+  for (std::size_t b = first; b < n; ++b)
+  {
+    bead_cell_[b] = cell[b - first];
+    for (int d = 0; d < 3; ++d)
+      wrap_shift_[3 * b + d] = xw_[3 * b + d] - coord[d][b];
+  }
+  // Every cell's beads in ascending index (as build()'s sort leaves them): the old ones, then
+  // the appended ones of that cell.
+  const std::size_t nc = bead_begin_.size() - 1;
+  begin_scratch_.assign(nc + 1, 0);
+  for (std::size_t c = 0; c < nc; ++c)
+    begin_scratch_[c + 1] = bead_begin_[c + 1] - bead_begin_[c];
+  for (std::size_t b = first; b < n; ++b)
+    ++begin_scratch_[bead_cell_[b] + 1];
+  for (std::size_t c = 0; c < nc; ++c)
+    begin_scratch_[c + 1] += begin_scratch_[c];
+  order_scratch_.resize(n);
+  for (std::size_t c = 0; c < nc; ++c)
+    std::copy(bead_order_.begin() + bead_begin_[c], bead_order_.begin() + bead_begin_[c + 1],
+              order_scratch_.begin() + begin_scratch_[c]);
+  std::vector<std::uint32_t> fill(nc);
+  for (std::size_t c = 0; c < nc; ++c)
+    fill[c] = begin_scratch_[c] + (bead_begin_[c + 1] - bead_begin_[c]);
+  for (std::size_t b = first; b < n; ++b)
+    order_scratch_[fill[bead_cell_[b]]++] = static_cast<std::uint32_t>(b);
+  bead_order_.swap(order_scratch_);
+  bead_begin_.swap(begin_scratch_);
+  return true;
+}
+
+void CellMultipoleField::appended_near_pairs(std::size_t first, std::vector<MagneticNeighbourList::Pair> &out) const
+{
+  const long s = near_reach_, span = 2 * s + 1, per_cell = span * span * span;
+  auto make_pair = [&](std::uint32_t i, std::uint32_t j, const double shift[3]) {
+    MagneticNeighbourList::Pair p;
+    p.i = i;
+    p.j = j;
+    for (int d = 0; d < 3; ++d)
+      p.shift[d] = shift[d] + wrap_shift_[3 * j + d] - wrap_shift_[3 * i + d];
+    return p;
+  };
+  for (std::size_t c = first; c < n_; ++c)
+  {
+    const std::size_t e0 = bead_cell_[c] * per_cell;
+    for (std::size_t e = e0; e < e0 + per_cell; ++e)
+    {
+      const std::int32_t cell = neighbour_cell_[e];
+      if (cell < 0)
+        continue;
+      double shift[3], back[3];
+      for (int d = 0; d < 3; ++d)
+      {
+        shift[d] = box_[d] > 0.0 ? static_cast<double>(static_cast<long>(neighbour_image_[3 * e + d])) * box_[d] : 0.0;
+        back[d] = -shift[d];
+      }
+      const bool zero_shift = shift[0] == 0.0 && shift[1] == 0.0 && shift[2] == 0.0;
+      const bool positive_shift =
+        shift[0] > 0.0 || (shift[0] == 0.0 && (shift[1] > 0.0 || (shift[1] == 0.0 && shift[2] > 0.0)));
+      for (std::uint32_t k = bead_begin_[cell]; k < bead_begin_[cell + 1]; ++k)
+      {
+        const std::uint32_t j = bead_order_[k];
+        if (j < first) // an older bead: listed from its side, with the image seen from there
+          out.push_back(make_pair(j, static_cast<std::uint32_t>(c), back));
+        else if (j > c || (j == c && !zero_shift && positive_shift))
+          out.push_back(make_pair(static_cast<std::uint32_t>(c), j, shift));
+      }
+    }
+  }
+}
+
+void CellMultipoleField::far_field_at(std::size_t b, double B[3], double gradB[9]) const
+{
+  const Level &fine = levels_[0];
+  const std::uint32_t c = bead_cell_[b];
+  const auto centre_c = centre(0, fine.index[c]);
+  const double u[3] = {xw_[3 * b] - centre_c[0], xw_[3 * b + 1] - centre_c[1], xw_[3 * b + 2] - centre_c[2]};
+  double G[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+  B[0] = B[1] = B[2] = 0.0;
+  taylor_.evaluate(u, &fine.L[c * taylor_.local_size()], B, G);
+  for (int a = 0; a < 3; ++a)
+    for (int d = 0; d < 3; ++d)
+      gradB[3 * a + d] = G[a][d];
+}
+
+bool CellMultipoleField::set_fine_locals(const std::vector<double> &L)
+{
+  if (levels_.empty() || L.size() != levels_[0].L.size())
+    return false;
+  levels_[0].L = L;
+  return true;
+}
+
 bool CellMultipoleField::near(int level, const std::array<long, 3> &D) const
 {
   // Columns (all periodic axes collapsed): neighbours along the open axes, any image.

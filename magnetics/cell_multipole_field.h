@@ -90,6 +90,35 @@ public:
   // a bead wrapped by the caller since build() must trigger a build() instead.
   void update_positions(const double *x, const double *y, const double *z);
 
+  // Beads appended since build() (indices bead_count() … n−1; x, y, z raw, all n beads) join
+  // the fine cells they fall in, without a rebuild: the levels, interaction lists and
+  // translations stay. Each must fall in an occupied fine cell (a new cell would change the
+  // tree) and, along an open axis, not below the grid's origin (so that build() from the
+  // same positions, as a restart does, finds the same cells and the same bead order). False,
+  // and nothing changed, when some bead cannot join.
+  bool add_beads(std::size_t n, const double *x, const double *y, const double *z);
+  // Whether a bead at x (raw) could join: in an occupied fine cell, not below the origin.
+  bool can_add(const double x[3]) const;
+  // The near pairs of the beads appended from `first` on (with every bead, each pair once,
+  // by the rule of build(): pairs with an older bead are listed from the older one), with
+  // the image shifts for the raw positions given to build() / add_beads(). Appends to `out`.
+  void appended_near_pairs(std::size_t first, std::vector<MagneticNeighbourList::Pair> &out) const;
+  // Dipoles: the far field and gradient at bead b from its fine cell's local expansion of the
+  // last evaluate() (L2P for one bead: what evaluate() gave the beads of that cell).
+  void far_field_at(std::size_t b, double B[3], double gradB[9]) const;
+  // The fine cells' local expansions of the last evaluate() (restart: with the cells rebuilt
+  // from the same positions, set_fine_locals() restores them exactly).
+  const std::vector<double> &fine_locals() const { return levels_.at(0).L; }
+  bool set_fine_locals(const std::vector<double> &L);
+  // The sources were scaled by `ratio` (a field ramp): so are the fine local expansions.
+  void scale_fine_locals(double ratio)
+  {
+    if (!levels_.empty())
+      for (double &v : levels_[0].L)
+        v *= ratio;
+  }
+  std::size_t bead_count() const { return n_; }
+
   // Pairs of beads (and periodic images) in adjacent fine cells, each once, in a fixed order;
   // r = x_j − x_i + shift with the raw positions given to build().
   const std::vector<MagneticNeighbourList::Pair> &near_pairs() const { return near_pairs_; }
@@ -148,6 +177,10 @@ private:
   std::vector<std::uint32_t> bead_begin_;  // per fine cell, into bead_order_
   std::vector<std::uint32_t> bead_cell_;   // fine cell of every bead
   std::vector<MagneticNeighbourList::Pair> near_pairs_;
+  std::vector<std::uint32_t> order_scratch_, begin_scratch_; // add_beads()
+  // Bead b's fine cell index vector from its wrapped position; false when it lies below the
+  // origin along an open axis.
+  bool fine_index(const double xw[3], std::array<long, 3> &I) const;
   std::vector<std::int32_t> neighbour_cell_, neighbour_image_; // build_near_pairs(): per fine cell
   std::size_t near_targets_ = static_cast<std::size_t>(-1);
 

@@ -529,6 +529,8 @@ void InducedDipoles::scale_applied_field(double ratio)
       x *= ratio;
   if (tail_)
     tail_->scale(ratio);
+  if (far_)
+    far_->scale_fine_locals(ratio);
   const double ratio2 = ratio * ratio;
   for (auto *v : {&force_, &torque_})
     for (double &x : *v)
@@ -623,6 +625,122 @@ void InducedDipoles::reevaluate_local_forces(const BeadArrays &beads, MagneticSt
 }
 
 // ---------------------------------------------------------------------------------------
+// Admission of an exchange without a rebuild.
+
+bool InducedDipoles::admit(const BeadArrays &beads, std::size_t first, const std::vector<std::uint32_t> &leavers,
+                           const AppliedFieldFunction &field, MagneticStats &stats)
+{
+  stats = MagneticStats();
+  const double t_start = omp_get_wtime();
+  if (!can_admit(beads, first) || !far_->add_beads(beads.n, beads.x, beads.y, beads.z))
+    return false;
+  // From here on nothing can fail. The newcomers' near pairs join the list (the older beads
+  // keep their pairs, tensors and stored forces), then the correction's list.
+  MagneticNeighbourList &list = near_.list();
+  const std::size_t old_pairs = list.size();
+  if (beads.n > first) // (only leavers: the lists stay as they are)
+  {
+    admitted_pairs_.clear();
+    far_->appended_near_pairs(first, admitted_pairs_);
+    list.append(beads.n, beads.x, beads.y, beads.z, admitted_pairs_);
+    near_.appended(beads, old_pairs);
+    pair_forces_.resize(list.size());
+    if (far_corrections())
+      correction_.admit(beads, first);
+  }
+  append_bead_state(beads, first, leavers, field);
+  staleness_.admit(beads, first, near_, old_pairs, skin_, leavers);
+  stats.time_lists = omp_get_wtime() - t_start;
+  solve_around(beads, first, leavers, field, stats);
+  stats.listed_pairs = list.size();
+  return true;
+}
+
+bool InducedDipoles::can_admit(const BeadArrays &beads, std::size_t first) const
+{
+  if (!far_ || settings_.model == DipoleModel::point_dipole || beads.n < first)
+    return false;
+  // The held state must be that of the first `first` beads and current, as for a local refresh.
+  const BeadArrays held{first, beads.x, beads.y, beads.z, beads.radius, beads.mu_r, beads.saturation_magnetisation};
+  if (!can_refresh_locally(held))
+    return false;
+  if (!far_corrections() || beads.n == first)
+    return true;
+  if (!correction_.can_admit(beads, first))
+    return false;
+  // A newcomer's β must be one the correction has tables for (those of the held beads).
+  for (std::size_t b = first; b < beads.n; ++b)
+    if (std::find(beta_.begin(), beta_.end(), clausius_mossotti(beads.mu_r[b])) == beta_.end())
+      return false;
+  return true;
+}
+
+// The per-bead state of the newcomers: materials, applied field, the held far field (their
+// fine cell's local expansion of the last full evaluation, as every bead of that cell holds
+// it), the applied-field-plus-far-field dipole as the sweeps' start; the leavers' dipoles
+// vanish (β = 0 from now on).
+void InducedDipoles::append_bead_state(const BeadArrays &beads, std::size_t first,
+                                       const std::vector<std::uint32_t> &leavers, const AppliedFieldFunction &field)
+{
+  const std::size_t n = beads.n;
+  set_materials(beads);
+  for (auto *v : {&B0_, &B_far_, &p_, &p_next_, &B_local_, &force_, &torque_})
+    v->resize(3 * n, 0.0);
+  for (auto *v : {&gradB0_, &gradB_far_})
+    v->resize(9 * n, 0.0);
+  for (std::size_t b = first; b < n; ++b)
+  {
+    evaluate_applied_field_at(beads, field, b);
+    far_->far_field_at(b, &B_far_[3 * b], &gradB_far_[9 * b]);
+    double B[3];
+    for (int a = 0; a < 3; ++a)
+      B[a] = B0_[3 * b + a] + B_far_[3 * b + a];
+    induced_moment(beads.radius[b], beta_[b], Ms_[b], B, &p_[3 * b]);
+    for (int a = 0; a < 3; ++a)
+      B_local_[3 * b + a] = B[a];
+  }
+  for (const std::uint32_t b : leavers)
+    for (int a = 0; a < 3; ++a)
+      p_[3 * b + a] = 0.0;
+}
+
+// The local refresh of an admission: the leavers and the newcomers count as moved (their
+// pairs' tensors, the region's dipoles, the forces of every pair touching a changed dipole).
+void InducedDipoles::solve_around(const BeadArrays &beads, std::size_t first, const std::vector<std::uint32_t> &leavers,
+                                  const AppliedFieldFunction &field, MagneticStats &stats)
+{
+  admitted_moved_.assign(leavers.begin(), leavers.end());
+  for (std::size_t b = first; b < beads.n; ++b)
+    admitted_moved_.push_back(static_cast<std::uint32_t>(b));
+  local_.select_given(admitted_moved_, beads.n);
+  local_.grow_region(beads, near_, settings_.local_region_radius);
+  const double t_tensors = omp_get_wtime();
+  reevaluate_moved_beads(beads, field);
+  const double t_sweeps = omp_get_wtime();
+  stats.time_tensors = t_sweeps - t_tensors;
+  local_.hold_region_dipoles(p_);
+  sweep_to_tolerance(beads, stats, &local_.region());
+  stats.time_sweeps = omp_get_wtime() - t_sweeps;
+  local_.select_changed(p_, settings_.local_dipole_change);
+  const double t_forces = omp_get_wtime();
+  reevaluate_local_forces(beads, stats);
+  stats.time_forces = omp_get_wtime() - t_forces;
+  stats.local_moved = local_.moved().size();
+  stats.local_region = local_.region().size();
+  stats.local_gathered = local_.gathered().size();
+  stats.pairs = local_.moved_pairs().size();
+}
+
+bool InducedDipoles::lists_current(const BeadArrays &beads) const
+{
+  const MagneticNeighbourList &list = near_.list();
+  if (!list.built() || list.particle_count() != beads.n ||
+      list.max_displacement(beads.n, beads.x, beads.y, beads.z) > 0.5 * skin_)
+    return false;
+  return !far_corrections() || correction_.list_current(beads, skin_);
+}
+
+// ---------------------------------------------------------------------------------------
 // Restart.
 
 namespace {
@@ -643,7 +761,7 @@ std::string settings_fingerprint(const MagneticSettings &s)
                    static_cast<double>(s.slab_tail_correction), static_cast<double>(s.far_field),
                    s.far_cell_diameters, static_cast<double>(s.far_order), static_cast<double>(s.far_near_reach),
                    static_cast<double>(s.far_passes), static_cast<double>(s.far_single_precision),
-                   static_cast<double>(s.defer_exchange)})
+                   static_cast<double>(s.defer_exchange), static_cast<double>(s.admit_exchange)})
     add(v);
   return f;
 }
@@ -666,6 +784,9 @@ void InducedDipoles::write_state(StateOut &out) const
   staleness_.write_state(out);
   if (tail_)
     tail_->write_state(out);
+  // The fine cells' local expansions (admit(): a newcomer's held far field).
+  static const std::vector<double> none;
+  out.put_array(far_ && far_->levels() > 0 ? far_->fine_locals() : none);
 }
 
 bool InducedDipoles::read_state(StateIn &in)
@@ -703,6 +824,10 @@ bool InducedDipoles::read_state(StateIn &in)
     }
     far_->build(n, x.data(), y.data(), z.data(), far_cell_size_);
   }
+  std::vector<double> locals;
+  in.get_array(locals);
+  if (far_ && !locals.empty())
+    far_->set_fine_locals(locals);
   return true;
 }
 

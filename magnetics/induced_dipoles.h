@@ -140,6 +140,30 @@ public:
   // must be the next call.
   void particles_changed(const std::vector<std::int32_t> &origin);
 
+  // An exchange admitted without a rebuild (MagneticSettings::admit_exchange). `beads`: the
+  // beads of the held state (indices < first, same order) followed by the newcomers (first …
+  // n−1). `leavers` (ascending, < first): beads whose particle left; from now on they are
+  // inert holes — the caller passes them with μr = 1 and no saturation (β = 0: no dipole, no
+  // force, no two-sphere correction) at their last position — until a rebuild drops them
+  // (particles_changed). The newcomers join the kept fine cells (CellMultipoleField::
+  // add_beads), the near pairs, the correction's list and the watched pairs; their far field
+  // is the held one (their fine cell's local expansion of the last evaluation); then a local
+  // refresh around the newcomers and the leavers solves the dipoles of the region (the newcomers and everything within local_region_radius of
+  // them or of a leaver) and renews the forces of every pair touching a changed dipole, as
+  // refresh_locally() does. What is held (the far field of everything else) stays held until
+  // the next compute(). Returns false and changes nothing when this cannot be done: no
+  // cell-multipole far field, the point-dipole model, nothing held (as for a local refresh),
+  // lists expired, a newcomer outside the occupied fine cells or larger than the correction's
+  // list allows, or of a β without a correction table.
+  bool admit(const BeadArrays &beads, std::size_t first, const std::vector<std::uint32_t> &leavers,
+             const AppliedFieldFunction &field, MagneticStats &stats);
+  // The near lists (and the correction's) still hold these beads and no bead moved half the
+  // skin: the next compute() keeps them (no rebuild).
+  bool lists_current(const BeadArrays &beads) const;
+  // Whether a newcomer at x (raw) could be admitted as far as the far field's cells go (an
+  // occupied fine cell); the caller keeps the others waiting.
+  bool admissible_position(const double x[3]) const { return far_ && far_->can_add(x); }
+
   // Restart (common/state_stream.h): everything a later evaluation or local refresh reads —
   // the held forces, the dipoles (the next solve's start), the fields, the near pairs and
   // their stored forces, the staleness references — so that a restarted run continues bit
@@ -182,6 +206,8 @@ private:
   std::vector<double> force_, torque_;
   std::vector<MagneticNeighbourList::Pair> spare_pairs_; // an empty pair buffer (update_cells)
   std::vector<std::uint32_t> fresh_; // beads that entered since the last compute (particles_changed)
+  std::vector<MagneticNeighbourList::Pair> admitted_pairs_; // admit(): the newcomers' near pairs
+  std::vector<std::uint32_t> admitted_moved_;                // admit(): newcomers and leavers
   bool computed_ = false;
   LocalFallback local_fallback_ = LocalFallback::none;
   bool zero_field_ = false; // the last compute() found no applied field at any bead
@@ -213,6 +239,13 @@ private:
   // Bead b's total force and torque from its dipole, the fields and the stored pair forces.
   void gather_bead(std::size_t b);
   void remember_evaluation(const BeadArrays &beads, double time);
+
+  // admit(), step by step.
+  bool can_admit(const BeadArrays &beads, std::size_t first) const;
+  void append_bead_state(const BeadArrays &beads, std::size_t first, const std::vector<std::uint32_t> &leavers,
+                         const AppliedFieldFunction &field);
+  void solve_around(const BeadArrays &beads, std::size_t first, const std::vector<std::uint32_t> &leavers,
+                    const AppliedFieldFunction &field, MagneticStats &stats);
 
   // refresh_locally(), step by step.
   bool can_refresh_locally(const BeadArrays &beads) const;

@@ -41,6 +41,14 @@ bool LocalRefresh::select_moved(const BeadArrays &beads, const StalenessTracker 
   return due;
 }
 
+void LocalRefresh::select_given(const std::vector<std::uint32_t> &beads, std::size_t n)
+{
+  moved_.clear();
+  bead_mark_.assign(n, 0);
+  for (const std::uint32_t b : beads)
+    add_once(is_moved, moved_, b);
+}
+
 void LocalRefresh::grow_region(const BeadArrays &beads, const NearPairs &near, double region_radius)
 {
   const auto &pairs = near.pairs();

@@ -36,6 +36,9 @@ public:
   // 1. The moved beads; false when nothing is past its limit (no refresh due).
   bool select_moved(const BeadArrays &beads, const StalenessTracker &staleness,
                     const MagneticSettings &settings);
+  // 1'. The moved beads given (an admission: the newcomers and the leavers), in ascending
+  // order, for a refresh of n beads.
+  void select_given(const std::vector<std::uint32_t> &beads, std::size_t n);
   // 2. The region around the moved beads (current positions), sorted by bead.
   void grow_region(const BeadArrays &beads, const NearPairs &near, double region_radius);
   // A region larger than `limit` of the beads (and than 64 beads: a small region is always

@@ -209,6 +209,29 @@ void MagneticNeighbourList::clear()
 
 void MagneticNeighbourList::build_incidence(std::size_t n, const double *const coord[3])
 {
+  build_pair_incidence(n);
+  x_ref_.resize(3 * n);
+  for (std::size_t b = 0; b < n; ++b)
+    for (int d = 0; d < 3; ++d)
+      x_ref_[3 * b + d] = coord[d][b];
+  built_ = true;
+}
+
+void MagneticNeighbourList::append(std::size_t n, const double *x, const double *y, const double *z,
+                                   const std::vector<Pair> &more)
+{
+  const std::size_t first = particle_count();
+  pairs_.insert(pairs_.end(), more.begin(), more.end());
+  build_pair_incidence(n);
+  const double *coord[3] = {x, y, z};
+  x_ref_.resize(3 * n);
+  for (std::size_t b = first; b < n; ++b)
+    for (int d = 0; d < 3; ++d)
+      x_ref_[3 * b + d] = coord[d][b];
+}
+
+void MagneticNeighbourList::build_pair_incidence(std::size_t n)
+{
   // Incidence (CSR), in increasing pair order for every bead.
   incident_begin_.assign(n + 1, 0);
   for (const Pair &p : pairs_)
@@ -220,23 +243,16 @@ void MagneticNeighbourList::build_incidence(std::size_t n, const double *const c
     incident_begin_[b + 1] += incident_begin_[b];
   incident_pair_.resize(2 * pairs_.size());
   incident_first_.resize(2 * pairs_.size());
+  std::vector<std::size_t> &fill = fill_;
+  fill.assign(incident_begin_.begin(), incident_begin_.end() - 1);
+  for (std::size_t k = 0; k < pairs_.size(); ++k)
   {
-    std::vector<std::size_t> fill(incident_begin_.begin(), incident_begin_.end() - 1);
-    for (std::size_t k = 0; k < pairs_.size(); ++k)
-    {
-      const Pair &p = pairs_[k];
-      incident_pair_[fill[p.i]] = static_cast<std::uint32_t>(k);
-      incident_first_[fill[p.i]++] = 1;
-      incident_pair_[fill[p.j]] = static_cast<std::uint32_t>(k);
-      incident_first_[fill[p.j]++] = 0;
-    }
+    const Pair &p = pairs_[k];
+    incident_pair_[fill[p.i]] = static_cast<std::uint32_t>(k);
+    incident_first_[fill[p.i]++] = 1;
+    incident_pair_[fill[p.j]] = static_cast<std::uint32_t>(k);
+    incident_first_[fill[p.j]++] = 0;
   }
-
-  x_ref_.resize(3 * n);
-  for (std::size_t b = 0; b < n; ++b)
-    for (int d = 0; d < 3; ++d)
-      x_ref_[3 * b + d] = coord[d][b];
-  built_ = true;
 }
 
 double MagneticNeighbourList::max_displacement(std::size_t n, const double *x,

@@ -65,6 +65,12 @@ public:
   void set_pairs(std::size_t n, const double *x, const double *y, const double *z,
                  const std::array<double, 3> &box, double list_radius, std::vector<Pair> &pairs);
 
+  // Beads appended (indices particle_count() … n−1, positions x, y, z of all n) with their
+  // pairs `more` (each touching an appended bead): the pairs join at the end, the incidence
+  // is rebuilt, and the appended beads' positions become their reference; the other beads
+  // keep theirs (their displacement still counts from the build).
+  void append(std::size_t n, const double *x, const double *y, const double *z, const std::vector<Pair> &more);
+
   // Forgets the pairs (the bead indices they refer to changed) but keeps the memory: the
   // next build fills the same buffers. built() is false afterwards.
   void clear();
@@ -151,7 +157,9 @@ private:
   std::vector<std::uint32_t> incident_pair_;
   std::vector<std::uint8_t> incident_first_;
 
+  std::vector<std::size_t> fill_; // build_pair_incidence(): scratch
   void build_incidence(std::size_t n, const double *const coord[3]);
+  void build_pair_incidence(std::size_t n);
 };
 
 } // namespace magbrush::magnetics

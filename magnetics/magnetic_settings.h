@@ -130,6 +130,15 @@ struct MagneticSettings
   // lists at every exchange, even an empty one (the behaviour before; docs/magnetics.md
   // "Particle exchange").
   bool defer_exchange = true;
+  // With defer_exchange and the cell-multipole far field: admit the exchange at the next
+  // step without a rebuild (InducedDipoles::admit): the newcomers join the kept fine cells
+  // and pair lists, the leavers stay as inert holes (no dipole, no force) until the lists
+  // are rebuilt anyway, and the newcomers' dipoles and their neighbourhood's (and the
+  // leavers' neighbours') are solved by a local refresh. Where that cannot be done (a
+  // newcomer in an empty fine cell, expired lists, no far field) the exchange waits as
+  // above. docs/magnetics.md "Particle exchange" (regulation cell at 16 ms: as accurate as
+  // evaluating every exchange, at the deferral's cost).
+  bool admit_exchange = true;
 
   // `corrected`: the exact-minus-dipole pair correction is applied fully for centre
   // distances below switch_begin (in mean pair radii, 2 = touching) and blended smoothly to

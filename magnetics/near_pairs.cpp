@@ -49,6 +49,19 @@ void NearPairs::evaluate_tensor(const BeadArrays &beads, std::size_t k)
     tensor_[k] = {0, 0, 0, 0, 0, 0};
 }
 
+void NearPairs::appended(const BeadArrays &beads, std::size_t first_pair)
+{
+  const bool rows = !row_entry_.empty() && row_entry_.size() == 2 * first_pair;
+  const std::size_t np = list_.pairs().size();
+  tensor_.resize(np);
+  r_.resize(3 * np);
+  active_.resize(np);
+  for (std::size_t k = first_pair; k < np; ++k)
+    evaluate_tensor(beads, k);
+  if (rows)
+    build_rows();
+}
+
 void NearPairs::update_rows(std::size_t k)
 {
   if (row_entry_.size() != 2 * list_.pairs().size())

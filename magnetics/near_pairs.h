@@ -39,6 +39,10 @@ public:
   void evaluate_tensor(const BeadArrays &beads, std::size_t k);
   void update_rows(std::size_t k);
 
+  // Beads and pairs were appended to the list (MagneticNeighbourList::append): the tensors
+  // of the pairs from `first_pair` on are evaluated, and the rows rebuilt if there were any.
+  void appended(const BeadArrays &beads, std::size_t first_pair);
+
   // Builds the per-bead rows from the tensors (the sweeps of the cell-multipole path).
   void build_rows();
 

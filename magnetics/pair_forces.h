@@ -34,6 +34,8 @@ public:
   {
     add_incident_pair_forces(near.list(), force_, b, F);
   }
+  // Pairs were appended to the list: their stored forces start at zero (evaluate() fills them).
+  void resize(std::size_t pairs) { force_.resize(3 * pairs, 0.0); }
   // The applied field was scaled by `ratio`: forces by ratio².
   void scale(double ratio2);
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace magbrush::magnetics {
 
@@ -46,20 +47,52 @@ void StalenessTracker::watch_close_pairs(const BeadArrays &beads, const NearPair
   close_of_pair_.assign(pairs.size(), -1);
   min_radius_ = *std::min_element(beads.radius, beads.radius + beads.n);
   max_radius_ = *std::max_element(beads.radius, beads.radius + beads.n);
-  const double f = settings_.staleness_fraction;
   for (std::size_t k = 0; k < pairs.size(); ++k)
+    watch_pair(beads, near, k, skin);
+}
+
+void StalenessTracker::watch_pair(const BeadArrays &beads, const NearPairs &near, std::size_t k, double skin)
+{
+  const auto &pair = near.pairs()[k];
+  // (A bead that does not magnetise, such as an admitted leaver's inert hole, moves no force.)
+  if (!near.active(k) || (beads.mu_r && (beads.mu_r[pair.i] == 1.0 || beads.mu_r[pair.j] == 1.0)))
+    return;
+  const double f = settings_.staleness_fraction;
+  const double a = 0.5 * (beads.radius[pair.i] + beads.radius[pair.j]);
+  const double reach = settings_.relative_check_radius * a + skin;
+  const double *r = near.r(k);
+  if (r[0] * r[0] + r[1] * r[1] + r[2] * r[2] >= reach * reach)
+    return;
+  close_of_pair_[k] = static_cast<std::int32_t>(close_.size());
+  close_.push_back({pair.i, pair.j, {0, 0, 0}, f * f * a * a});
+  pair_reevaluated(near, k);
+}
+
+void StalenessTracker::admit(const BeadArrays &beads, std::size_t first, const NearPairs &near,
+                             std::size_t first_pair, double skin, const std::vector<std::uint32_t> &inert)
+{
+  limit2_.resize(beads.n);
+  inv_radius2_.resize(beads.n);
+  for (std::size_t b = first; b < beads.n; ++b)
   {
-    if (!near.active(k))
-      continue;
-    const double a = 0.5 * (beads.radius[pairs[k].i] + beads.radius[pairs[k].j]);
-    const double reach = settings_.relative_check_radius * a + skin;
-    const double *r = near.r(k);
-    if (r[0] * r[0] + r[1] * r[1] + r[2] * r[2] >= reach * reach)
-      continue;
-    close_of_pair_[k] = static_cast<std::int32_t>(close_.size());
-    close_.push_back({pairs[k].i, pairs[k].j, {0, 0, 0}, f * f * a * a});
-    pair_reevaluated(near, k);
+    const double limit = move_limit(beads, b);
+    limit2_[b] = limit * limit;
+    inv_radius2_[b] = 1.0 / (beads.radius[b] * beads.radius[b]);
+    evaluated(beads, b);
+    min_radius_ = std::min(min_radius_, beads.radius[b]);
+    max_radius_ = std::max(max_radius_, beads.radius[b]);
   }
+  if (settings_.staleness_mode != StalenessMode::relative || close_of_pair_.size() != first_pair)
+    return;
+  const auto &begin = near.list().incident_begin();
+  const auto &pair_of = near.list().incident_pair();
+  for (const std::uint32_t b : inert)
+    for (std::size_t q = begin[b]; q < begin[b + 1]; ++q)
+      if (close_of_pair_[pair_of[q]] >= 0)
+        close_[static_cast<std::size_t>(close_of_pair_[pair_of[q]])].limit2 = std::numeric_limits<double>::infinity();
+  close_of_pair_.resize(near.pairs().size(), -1);
+  for (std::size_t k = first_pair; k < near.pairs().size(); ++k)
+    watch_pair(beads, near, k, skin);
 }
 
 void StalenessTracker::pair_reevaluated(const NearPairs &near, std::size_t k)

@@ -64,6 +64,12 @@ public:
   // relative: watch the near pairs that can come within relative_check_radius mean radii
   // before the list expires (`skin` [m]).
   void watch_close_pairs(const BeadArrays &beads, const NearPairs &near, double skin);
+  // An admission: beads first … n−1 appended (evaluated now: reference positions and limits)
+  // with the near pairs from `first_pair` on (relative: watched like watch_close_pairs());
+  // the `inert` beads (leavers kept as holes) no longer move anything: their watched pairs
+  // are never stale.
+  void admit(const BeadArrays &beads, std::size_t first, const NearPairs &near, std::size_t first_pair,
+             double skin, const std::vector<std::uint32_t> &inert);
   // Near pair k's tensor was evaluated again: its drift restarts from the current vector.
   void pair_reevaluated(const NearPairs &near, std::size_t k);
 
@@ -106,6 +112,7 @@ private:
   // Bead b's limit on its absolute move [m]: staleness_fraction × radius, times
   // absolute_factor in the relative mode.
   double move_limit(const BeadArrays &beads, std::size_t b) const;
+  void watch_pair(const BeadArrays &beads, const NearPairs &near, std::size_t k, double skin);
   std::size_t count_stale_pairs(const BeadArrays &beads) const;
 };
 

@@ -29,7 +29,10 @@ TwoSphereCorrection::TwoSphereCorrection(const MagneticSettings &settings, const
 
 void TwoSphereCorrection::prepare_tables(const std::vector<double> &beta)
 {
-  std::vector<double> distinct(beta.begin(), beta.end());
+  std::vector<double> distinct;
+  for (const double b : beta)
+    if (b != 0.0) // (inert holes: no correction, no table)
+      distinct.push_back(b);
   std::sort(distinct.begin(), distinct.end());
   distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
   for (std::size_t a = 0; a < distinct.size(); ++a)
@@ -73,7 +76,8 @@ bool TwoSphereCorrection::add(const InducedState &s, std::uint32_t i, std::uint3
   const double a = 0.5 * (s.beads.radius[i] + s.beads.radius[j]);
   const double dist = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
   const double D = dist / a;
-  if (D >= s1)
+  // A bead that does not magnetise (β = 0: an inert hole left by a leaver) induces nothing.
+  if (D >= s1 || s.beta[i] == 0.0 || s.beta[j] == 0.0)
     return false;
   const TwoSphereTable *tab = table(s.beta[i], s.beta[j]);
   // The field the pair sits in: the local field at each bead minus the partner's own
@@ -123,21 +127,101 @@ void TwoSphereCorrection::refresh_list(const BeadArrays &beads)
   }
   const double skin = settings_.skin_fraction * 2.0 * sum / beads.n;
   const double radius = settings_.switch_end * largest + skin;
+  // The list holds every pair within its reach with the build's skin, and stays good while
+  // no bead moved half that skin and no bead is larger than the build's largest. (After an
+  // admission the mean radius, hence `skin`, differs a little from the build's; otherwise
+  // skin_ = skin and the radius is the list's.)
   const bool stale = !list_.built() || list_.particle_count() != beads.n || list_.box() != box_ ||
-                     std::abs(list_.list_radius() - radius) > 1e-12 * radius ||
-                     list_.max_displacement(beads.n, beads.x, beads.y, beads.z) > 0.5 * skin;
+                     settings_.switch_end * largest + skin_ > list_.list_radius() * (1.0 + 1e-12) ||
+                     list_.max_displacement(beads.n, beads.x, beads.y, beads.z) > 0.5 * skin_;
   // Each pair is listed only within its own reach, switch_end × its mean radius + skin: with
   // ±10 % beads the largest radius sets a search radius whose sphere holds ~3× the pairs
   // that can ever be corrected (the rest cost a force evaluation, a gather and a local
   // refresh's attention each, for a zero force).
   if (stale)
+  {
     list_.build(beads.n, beads.x, beads.y, beads.z, box_, radius, {beads.radius, settings_.switch_end, skin});
+    skin_ = skin;
+  }
+}
+
+bool TwoSphereCorrection::can_admit(const BeadArrays &beads, std::size_t first) const
+{
+  const std::size_t n = beads.n;
+  if (!list_.built() || list_.particle_count() != first || first == 0 || first >= n)
+    return false;
+  const double R = list_.list_radius();
+  double largest = 0.0;
+  for (std::size_t b = 0; b < n; ++b)
+    largest = std::max(largest, beads.radius[b]);
+  if (settings_.switch_end * largest + skin_ > R * (1.0 + 1e-12))
+    return false;
+  for (double L : box_)
+    if (L > 0.0 && R >= L)
+      return false;
+  return true;
+}
+
+bool TwoSphereCorrection::admit(const BeadArrays &beads, std::size_t first)
+{
+  if (!can_admit(beads, first))
+    return false;
+  const std::size_t n = beads.n;
+  // Every image shift along the periodic axes within one period.
+  const double *x[3] = {beads.x, beads.y, beads.z};
+  admitted_.clear();
+  for (std::size_t c = first; c < n; ++c)
+    for (std::size_t j = 0; j < n; ++j)
+    {
+      if (j < c && j >= first)
+        continue; // (a pair of two newcomers: listed from the lower one)
+      for (int sx = -1; sx <= 1; ++sx)
+        for (int sy = -1; sy <= 1; ++sy)
+          for (int sz = -1; sz <= 1; ++sz)
+          {
+            const int s[3] = {sx, sy, sz};
+            double shift[3], r[3];
+            bool valid = true;
+            for (int d = 0; d < 3; ++d)
+            {
+              valid = valid && (s[d] == 0 || box_[d] > 0.0);
+              shift[d] = s[d] * box_[d];
+              r[d] = x[d][j] - x[d][c] + shift[d]; // from the newcomer to j's image
+            }
+            const bool zero = s[0] == 0 && s[1] == 0 && s[2] == 0;
+            const bool positive = sx > 0 || (sx == 0 && (sy > 0 || (sy == 0 && sz > 0)));
+            if (!valid || (j == c && (zero || !positive)))
+              continue;
+            const double reach = settings_.switch_end * 0.5 * (beads.radius[c] + beads.radius[j]) + skin_;
+            if (r[0] * r[0] + r[1] * r[1] + r[2] * r[2] >= reach * reach)
+              continue;
+            MagneticNeighbourList::Pair p;
+            if (j < first) // r = x_c − x_j − shift: the pair seen from the older bead
+            {
+              p.i = static_cast<std::uint32_t>(j);
+              p.j = static_cast<std::uint32_t>(c);
+              for (int d = 0; d < 3; ++d)
+                p.shift[d] = -shift[d];
+            }
+            else
+            {
+              p.i = static_cast<std::uint32_t>(c);
+              p.j = static_cast<std::uint32_t>(j);
+              for (int d = 0; d < 3; ++d)
+                p.shift[d] = shift[d];
+            }
+            admitted_.push_back(p);
+          }
+    }
+  list_.append(n, beads.x, beads.y, beads.z, admitted_);
+  force_.resize(3 * list_.pairs().size(), 0.0);
+  return true;
 }
 
 bool TwoSphereCorrection::list_current(const BeadArrays &beads, double skin) const
 {
   return list_.built() && list_.particle_count() == beads.n &&
-         !(list_.max_displacement(beads.n, beads.x, beads.y, beads.z) > 0.5 * skin);
+         !(list_.max_displacement(beads.n, beads.x, beads.y, beads.z) > 0.5 * std::min(skin, skin_));
 }
 
 std::size_t TwoSphereCorrection::evaluate_list_forces(const InducedState &s)
@@ -183,12 +267,14 @@ void TwoSphereCorrection::write_state(StateOut &out) const
 {
   list_.write_state(out);
   out.put_array(force_);
+  out.put(skin_);
 }
 
 void TwoSphereCorrection::read_state(StateIn &in)
 {
   list_.read_state(in);
   in.get_array(force_);
+  skin_ = in.get<double>();
 }
 
 } // namespace magbrush::magnetics

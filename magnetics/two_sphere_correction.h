@@ -63,6 +63,13 @@ public:
 
   // The own pair list (cell-multipole far field): rebuilt when stale, like a Verlet list.
   void refresh_list(const BeadArrays &beads);
+  // Beads appended (indices first … n−1): their pairs within reach join the list (a
+  // brute-force search over all beads and the nearest periodic images: a handful of
+  // newcomers), their forces start at zero. False, and nothing changed, when the list is not
+  // current or its radius does not cover the newcomers (larger beads, or a radius beyond a
+  // period: images farther than the next one).
+  bool can_admit(const BeadArrays &beads, std::size_t first) const;
+  bool admit(const BeadArrays &beads, std::size_t first);
   // The list still holds every pair within switch_end (no bead moved half the skin).
   bool list_current(const BeadArrays &beads, double skin) const;
   const MagneticNeighbourList &list() const { return list_; }
@@ -87,6 +94,8 @@ private:
   std::map<double, std::shared_ptr<const TwoSphereTable>> tables_;
   MagneticNeighbourList list_;
   std::vector<double> force_; // per listed pair: the force on its j bead
+  double skin_ = 0.0;         // the skin the list was built with [m]
+  std::vector<MagneticNeighbourList::Pair> admitted_; // admit(): scratch
 
   const TwoSphereTable *table(double beta_i, double beta_j) const;
 };

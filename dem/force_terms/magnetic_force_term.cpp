@@ -90,6 +90,7 @@ void MagneticForceTerm::select_carriers(const dem::ParticleState &state)
   dipoles_.reset_dipoles();
   newcomers_.clear();
   left_ = 0;
+  holes_ = 0;
   pending_ = false;
 }
 
@@ -196,17 +197,22 @@ void MagneticForceTerm::add_forces(const dem::ParticleState &state, dem::ForceBu
   else if (carrier_.size() == left_ || newcomers_.size() > kMaxWaiting)
     apply_pending(state); // nothing held to wait with (the first carriers of an inflow), or
                           // so many newcomers that their per-step sums would cost more
-  const std::size_t n = carrier_.size();
-  if (n == 0)
+  if (carrier_.empty())
     return;
   gather_positions(state);
-  BeadArrays beads = bead_arrays();
   const double ramp = field_.ramp(t);
-  // A full evaluation is due: the exchanges held back since the last one join it first.
+  const MagneticSettings &settings = dipoles_.settings();
+  if (pending_ && !must_refresh_ && settings.admit_exchange && settings.far_field == FarField::cell_multipole &&
+      ramp == held_ramp_)
+    admit_pending(state, t);
+  BeadArrays beads = bead_arrays();
+  // A full evaluation is due: the exchanges held back since the last one join it first, and
+  // so do the holes of admitted leavers when the lists are rebuilt anyway (or are many).
   auto full = [&]() {
-    if (pending_)
+    const bool holes = left_ > 0 && (8 * left_ > carrier_.size() || !dipoles_.lists_current(beads));
+    if (pending_ || holes)
     {
-      ++counts_.set_changed;
+      counts_.set_changed += pending_;
       apply_pending(state);
       beads = bead_arrays();
     }
@@ -299,6 +305,82 @@ void MagneticForceTerm::add_forces(const dem::ParticleState &state, dem::ForceBu
       forces.ty[i] += scale * ty_[k];
       forces.tz[i] += scale * tz_[k];
     }
+}
+
+// MagneticSettings::admit_exchange: the exchanges since the last step join the held state
+// without a full evaluation (InducedDipoles::admit). The carriers that left become inert
+// holes in place (μr = 1, no saturation: no dipole, no force; still kLeft, at their last
+// position) until a full evaluation that rebuilds the lists drops them (apply_pending); the
+// carriers among the newcomers are appended, in ascending engine index. False when the
+// magnetics cannot admit them now: everything is as before and they keep waiting.
+bool MagneticForceTerm::admit_pending(const dem::ParticleState &state, double t)
+{
+  const std::size_t first = carrier_.size();
+  leavers_.clear();
+  leaver_mu_r_.clear();
+  leaver_Ms_.clear();
+  for (std::size_t k = 0; k < first; ++k)
+    if (carrier_[k] == kLeft && mu_r_[k] != 1.0) // (a hole already has μr = 1)
+    {
+      leavers_.push_back(static_cast<std::uint32_t>(k));
+      leaver_mu_r_.push_back(mu_r_[k]);
+      leaver_Ms_.push_back(Ms_[k]);
+      mu_r_[k] = 1.0;
+      Ms_[k] = 0.0;
+    }
+  // The carriers among the newcomers that land in an occupied fine cell join now; the others
+  // (entering empty space, e.g. above the pile: nobody near to get them wrong) keep waiting.
+  std::sort(newcomers_.begin(), newcomers_.end());
+  still_waiting_.clear();
+  for (std::uint32_t i : newcomers_)
+  {
+    const std::size_t species = static_cast<std::size_t>(state.species[i]);
+    if (species >= species_.size() || !species_[species].carrier)
+      continue;
+    const double x[3] = {state.x[i], state.y[i], state.z[i]};
+    if (!dipoles_.admissible_position(x))
+    {
+      still_waiting_.push_back(i);
+      continue;
+    }
+    carrier_.push_back(i);
+    x_.push_back(state.x[i]);
+    y_.push_back(state.y[i]);
+    z_.push_back(state.z[i]);
+    radius_.push_back(state.radius[i]);
+    mu_r_.push_back(species_[species].mu_r);
+    Ms_.push_back(species_[species].saturation_magnetisation);
+  }
+  if (leavers_.empty() && carrier_.size() == first) // (no carrier came or went that can join)
+  {
+    newcomers_.swap(still_waiting_);
+    pending_ = !newcomers_.empty();
+    return true;
+  }
+  const double t0 = omp_get_wtime();
+  const bool admitted = dipoles_.admit(bead_arrays(), first, leavers_, lookup_at(t), admit_stats_);
+  counts_.admit_s += omp_get_wtime() - t0;
+  if (!admitted)
+  {
+    for (auto *v : {&x_, &y_, &z_, &radius_, &mu_r_, &Ms_})
+      v->resize(first);
+    carrier_.resize(first);
+    for (std::size_t m = 0; m < leavers_.size(); ++m)
+    {
+      mu_r_[leavers_[m]] = leaver_mu_r_[m];
+      Ms_[leavers_[m]] = leaver_Ms_[m];
+    }
+    return false;
+  }
+  ++counts_.admitted;
+  holes_ += leavers_.size();
+  counts_.admit_region_beads += static_cast<long>(admit_stats_.local_region);
+  newcomers_.swap(still_waiting_);
+  pending_ = !newcomers_.empty();
+  for (auto *v : {&fx_, &fy_, &fz_, &tx_, &ty_, &tz_})
+    v->resize(carrier_.size());
+  take_held_forces();
+  return true;
 }
 
 // The carriers waiting for admission (defer_exchange), every step: each one's dipole induced
@@ -547,7 +629,7 @@ void MagneticForceTerm::defer_change(const std::vector<std::int32_t> &origin)
       i = to < 0 ? kLeft : static_cast<std::uint32_t>(to);
     }
   state_size_ = origin.size();
-  pending_ = left_ > 0 || !newcomers_.empty();
+  pending_ = left_ > holes_ || !newcomers_.empty();
 }
 
 // Before a full evaluation: the frozen sources go, the newcomers join (as particles_changed
@@ -571,6 +653,7 @@ void MagneticForceTerm::apply_pending(const dem::ParticleState &state)
   for (auto *v : {&x_, &y_, &z_, &radius_, &mu_r_, &Ms_})
     v->resize(kept);
   left_ = 0;
+  holes_ = 0;
   pending_ = false;
   admit_newcomers(state);
   newcomers_.clear();
@@ -629,6 +712,9 @@ void MagneticForceTerm::write_state(dem::CheckpointWriter &out) const
   block.put(counts_.moved_lists);
   block.put(counts_.moved_region);
   block.put(counts_.set_changed);
+  block.put(counts_.admitted); // (appended later again: a block without them reads as 0)
+  block.put(counts_.admit_s);
+  block.put(counts_.admit_region_beads);
   out.put_string(block.bytes());
 }
 
@@ -677,6 +763,12 @@ void MagneticForceTerm::read_state(dem::CheckpointReader &in)
     counts.moved_region = block.get<long>();
     counts.set_changed = block.get<long>();
   }
+  if (block.remaining() > 0)
+  {
+    counts.admitted = block.get<long>();
+    counts.admit_s = block.get<double>();
+    counts.admit_region_beads = block.get<long>();
+  }
   state_size_ = static_cast<std::size_t>(state_size);
   carrier_ = std::move(carrier);
   newcomers_ = std::move(newcomers);
@@ -685,6 +777,10 @@ void MagneticForceTerm::read_state(dem::CheckpointReader &in)
   std::vector<double> *mine[12] = {&x_, &y_, &z_, &radius_, &mu_r_, &Ms_, &fx_, &fy_, &fz_, &tx_, &ty_, &tz_};
   for (int k = 0; k < 12; ++k)
     *mine[k] = std::move(v[k]);
+  holes_ = 0; // the admitted leavers (inert, μr = 1): only admit_exchange makes them
+  if (dipoles_.settings().admit_exchange)
+    for (std::size_t k = 0; k < carrier_.size(); ++k)
+      holes_ += carrier_[k] == kLeft && mu_r_[k] == 1.0;
   must_refresh_ = must_refresh;
   held_ramp_ = held_ramp;
   last_scale_ = last_scale;

@@ -12,7 +12,10 @@
 //     the applied field ramps (linear beads: p ∝ B, F ∝ B², exact).
 //
 // Particles entering or leaving (the inflow / outflow exchange) fire no evaluation of their
-// own (MagneticSettings::defer_exchange): they join the next full one; meanwhile the leavers
+// own (MagneticSettings::defer_exchange): with admit_exchange they are admitted at the next
+// step into the held state (the leavers become inert holes until the lists are rebuilt, the
+// newcomers join the kept cells and lists, a local refresh solves around both); otherwise,
+// or where that cannot be done, they join the next full evaluation, meanwhile the leavers
 // stay frozen sources and the newcomers feel the field and their held neighbours.
 //
 // The compact carrier order is the magnetics' own, fixed when the carriers are selected: the
@@ -65,6 +68,7 @@ public:
   // Statistics of the last full evaluation, and of the last local refresh.
   const MagneticStats &last_stats() const { return stats_; }
   const MagneticStats &last_local_stats() const { return local_stats_; }
+  const MagneticStats &last_admission_stats() const { return admit_stats_; }
   // A disabled term adds nothing (benchmarks compare settings in one system).
   void set_enabled(bool enabled) { enabled_ = enabled; }
   // Full evaluations (compute) and local refreshes so far.
@@ -96,6 +100,11 @@ public:
     // Full evaluations that took in particles entered or left (inflow, outflow): of `first`
     // without MagneticSettings::defer_exchange (one per exchange), of any cause with it.
     long set_changed = 0;
+    // MagneticSettings::admit_exchange: exchanges admitted at the next step without a full
+    // evaluation (InducedDipoles::admit), their wall time [s] and the beads solved again.
+    long admitted = 0;
+    double admit_s = 0.0;
+    long admit_region_beads = 0;
   };
   const RefreshCounts &refresh_counts() const { return counts_; }
   const InducedDipoles &dipoles() const { return dipoles_; }
@@ -115,7 +124,7 @@ private:
   InducedDipoles dipoles_;
   AppliedMagneticField field_;
   std::array<double, 3> box_;
-  MagneticStats stats_, local_stats_;
+  MagneticStats stats_, local_stats_, admit_stats_;
   long evaluations_ = 0, local_refreshes_ = 0;
   RefreshCounts counts_;
 
@@ -133,6 +142,7 @@ private:
   // evaluation compacts the set and admits the newcomers (`pending_`).
   static constexpr std::uint32_t kLeft = 0xffffffffu;
   std::size_t left_ = 0;
+  std::size_t holes_ = 0; // of left_: admitted leavers, inert holes (admit_exchange)
   bool pending_ = false;
   // More newcomers than this are admitted at once (each waiting one costs a sum over all
   // carriers per step).
@@ -161,6 +171,10 @@ private:
   void admit_newcomers(const dem::ParticleState &state);
   bool follow_exchange(const std::vector<std::int32_t> &origin);
   void defer_change(const std::vector<std::int32_t> &origin);
+  bool admit_pending(const dem::ParticleState &state, double t);
+  std::vector<std::uint32_t> leavers_; // admit_pending(): the carriers that left since the last one
+  std::vector<std::uint32_t> still_waiting_; // admit_pending(): newcomers in empty fine cells
+  std::vector<double> leaver_mu_r_, leaver_Ms_; // (their materials, should the admission fail)
   void add_waiting_forces(const dem::ParticleState &state, dem::ForceBuffers &forces, double t);
   void add_waiting(dem::ForceBuffers &forces, std::uint32_t i, double fx, double fy, double fz);
   void apply_pending(const dem::ParticleState &state);

@@ -202,7 +202,8 @@ ModeResult run_mode(Case c, const std::string &mode, const std::string &restart,
 {
   // A mode may carry variants of knobs without a case key, side by side in the same run:
   // "relative+R1+S0.6" = relative with local_region_limit 1 and the magnetic lists' skin 0.6
-  // diameters; "+X0" = defer_exchange off (a full evaluation at every particle exchange).
+  // diameters; "+X0" = defer_exchange off (a full evaluation at every particle exchange);
+  // "+A1" / "+A0" = admit_exchange on / off (admission without a rebuild at the next step).
   const std::vector<std::string> parts = split(mode, '+');
   c.dem.magnetic_staleness_mode = parts[0];
   dem::RunOptions options;
@@ -238,6 +239,8 @@ ModeResult run_mode(Case c, const std::string &mode, const std::string &restart,
       settings.skin_fraction = v;
     else if (parts[k][0] == 'X')
       settings.defer_exchange = v != 0.0;
+    else if (parts[k][0] == 'A')
+      settings.admit_exchange = v != 0.0;
     else
       throw std::runtime_error("unknown mode variant " + parts[k]);
   }
@@ -290,6 +293,10 @@ void print(const char *title, const char *wall_name, const std::vector<ModeResul
   for (const ModeResult &r : results)
     std::printf("| %s | %ld | %ld | %ld | %ld / %ld | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f |\n", r.mode.c_str(), r.full, r.counts.rebuilds,
                 r.counts.set_changed, r.counts.moved_lists, r.counts.moved_region, r.counts.cold_s, r.counts.lists_s, r.counts.tensors_s, r.counts.far_s, r.counts.sweeps_s, r.counts.forces_s);
+  std::printf("\nExchanges admitted without a full evaluation (admit_exchange):\n\n| staleness mode | admissions | wall [s] | mean region |\n|---|---|---|---|\n");
+  for (const ModeResult &r : results)
+    std::printf("| %s | %ld | %.2f | %.0f |\n", r.mode.c_str(), r.counts.admitted, r.counts.admit_s,
+                r.counts.admitted ? double(r.counts.admit_region_beads) / r.counts.admitted : 0.0);
   std::printf("\n(%ld samples per mode over %.3g ms)\n", results.empty() ? 0L : results[0].samples,
               results.empty() ? 0.0 : results[0].simulated_ms);
   std::fflush(stdout);

@@ -8,6 +8,8 @@
 // neighbour list, contacts, integration and output (one HDF5 snapshot every 100 steps), the
 // parallel speed-up, and the memory per particle including the contact history.
 //   bench_dem_packing [steps [max_threads [repeats]]]   (default 300 2 1)
+// BENCH_SIDES=38 (or 24, or 24,38: the default) runs only those lattice sizes, e.g. to profile
+// one of them alone.
 // The machine may be shared: each row also gives the median rate over 10-step windows (a
 // preempted window does not pull it down), the 1-minute load average, and the CPU time of the
 // busiest thread. The "CPU speed-up" (1-thread CPU time / busiest thread's CPU time with more
@@ -218,6 +220,24 @@ Result run(int per_side, int threads, int steps)
   return r;
 }
 
+// The lattice sizes (particles per side) to run: BENCH_SIDES="24,38" by default.
+std::vector<int> bench_sides()
+{
+  std::vector<int> sides;
+  const char *env = std::getenv("BENCH_SIDES");
+  for (const char *c = env ? env : "24,38"; *c;)
+  {
+    char *end = nullptr;
+    const long v = std::strtol(c, &end, 10);
+    if (end == c)
+      break;
+    if (v > 0)
+      sides.push_back(static_cast<int>(v));
+    c = *end == ',' ? end + 1 : end;
+  }
+  return sides;
+}
+
 } // namespace
 
 int main(int argc, char **argv)
@@ -241,7 +261,7 @@ int main(int argc, char **argv)
   // rate[(N, threads)] and speed-up[(N, threads)] over the repeats
   std::map<std::pair<int, int>, std::vector<double>> rates, window_rates, speedups, cpu_speedups, loads;
   for (int rep = 0; rep < repeats; ++rep)
-    for (int per_side : {24, 38})
+    for (int per_side : bench_sides())
     {
       double single = 0, single_cpu = 0;
       for (int threads = 1; threads <= max_threads; ++threads)
@@ -291,7 +311,7 @@ int main(int argc, char **argv)
     std::printf("\n2-thread speed-up from interleaved windows (one system, 10 steps on 1 thread, then 10 on 2, "
                 "%d steps each; robust against a slow spell of a shared host):\n%8s %22s %26s\n",
                 steps, "N", "sum(t1)/sum(t2)", "median of window ratios");
-    for (int per_side : {24, 38})
+    for (int per_side : bench_sides())
     {
       const auto [ratio, med] = interleaved_speedup(per_side, steps);
       std::printf("%8d %22.2f %26.2f\n", per_side * per_side * per_side, ratio, med);

@@ -18,6 +18,7 @@
 // every configuration runs `repeats` times (1 and 2 threads back to back, so that the
 // speed-up compares runs under the same load) and a summary gives medians and ranges.
 #include "dem/dem_system.h"
+#include "dem/huge_page_heap.h"
 #include "dem/openmp_waiting.h"
 #include "dem/snapshot_writer.h"
 #include "tests/test_temp_dir.h"
@@ -242,9 +243,12 @@ std::vector<int> bench_sides()
 
 int main(int argc, char **argv)
 {
-  // The OpenMP runtime reads its wait policy once, at start-up: choose it (a spin as long
-  // as a wake-up, then sleep; openmp_waiting.h) and restart once so that it takes effect.
-  if (magbrush::dem::choose_openmp_waiting())
+  // The OpenMP runtime reads its wait policy once, at start-up, and glibc its allocator
+  // tunables: choose them (a spin as long as a wake-up, then sleep: openmp_waiting.h; the
+  // arrays on huge pages: huge_page_heap.h) and restart once so that they take effect.
+  const bool waiting = magbrush::dem::choose_openmp_waiting();
+  const bool huge_pages = magbrush::dem::choose_huge_page_heap();
+  if (waiting || huge_pages)
     execv("/proc/self/exe", argv);
   const int steps = argc > 1 ? std::atoi(argv[1]) : 300;
   const int max_threads = argc > 2 ? std::atoi(argv[2]) : 2;
@@ -252,7 +256,9 @@ int main(int argc, char **argv)
   std::printf("DEM dense periodic packing: 60 um, 2200 kg/m3, E = 1 GPa, nu = 0.35, mu = 0.45, rolling "
               "friction, damping; %d steps (+20 warm-up), snapshot every 100 steps; %d repeat(s)\n\n",
               steps, repeats);
-  std::printf("OpenMP waiting: %s\n\n", magbrush::dem::openmp_waiting_description().c_str());
+  std::printf("OpenMP waiting: %s\n", magbrush::dem::openmp_waiting_description().c_str());
+  std::printf("allocator: %s (huge pages: MAGBRUSH_HUGE_PAGES=0 turns them off)\n\n",
+              magbrush::dem::huge_page_heap_description().c_str());
   std::printf("%8s %7s %12s %8s | %7s %7s %7s %7s | %8s %9s %8s %8s   %-16s %12s %5s %9s\n", "N", "threads",
               "p-steps/s", "speedup", "neigh%", "cont%", "integ%", "out%", "B/part", "contacts", "rebuilds",
               "wall s", "one rebuild", "median 10-st", "load", "CPU s");

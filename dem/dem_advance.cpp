@@ -14,6 +14,12 @@
 //                       serial call outside the team (they parallelise themselves)
 //   final kick          v += (dt/2) F/m                                      static share
 //
+// When the team goes straight on to the next step, the final kick and the next step's kick
+// and drift run as one pass over the particles (final_kick_and_next_drift_phase: the same
+// operations per particle in the same order, so the same bits, with the particle and force
+// arrays read once instead of twice); before a pause (the end of the run, the energy guard)
+// the final kick runs alone, so the state between steps is what it always was.
+//
 // The last three loops and the next step's kick-and-drift share one static split of the
 // particles, so each thread carries its own particles from the column sums to the next drift
 // without waiting: a step costs two barriers (K and P) and nothing else. Before, each step
@@ -184,13 +190,16 @@ DemSystem::Pause DemSystem::run_team(long &steps_left, Resume from)
     long left = steps_left;
     Resume at = from;
     Pause stop = Pause::done;
+    bool drifted = false; // this step's kick and drift came with the last final kick
     while (true)
     {
       if (at == Resume::step_start)
       {
         if (left == 0)
           break; // Pause::done
-        kick_and_drift_phase(mine); // ends with barrier K
+        if (!drifted)
+          kick_and_drift_phase(mine); // ends with barrier K
+        drifted = false;
         clock.charge(times_.integrate);
         if (team_has_state_alarm()) // the previous step's walls or final kick
         {
@@ -235,11 +244,17 @@ DemSystem::Pause DemSystem::run_team(long &steps_left, Resume from)
           break;
         }
       }
-      final_kick_phase(mine);
-      clock.charge(times_.integrate);
       --left;
       at = Resume::step_start;
-      if (step_ % 100 == 0)
+      const bool energy_guard = step_ % 100 == 0;
+      // Straight on to the next step: its kick and drift share the final kick's pass.
+      drifted = left > 0 && !energy_guard;
+      if (drifted)
+        final_kick_and_next_drift_phase(mine); // ends with the next step's barrier K
+      else
+        final_kick_phase(mine);
+      clock.charge(times_.integrate);
+      if (energy_guard)
       {
         stop = Pause::energy_guard;
         break;

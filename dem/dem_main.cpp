@@ -4,6 +4,7 @@
 #include "dem/dem_command_line.h"
 #include "dem/dem_run.h"
 #include "dem/measurements/measurement_registry.h"
+#include "dem/huge_page_heap.h"
 #include "dem/openmp_waiting.h"
 
 #include "coupling/case_parser.h"
@@ -55,9 +56,12 @@ int run_engine(const magbrush::cli::ParsedArguments &args)
 
 int main(int argc, char **argv)
 {
-  // The OpenMP runtime reads its wait policy once, at start-up: choose it (a spin as long
-  // as a wake-up, then sleep; openmp_waiting.h) and restart once so that it takes effect.
-  if (magbrush::dem::choose_openmp_waiting())
+  // The OpenMP runtime reads its wait policy once, at start-up, and glibc its allocator
+  // tunables: choose them (a spin as long as a wake-up, then sleep: openmp_waiting.h; the
+  // arrays on huge pages: huge_page_heap.h) and restart once so that they take effect.
+  const bool waiting = magbrush::dem::choose_openmp_waiting();
+  const bool huge_pages = magbrush::dem::choose_huge_page_heap();
+  if (waiting || huge_pages)
     execv("/proc/self/exe", argv);
   return magbrush::cli::run_command(command_line(), {argv + 1, argv + argc}, run_engine);
 }

@@ -207,6 +207,10 @@ private:
   void column_phase();
   void wall_phase(StepFlags &mine);
   void final_kick_phase(StepFlags &mine);
+  // final_kick_phase, then the next step's kick_and_drift_phase, in one pass over the
+  // particles (dem_advance.cpp: when the team goes straight on to the next step).
+  void final_kick_and_next_drift_phase(StepFlags &mine);
+  double drift(std::size_t i, double dt); // x += dt v of particle i; its squared drift since the build
   void begin_step(); // the clock and the walls' pose at the new time (one thread)
   // advance(): the team's loop over steps, from `from` until it needs serial work.
   Pause run_team(long &steps_left, Resume from);

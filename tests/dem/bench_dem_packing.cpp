@@ -8,6 +8,8 @@
 // neighbour list, contacts, integration and output (one HDF5 snapshot every 100 steps), the
 // parallel speed-up, and the memory per particle including the contact history.
 //   bench_dem_packing [steps [max_threads [repeats]]]   (default 300 2 1)
+// BENCH_SIDES=38 (or 24, or 24,38: the default) runs only those lattice sizes, e.g. to profile
+// one of them alone.
 // The machine may be shared: each row also gives the median rate over 10-step windows (a
 // preempted window does not pull it down), the 1-minute load average, and the CPU time of the
 // busiest thread. The "CPU speed-up" (1-thread CPU time / busiest thread's CPU time with more
@@ -16,6 +18,7 @@
 // every configuration runs `repeats` times (1 and 2 threads back to back, so that the
 // speed-up compares runs under the same load) and a summary gives medians and ranges.
 #include "dem/dem_system.h"
+#include "dem/huge_page_heap.h"
 #include "dem/openmp_waiting.h"
 #include "dem/snapshot_writer.h"
 #include "tests/test_temp_dir.h"
@@ -218,13 +221,34 @@ Result run(int per_side, int threads, int steps)
   return r;
 }
 
+// The lattice sizes (particles per side) to run: BENCH_SIDES="24,38" by default.
+std::vector<int> bench_sides()
+{
+  std::vector<int> sides;
+  const char *env = std::getenv("BENCH_SIDES");
+  for (const char *c = env ? env : "24,38"; *c;)
+  {
+    char *end = nullptr;
+    const long v = std::strtol(c, &end, 10);
+    if (end == c)
+      break;
+    if (v > 0)
+      sides.push_back(static_cast<int>(v));
+    c = *end == ',' ? end + 1 : end;
+  }
+  return sides;
+}
+
 } // namespace
 
 int main(int argc, char **argv)
 {
-  // The OpenMP runtime reads its wait policy once, at start-up: choose it (a spin as long
-  // as a wake-up, then sleep; openmp_waiting.h) and restart once so that it takes effect.
-  if (magbrush::dem::choose_openmp_waiting())
+  // The OpenMP runtime reads its wait policy once, at start-up, and glibc its allocator
+  // tunables: choose them (a spin as long as a wake-up, then sleep: openmp_waiting.h; the
+  // arrays on huge pages: huge_page_heap.h) and restart once so that they take effect.
+  const bool waiting = magbrush::dem::choose_openmp_waiting();
+  const bool huge_pages = magbrush::dem::choose_huge_page_heap();
+  if (waiting || huge_pages)
     execv("/proc/self/exe", argv);
   const int steps = argc > 1 ? std::atoi(argv[1]) : 300;
   const int max_threads = argc > 2 ? std::atoi(argv[2]) : 2;
@@ -232,7 +256,9 @@ int main(int argc, char **argv)
   std::printf("DEM dense periodic packing: 60 um, 2200 kg/m3, E = 1 GPa, nu = 0.35, mu = 0.45, rolling "
               "friction, damping; %d steps (+20 warm-up), snapshot every 100 steps; %d repeat(s)\n\n",
               steps, repeats);
-  std::printf("OpenMP waiting: %s\n\n", magbrush::dem::openmp_waiting_description().c_str());
+  std::printf("OpenMP waiting: %s\n", magbrush::dem::openmp_waiting_description().c_str());
+  std::printf("allocator: %s (huge pages: MAGBRUSH_HUGE_PAGES=0 turns them off)\n\n",
+              magbrush::dem::huge_page_heap_description().c_str());
   std::printf("%8s %7s %12s %8s | %7s %7s %7s %7s | %8s %9s %8s %8s   %-16s %12s %5s %9s\n", "N", "threads",
               "p-steps/s", "speedup", "neigh%", "cont%", "integ%", "out%", "B/part", "contacts", "rebuilds",
               "wall s", "one rebuild", "median 10-st", "load", "CPU s");
@@ -241,7 +267,7 @@ int main(int argc, char **argv)
   // rate[(N, threads)] and speed-up[(N, threads)] over the repeats
   std::map<std::pair<int, int>, std::vector<double>> rates, window_rates, speedups, cpu_speedups, loads;
   for (int rep = 0; rep < repeats; ++rep)
-    for (int per_side : {24, 38})
+    for (int per_side : bench_sides())
     {
       double single = 0, single_cpu = 0;
       for (int threads = 1; threads <= max_threads; ++threads)
@@ -291,7 +317,7 @@ int main(int argc, char **argv)
     std::printf("\n2-thread speed-up from interleaved windows (one system, 10 steps on 1 thread, then 10 on 2, "
                 "%d steps each; robust against a slow spell of a shared host):\n%8s %22s %26s\n",
                 steps, "N", "sum(t1)/sum(t2)", "median of window ratios");
-    for (int per_side : {24, 38})
+    for (int per_side : bench_sides())
     {
       const auto [ratio, med] = interleaved_speedup(per_side, steps);
       std::printf("%8d %22.2f %26.2f\n", per_side * per_side * per_side, ratio, med);

@@ -15,11 +15,15 @@
 #include <hdf5.h>
 #include <omp.h>
 
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <set>
 #include <sstream>
 
 using namespace magbrush;
@@ -173,6 +177,49 @@ TEST(DemEngine, HistorySurvivesRebuildAndResorting)
       ++found;
     }
   EXPECT_EQ(found, set);
+}
+
+TEST(DemEngine, NeighbourListHoldsExactlyThePairsInReach)
+{
+  // On cell grids of unequal sides, periodic and open, the list must hold every pair closer
+  // than r_i + r_j + skin exactly once (i < j in the sorted order), whatever the sort does.
+  for (bool periodic : {true, false})
+  {
+    ParticleState s;
+    std::mt19937_64 rng(9);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    const double r = 50e-6, skin = 20e-6;
+    const std::array<double, 3> L{2.3e-3, 1.7e-3, 0.9e-3};
+    for (int k = 0; k < 1500; ++k)
+      s.add({L[0] * u(rng), L[1] * u(rng), L[2] * u(rng)}, r * (0.6 + 0.4 * u(rng)), 2000, 0, 0.0);
+    PeriodicBox box;
+    if (periodic)
+      box.length = L;
+    NeighbourList list;
+    std::vector<double> scratch;
+    std::vector<std::int32_t> iscratch;
+    list.rebuild(s, box, skin, [&](const std::vector<std::int32_t> &order) { s.permute(order, scratch, iscratch); });
+    std::set<std::pair<std::int32_t, std::int32_t>> listed, want;
+    for (std::size_t i = 0; i < s.size(); ++i)
+      for (std::int32_t p = list.row_start[i]; p < list.row_start[i + 1]; ++p)
+      {
+        const std::size_t j = static_cast<std::size_t>(list.partner[static_cast<std::size_t>(p)]);
+        EXPECT_GT(j, i);
+        EXPECT_TRUE(listed.insert({s.id[i], s.id[j]}).second) << "a pair listed twice";
+      }
+    for (std::size_t i = 0; i < s.size(); ++i)
+      for (std::size_t j = i + 1; j < s.size(); ++j)
+      {
+        double d[3] = {s.x[j] - s.x[i], s.y[j] - s.y[i], s.z[j] - s.z[i]};
+        for (int q = 0; q < 3 && periodic; ++q)
+          d[q] -= L[static_cast<std::size_t>(q)] * std::round(d[q] / L[static_cast<std::size_t>(q)]);
+        const double reach = s.radius[i] + s.radius[j] + skin;
+        if (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < reach * reach)
+          want.insert({s.id[i], s.id[j]});
+      }
+    EXPECT_GT(want.size(), 200u);
+    EXPECT_EQ(listed, want) << (periodic ? "periodic" : "open");
+  }
 }
 
 TEST(DemEngine, ForcesAreContinuousAcrossForcedRebuilds)

@@ -3,9 +3,11 @@
 // Why: a step streams every particle, pair and history array once or more (~29 MB at 55k
 // particles, ~40 arrays read side by side). On 4 KiB pages that is ~7,400 pages, more than the
 // second-level TLB holds, so the streams keep missing the TLB, and on a virtual machine each
-// miss walks two page tables (guest and host). Measured on the 2-core VM (docs/dem_vs_lammps.md,
-// bench_dem_packing at N = 54,872): with the arrays on huge pages the step ran ~1.3-1.7x faster
-// at 55k, and the gap to 14k (7 MB, ~1,800 pages) closed.
+// miss walks two page tables (guest and host). Measured on the loaded 2-core VM
+// (docs/dem_vs_lammps.md, bench_dem_packing, 5 rounds against main): the whole bench 1.30x
+// faster at 14k and 1.12x at 55k (medians; min-max 1.18-1.62 and 0.92-1.52), mostly in the
+// HDF5 snapshots (13-21 % of the time -> 3-5 %); the contact phase itself did not change
+// measurably.
 //
 // How: glibc's allocator puts blocks over its mmap threshold (128 KiB, i.e. every array of a
 // few thousand particles) each in its own mapping, too small for a huge page, and the kernel

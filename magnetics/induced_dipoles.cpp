@@ -563,22 +563,8 @@ bool InducedDipoles::refresh_locally(const BeadArrays &beads, const AppliedField
     return false;
   }
   reevaluate_moved_beads(beads, field);
-
-  const double t_sweeps = omp_get_wtime();
-  local_.hold_region_dipoles(p_);
-  sweep_to_tolerance(beads, stats, &local_.region());
-  stats.time_sweeps = omp_get_wtime() - t_sweeps;
-  local_.select_changed(p_, settings_.local_dipole_change);
-
-  const double t_forces = omp_get_wtime();
-  reevaluate_local_forces(beads, stats);
-  stats.time_forces = omp_get_wtime() - t_forces;
-
-  stats.local_moved = local_.moved().size();
-  stats.local_region = local_.region().size();
-  stats.local_gathered = local_.gathered().size();
-  stats.pairs = local_.moved_pairs().size();
-  stats.time_tensors = t_sweeps - t_start;
+  stats.time_tensors = omp_get_wtime() - t_start;
+  solve_region_and_refresh_forces(beads, stats);
   return true;
 }
 
@@ -716,8 +702,16 @@ void InducedDipoles::solve_around(const BeadArrays &beads, std::size_t first, co
   local_.grow_region(beads, near_, settings_.local_region_radius);
   const double t_tensors = omp_get_wtime();
   reevaluate_moved_beads(beads, field);
+  stats.time_tensors = omp_get_wtime() - t_tensors;
+  solve_region_and_refresh_forces(beads, stats);
+}
+
+// What every local refresh ends with, once the moved beads' tensors are new: the region's
+// dipoles by sweeps to the tolerance with everything else held, then the force of every pair
+// touching a dipole that changed, and the counts.
+void InducedDipoles::solve_region_and_refresh_forces(const BeadArrays &beads, MagneticStats &stats)
+{
   const double t_sweeps = omp_get_wtime();
-  stats.time_tensors = t_sweeps - t_tensors;
   local_.hold_region_dipoles(p_);
   sweep_to_tolerance(beads, stats, &local_.region());
   stats.time_sweeps = omp_get_wtime() - t_sweeps;

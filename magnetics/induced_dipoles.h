@@ -251,6 +251,7 @@ private:
   bool can_refresh_locally(const BeadArrays &beads) const;
   void reevaluate_moved_beads(const BeadArrays &beads, const AppliedFieldFunction &field);
   void reevaluate_local_forces(const BeadArrays &beads, MagneticStats &stats);
+  void solve_region_and_refresh_forces(const BeadArrays &beads, MagneticStats &stats);
 };
 
 } // namespace magbrush::magnetics

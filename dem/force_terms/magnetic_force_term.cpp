@@ -343,13 +343,7 @@ bool MagneticForceTerm::admit_pending(const dem::ParticleState &state, double t)
       still_waiting_.push_back(i);
       continue;
     }
-    carrier_.push_back(i);
-    x_.push_back(state.x[i]);
-    y_.push_back(state.y[i]);
-    z_.push_back(state.z[i]);
-    radius_.push_back(state.radius[i]);
-    mu_r_.push_back(species_[species].mu_r);
-    Ms_.push_back(species_[species].saturation_magnetisation);
+    append_bead(state, i, species_[species]);
   }
   if (leavers_.empty() && carrier_.size() == first) // (no carrier came or went that can join)
   {
@@ -669,13 +663,7 @@ void MagneticForceTerm::admit_newcomers(const dem::ParticleState &state)
     const std::size_t species = static_cast<std::size_t>(state.species[k]);
     if (species >= species_.size() || !species_[species].carrier)
       continue;
-    carrier_.push_back(k);
-    x_.push_back(state.x[k]);
-    y_.push_back(state.y[k]);
-    z_.push_back(state.z[k]);
-    radius_.push_back(state.radius[k]);
-    mu_r_.push_back(species_[species].mu_r);
-    Ms_.push_back(species_[species].saturation_magnetisation);
+    append_bead(state, k, species_[species]);
     compact_origin_.push_back(-1);
   }
   const std::size_t n = carrier_.size();
@@ -826,5 +814,16 @@ std::unique_ptr<dem::ForceTerm> make_magnetics(const Case &c, const dem::DemSyst
 const bool registered = dem::register_force_term({"magnetic dipoles", dem::force_term_order::magnetic_dipoles,
                                                   magnetics_not_needed_because, make_magnetics});
 } // namespace
+
+void MagneticForceTerm::append_bead(const dem::ParticleState &state, std::size_t i, const Species &species)
+{
+  carrier_.push_back(static_cast<std::uint32_t>(i));
+  x_.push_back(state.x[i]);
+  y_.push_back(state.y[i]);
+  z_.push_back(state.z[i]);
+  radius_.push_back(state.radius[i]);
+  mu_r_.push_back(species.mu_r);
+  Ms_.push_back(species.saturation_magnetisation);
+}
 
 } // namespace magbrush::magnetics

@@ -120,6 +120,8 @@ private:
     double mu_r = 1.0, saturation_magnetisation = 0.0;
   };
   std::vector<Species> species_;
+  // Appends particle i (a carrier of population `species`) to the compact bead arrays.
+  void append_bead(const dem::ParticleState &state, std::size_t i, const Species &species);
   std::size_t state_size_ = 0;
   InducedDipoles dipoles_;
   AppliedMagneticField field_;

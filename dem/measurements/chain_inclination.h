@@ -63,6 +63,9 @@ private:
   double t_first_ = -1.0, t_last_ = -1.0;
   std::vector<Vector3> positions_;
   std::vector<double> radii_;
+  // add_sample()'s cell list, kept between samples: each bead's cell, the cells' first slots
+  // (one past the last cell at the end), the beads by cell, a fill cursor per cell.
+  std::vector<std::size_t> cell_of_, cell_start_, in_cell_, fill_;
   std::vector<bool> species_is_carrier_; // by population index: toner is not part of the chains
 
   int bin_of(double theta) const;

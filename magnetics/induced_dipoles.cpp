@@ -110,6 +110,36 @@ MagneticStats InducedDipoles::compute(const BeadArrays &beads, const AppliedFiel
   return stats;
 }
 
+MagneticStats InducedDipoles::forces_of_dipoles(const BeadArrays &beads, const AppliedFieldFunction &field,
+                                                double time, const std::vector<double> &p, const ForceArrays &out)
+{
+  if (p.size() != 3 * beads.n)
+    throw std::invalid_argument("magnetics: forces_of_dipoles needs 3 dipole components per bead.");
+  MagneticStats stats;
+  if (beads.n == 0)
+    return stats;
+  set_materials(beads);
+  evaluate_applied_field(beads, field);
+  const double cutoff = find_near_pairs(beads, stats);
+  evaluate_pair_tensors(beads, cutoff, stats);
+  p_ = p;
+  p_next_.resize(3 * beads.n);
+  B_local_.resize(3 * beads.n);
+  if (far_)
+    evaluate_far_field(stats);
+  if (tail_)
+    tail_->evaluate(p_);
+#pragma omp parallel for schedule(static) if (beads.n >= bead_parallel_threshold)
+  for (long b = 0; b < static_cast<long>(beads.n); ++b)
+    gather_local_field(static_cast<std::size_t>(b), p_, &B_local_[3 * b]);
+  if (settings_.model == DipoleModel::corrected && (stats.list_rebuilt || !correction_.has_tables()))
+    correction_.prepare_tables(beta_);
+  evaluate_forces(beads, stats);
+  gather_forces(out);
+  remember_evaluation(beads, time);
+  return stats;
+}
+
 void InducedDipoles::set_materials(const BeadArrays &beads)
 {
   beta_.resize(beads.n);

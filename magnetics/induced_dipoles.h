@@ -87,6 +87,15 @@ public:
   MagneticStats compute(const BeadArrays &beads, const AppliedFieldFunction &field,
                         double time, const ForceArrays &out);
 
+  // The forces of the given dipoles `p` (3 per bead, this call's bead order) at the beads'
+  // current positions, without solving for the dipoles: the applied field and its gradient,
+  // the near pairs' tensors, the far field and the local fields from `p`, then the forces as
+  // compute() takes them. What a scheme that holds the dipoles between evaluations but moves
+  // the beads would feel (bench_magnetic_staleness measures its error against a fresh solve).
+  // The dipoles are kept as the next compute()'s start.
+  MagneticStats forces_of_dipoles(const BeadArrays &beads, const AppliedFieldFunction &field, double time,
+                                  const std::vector<double> &p, const ForceArrays &out);
+
   // True when the held forces are stale: never computed, bead count changed, the refresh
   // interval has elapsed since the last compute(), or some bead moved more than
   // staleness_fraction × its radius since its force was evaluated (minimum image: a

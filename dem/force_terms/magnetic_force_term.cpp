@@ -509,6 +509,18 @@ void MagneticForceTerm::last_forces(std::vector<double> &fx, std::vector<double>
   }
 }
 
+void MagneticForceTerm::held_dipoles(std::vector<double> &p) const
+{
+  p.assign(3 * state_size_, 0.0);
+  const std::vector<double> &held = dipoles_.dipoles();
+  if (held.size() != 3 * carrier_.size())
+    return; // nothing held yet
+  for (std::size_t k = 0; k < carrier_.size(); ++k)
+    if (carrier_[k] != kLeft)
+      for (std::size_t d = 0; d < 3; ++d)
+        p[3 * carrier_[k] + d] = std::sqrt(last_scale_) * held[3 * k + d]; // (p ∝ B, F ∝ B²)
+}
+
 void MagneticForceTerm::particles_reordered(const std::vector<std::int32_t> &order)
 {
   // The engine re-sorted its arrays (new[k] = old[order[k]]): only the engine index of each

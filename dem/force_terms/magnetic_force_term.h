@@ -111,6 +111,9 @@ public:
   // The magnetic forces this term added at its last step, by engine index (0 for toner):
   // `fx` etc. are resized to the engine's particle count and overwritten [N].
   void last_forces(std::vector<double> &fx, std::vector<double> &fy, std::vector<double> &fz) const;
+  // The dipoles held at this step, by engine index (3 per particle, 0 for toner and for
+  // carriers waiting for admission) [A m²], scaled with the ramp as the held forces are.
+  void held_dipoles(std::vector<double> &p) const;
 
 private:
   // Per population: is it a carrier, and its material's μr and M_s (copied from the case).

@@ -76,6 +76,7 @@ public:
     settings.staleness_mode = StalenessMode::absolute;
     settings.tolerance = 1e-6;
     fresh_ = std::make_unique<InducedDipoles>(settings, box);
+    live_ = std::make_unique<InducedDipoles>(settings, box);
     for (const Population &p : c.populations)
     {
       carrier_species_.push_back(p.kind == ParticleKind::carrier);
@@ -129,6 +130,27 @@ public:
     if (!(f2 > 0.0))
       return; // no field yet
     const double rms = std::sqrt(e2 / f2), worst = std::sqrt(emax2 / (f2 / n));
+    // Held dipoles, live geometry: the same error measure.
+    term_->held_dipoles(held_p_);
+    live_p_.assign(3 * n, 0.0);
+    for (auto *v : {&lx_, &ly_, &lz_})
+      v->assign(n, 0.0);
+    for (std::size_t k = 0; k < n; ++k)
+      for (std::size_t d = 0; d < 3; ++d)
+        live_p_[3 * k + d] = held_p_[3 * order_[k] + d];
+    live_->forces_of_dipoles({n, x_.data(), y_.data(), z_.data(), r_.data(), mu_r_.data(), nullptr},
+                             [&field, t](const double x[3], double B[3], double g[3][3]) { field.evaluate(x, t, B, g); },
+                             t, live_p_, {lx_.data(), ly_.data(), lz_.data()});
+    double l2 = 0.0, lmax2 = 0.0;
+    for (std::size_t k = 0; k < n; ++k)
+    {
+      const double e = std::pow(lx_[k] - fx_[k], 2) + std::pow(ly_[k] - fy_[k], 2) + std::pow(lz_[k] - fz_[k], 2);
+      l2 += e;
+      lmax2 = std::max(lmax2, e);
+    }
+    sum_live_rms_ += std::sqrt(l2 / f2);
+    sum_live_max_ += std::sqrt(lmax2 / (f2 / n));
+    max_live_rms_ = std::max(max_live_rms_, std::sqrt(l2 / f2));
     // The total magnetic force on the beads touching the wall.
     std::vector<dem::WallContactRecord> touching;
     system.wall_contacts(wall_, touching);
@@ -163,6 +185,7 @@ public:
 
   long samples_ = 0;
   double sum_rms_ = 0, sum_max_ = 0, sum_wall_ = 0, max_rms_ = 0, max_max_ = 0, max_wall_ = 0;
+  double sum_live_rms_ = 0, sum_live_max_ = 0, max_live_rms_ = 0;
 
 private:
   const MagneticForceTerm *term_;
@@ -170,6 +193,10 @@ private:
   std::size_t wall_;
   double interval_;
   std::unique_ptr<InducedDipoles> fresh_;
+  // The held dipoles' forces at the current positions (InducedDipoles::forces_of_dipoles):
+  // what holding the dipoles instead of the forces would give.
+  std::unique_ptr<InducedDipoles> live_;
+  std::vector<double> held_p_, live_p_, lx_, ly_, lz_;
   std::vector<bool> carrier_species_;
   std::vector<double> mu_;
   std::vector<std::size_t> order_;
@@ -194,6 +221,7 @@ struct ModeResult
   double magnetic_s = 0, rest_s = 0;
   long samples = 0;
   double mean_rms = 0, mean_max = 0, mean_wall = 0, max_rms = 0, max_max = 0, max_wall = 0;
+  double mean_live_rms = 0, mean_live_max = 0, max_live_rms = 0; // held dipoles, live geometry
 };
 
 // One run of `c` (fresh, or from `restart`) to its dem.duration with the magnetics in `mode`.
@@ -203,7 +231,8 @@ ModeResult run_mode(Case c, const std::string &mode, const std::string &restart,
   // A mode may carry variants of knobs without a case key, side by side in the same run:
   // "relative+R1+S0.6" = relative with local_region_limit 1 and the magnetic lists' skin 0.6
   // diameters; "+X0" = defer_exchange off (a full evaluation at every particle exchange);
-  // "+A1" / "+A0" = admit_exchange on / off (admission without a rebuild at the next step).
+  // "+A1" / "+A0" = admit_exchange on / off (admission without a rebuild at the next step);
+  // "+F0.1" = magnetic_staleness 0.1.
   const std::vector<std::string> parts = split(mode, '+');
   c.dem.magnetic_staleness_mode = parts[0];
   dem::RunOptions options;
@@ -241,6 +270,8 @@ ModeResult run_mode(Case c, const std::string &mode, const std::string &restart,
       settings.defer_exchange = v != 0.0;
     else if (parts[k][0] == 'A')
       settings.admit_exchange = v != 0.0;
+    else if (parts[k][0] == 'F')
+      settings.staleness_fraction = v;
     else
       throw std::runtime_error("unknown mode variant " + parts[k]);
   }
@@ -267,7 +298,10 @@ ModeResult run_mode(Case c, const std::string &mode, const std::string &restart,
     r.mean_rms = error->sum_rms_ / r.samples;
     r.mean_max = error->sum_max_ / r.samples;
     r.mean_wall = error->sum_wall_ / r.samples;
+    r.mean_live_rms = error->sum_live_rms_ / r.samples;
+    r.mean_live_max = error->sum_live_max_ / r.samples;
   }
+  r.max_live_rms = error->max_live_rms_;
   r.max_rms = error->max_rms_;
   r.max_max = error->max_max_;
   r.max_wall = error->max_wall_;
@@ -293,6 +327,12 @@ void print(const char *title, const char *wall_name, const std::vector<ModeResul
   for (const ModeResult &r : results)
     std::printf("| %s | %ld | %ld | %ld | %ld / %ld | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f |\n", r.mode.c_str(), r.full, r.counts.rebuilds,
                 r.counts.set_changed, r.counts.moved_lists, r.counts.moved_region, r.counts.cold_s, r.counts.lists_s, r.counts.tensors_s, r.counts.far_s, r.counts.sweeps_s, r.counts.forces_s);
+  std::printf("\nHolding the dipoles instead of the forces (the held dipoles' forces at the current positions, "
+              "InducedDipoles::forces_of_dipoles) against the same fresh solve:\n\n| staleness mode | held forces: RMS mean / max | "
+              "held dipoles, live geometry: RMS mean / max | worst bead: held forces / held dipoles (means) |\n|---|---|---|---|\n");
+  for (const ModeResult &r : results)
+    std::printf("| %s | %.2e / %.2e | %.2e / %.2e | %.2e / %.2e |\n", r.mode.c_str(), r.mean_rms, r.max_rms, r.mean_live_rms,
+                r.max_live_rms, r.mean_max, r.mean_live_max);
   std::printf("\nExchanges admitted without a full evaluation (admit_exchange):\n\n| staleness mode | admissions | wall [s] | mean region |\n|---|---|---|---|\n");
   for (const ModeResult &r : results)
     std::printf("| %s | %ld | %.2f | %.0f |\n", r.mode.c_str(), r.counts.admitted, r.counts.admit_s,

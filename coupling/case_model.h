@@ -232,6 +232,9 @@ struct DemSettings
   // (beads that moved magnetic_staleness × their radius: a local refresh) or "absolute"
   // (the same trigger, a full refresh: the papers' behaviour).
   std::string magnetic_staleness_mode = "relative";
+  // What the magnetics hold between evaluations: "forces", or "dipoles" (the close pairs'
+  // forces follow the beads; docs/magnetics.md "Holding the dipoles instead of the forces").
+  std::string magnetic_hold = "forces";
   double air_viscosity = 1.81e-5;    // η [Pa s] for Stokes drag (0 = no drag)
   Vec3 gravity{{0.0, -9.81, 0.0}};    // [m/s²]
   unsigned long seed = 1;

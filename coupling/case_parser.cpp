@@ -1082,6 +1082,7 @@ private:
     d.magnetic_far_cell = q(s, "magnetic_far_cell");
     d.magnetic_staleness = q(s, "magnetic_staleness");
     d.magnetic_staleness_mode = str(s, "magnetic_staleness_mode");
+    d.magnetic_hold = str(s, "magnetic_hold");
     d.air_viscosity = q(s, "air_viscosity");
     d.gravity = vec3(s, "gravity");
     d.seed = static_cast<unsigned long>(integer(s, "seed"));

@@ -35,6 +35,7 @@ InducedDipoles::InducedDipoles(const MagneticSettings &settings, const std::arra
   : settings_(settings), box_(box), solver_(settings.tolerance, settings.max_sweeps),
     correction_(settings, box), staleness_(settings, box)
 {
+  live_.set_steps(settings_.live_pair_steps);
   if (!(settings_.cutoff_length > 0.0 || settings_.cutoff_diameters > 0.0))
     throw std::invalid_argument("magnetics: expected a positive cutoff (cutoff_diameters or "
                                 "cutoff_length); found neither.");
@@ -107,6 +108,11 @@ MagneticStats InducedDipoles::compute(const BeadArrays &beads, const AppliedFiel
   gather_forces(out);
   clock.lap(stats.time_forces);
   remember_evaluation(beads, time);
+  if (settings_.hold_dipoles)
+  {
+    live_.select(beads, near_, settings_.live_pair_radius);
+    live_.rebase_all({beads, beta_, B_local_, p_}, near_, live_correction());
+  }
   return stats;
 }
 
@@ -178,6 +184,7 @@ void InducedDipoles::evaluate_applied_field_at(const BeadArrays &beads, const Ap
 
 void InducedDipoles::hold_zero_forces(const BeadArrays &beads, double time)
 {
+  live_.clear();
   // No applied field anywhere (before a field ramp starts, or a schedule at 0 mT): the
   // induced dipoles are all zero, and so are the forces: nothing to solve. The next compute
   // starts cold (from the applied-field dipoles).
@@ -501,6 +508,31 @@ StalenessCheck InducedDipoles::check_staleness(const BeadArrays &beads, double t
   return staleness_.check(beads, time, list.built() && list.particle_count() == beads.n);
 }
 
+const std::vector<double> *InducedDipoles::live_pair_changes(const BeadArrays &beads)
+{
+  if (!settings_.hold_dipoles || live_.size() == 0 || p_.size() != 3 * beads.n || B_local_.size() != 3 * beads.n)
+    return nullptr;
+  return &live_.update({beads, beta_, B_local_, p_}, near_, live_correction());
+}
+
+void InducedDipoles::add_live_pair_changes(const BeadArrays &beads, const ForceArrays &out)
+{
+  const std::vector<double> *change = live_pair_changes(beads);
+  if (!change)
+    return;
+  for (std::size_t b = 0; b < beads.n; ++b)
+  {
+    out.fx[b] += (*change)[3 * b];
+    out.fy[b] += (*change)[3 * b + 1];
+    out.fz[b] += (*change)[3 * b + 2];
+  }
+}
+
+const TwoSphereCorrection *InducedDipoles::live_correction() const
+{
+  return settings_.model == DipoleModel::corrected && correction_.has_tables() ? &correction_ : nullptr;
+}
+
 void InducedDipoles::particles_reordered(const std::vector<std::int32_t> &order)
 {
   auto permute = [&](std::vector<double> &v) {
@@ -517,6 +549,7 @@ void InducedDipoles::particles_reordered(const std::vector<std::int32_t> &order)
   staleness_.particles_reordered(order);
   near_.forget(); // pair indices refer to the old order
   correction_.forget_list();
+  live_.clear();
 }
 
 void InducedDipoles::particles_changed(const std::vector<std::int32_t> &origin)
@@ -541,6 +574,7 @@ void InducedDipoles::particles_changed(const std::vector<std::int32_t> &origin)
   computed_ = false;
   near_.forget(); // pair indices refer to the old set
   correction_.forget_list();
+  live_.clear();
 }
 
 bool InducedDipoles::linear() const
@@ -567,6 +601,7 @@ void InducedDipoles::scale_applied_field(double ratio)
       x *= ratio2;
   pair_forces_.scale(ratio2);
   correction_.scale_forces(ratio2);
+  live_.scale(ratio2);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -661,6 +696,8 @@ bool InducedDipoles::admit(const BeadArrays &beads, std::size_t first, const std
     list.append(beads.n, beads.x, beads.y, beads.z, admitted_pairs_);
     near_.appended(beads, old_pairs);
     pair_forces_.resize(list.size());
+    if (settings_.hold_dipoles)
+      live_.append(beads, near_, old_pairs, settings_.live_pair_radius);
     if (far_corrections())
       correction_.admit(beads, first);
   }
@@ -748,6 +785,8 @@ void InducedDipoles::solve_region_and_refresh_forces(const BeadArrays &beads, Ma
   local_.select_changed(p_, settings_.local_dipole_change);
   const double t_forces = omp_get_wtime();
   reevaluate_local_forces(beads, stats);
+  if (settings_.hold_dipoles) // the renewed pairs' forces are the live pairs' new base
+    live_.rebase({beads, beta_, B_local_, p_}, near_, live_correction(), local_.force_pairs());
   stats.time_forces = omp_get_wtime() - t_forces;
   stats.local_moved = local_.moved().size();
   stats.local_region = local_.region().size();
@@ -787,6 +826,8 @@ std::string settings_fingerprint(const MagneticSettings &s)
                    static_cast<double>(s.far_passes), static_cast<double>(s.far_single_precision),
                    static_cast<double>(s.defer_exchange), static_cast<double>(s.admit_exchange)})
     add(v);
+  if (s.hold_dipoles) // (only when on: checkpoints written before the setting still restore)
+    f += "hold_dipoles " + std::to_string(s.live_pair_radius) + " " + std::to_string(s.live_pair_steps) + " ";
   return f;
 }
 } // namespace
@@ -811,6 +852,8 @@ void InducedDipoles::write_state(StateOut &out) const
   // The fine cells' local expansions (admit(): a newcomer's held far field).
   static const std::vector<double> none;
   out.put_array(far_ && far_->levels() > 0 ? far_->fine_locals() : none);
+  if (settings_.hold_dipoles)
+    live_.write_state(out);
 }
 
 bool InducedDipoles::read_state(StateIn &in)
@@ -852,6 +895,8 @@ bool InducedDipoles::read_state(StateIn &in)
   in.get_array(locals);
   if (far_ && !locals.empty())
     far_->set_fine_locals(locals);
+  if (settings_.hold_dipoles)
+    live_.read_state(in, p_.size() / 3, near_);
   return true;
 }
 

@@ -33,6 +33,7 @@
 #include "magnetics/bead_arrays.h"
 #include "magnetics/cell_multipole_field.h"
 #include "magnetics/jacobi_solver.h"
+#include "magnetics/live_pairs.h"
 #include "magnetics/local_refresh.h"
 #include "magnetics/magnetic_neighbour_list.h"
 #include "magnetics/magnetic_settings.h"
@@ -105,6 +106,14 @@ public:
 
   // Adds the forces (and torques) of the last compute() / refresh_locally() again.
   void add_held_forces(const ForceArrays &out) const;
+  // MagneticSettings::hold_dipoles: per bead (3 each), how the forces of its close pairs
+  // changed since they were last evaluated, at the beads' current positions with the held
+  // dipoles (live_pairs.h); null when nothing is live. `beads` = the held state's beads.
+  // Call once per step: the changes are evaluated every live_pair_steps calls.
+  const std::vector<double> *live_pair_changes(const BeadArrays &beads);
+  // The same, added to `out` (tests).
+  void add_live_pair_changes(const BeadArrays &beads, const ForceArrays &out);
+  std::size_t live_pairs() const { return live_.size(); }
 
   // The local refresh (StalenessMode::local): re-evaluates the magnetics around the beads
   // that moved more than staleness_fraction × their radius since their forces were last
@@ -207,6 +216,7 @@ private:
   TwoSphereCorrection correction_;          // `corrected`: the exact two-sphere short range
   StalenessTracker staleness_;              // when the held forces go stale
   LocalRefresh local_;                      // what a local refresh re-evaluates
+  LivePairs live_;                          // hold_dipoles: the close pairs' forces follow the beads
 
   // Per bead (interleaved x, y, z; gradients 9 per bead): β, saturation magnetisation,
   // applied field and gradient, dipoles (and the sweeps' next dipoles), local field, far
@@ -248,6 +258,8 @@ private:
   // Bead b's total force and torque from its dipole, the fields and the stored pair forces.
   void gather_bead(std::size_t b);
   void remember_evaluation(const BeadArrays &beads, double time);
+  // hold_dipoles: the correction the live pairs apply (the `corrected` model's), or null.
+  const TwoSphereCorrection *live_correction() const;
 
   // admit(), step by step.
   bool can_admit(const BeadArrays &beads, std::size_t first) const;

@@ -81,6 +81,10 @@ MagneticSettings MagneticSettings::from_case(const DemSettings &dem)
   s.far_cell_diameters = dem.magnetic_far_cell;
   s.staleness_fraction = dem.magnetic_staleness;
   s.staleness_mode = parse_staleness_mode(dem.magnetic_staleness_mode);
+  if (dem.magnetic_hold != "forces" && dem.magnetic_hold != "dipoles")
+    throw std::invalid_argument("magnetics: unknown dem.magnetic_hold '" + dem.magnetic_hold +
+                                "'. Set it to forces or dipoles.");
+  s.hold_dipoles = dem.magnetic_hold == "dipoles";
   return s;
 }
 

@@ -139,6 +139,18 @@ struct MagneticSettings
   // above. docs/magnetics.md "Particle exchange" (regulation cell at 16 ms: as accurate as
   // evaluating every exchange, at the deferral's cost).
   bool admit_exchange = true;
+  // Between evaluations, hold the dipoles instead of the forces: every step the close pairs'
+  // forces (the relative trigger's watched pairs: within relative_check_radius mean radii +
+  // skin) are evaluated at the current pair vectors from the held dipoles and local fields
+  // (live_pairs.h); the rest of each held force stays. 5–8× less held-force error at the
+  // same schedule on the flowing nip, so that the staleness limit and the refresh interval
+  // can be larger (docs/magnetics.md "Holding the dipoles instead of the forces").
+  bool hold_dipoles = false;
+  // hold_dipoles: the live pairs are those within live_pair_radius mean radii at their last
+  // tensor evaluation (2 = touching), and their changes are evaluated every live_pair_steps
+  // steps.
+  double live_pair_radius = 3.0;
+  int live_pair_steps = 20;
 
   // `corrected`: the exact-minus-dipole pair correction is applied fully for centre
   // distances below switch_begin (in mean pair radii, 2 = touching) and blended smoothly to

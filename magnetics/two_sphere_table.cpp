@@ -48,12 +48,19 @@ std::shared_ptr<const TwoSphereTable> TwoSphereTable::shared(double beta, double
   return slot;
 }
 
-double TwoSphereTable::interpolate(const std::vector<double> &f, double D) const
+TwoSphereTable::Node TwoSphereTable::node(double D) const
 {
-  const int n = static_cast<int>(f.size());
+  const int n = static_cast<int>(par_.size());
   const double u = std::sqrt(std::clamp(D, 2.0, D_max_) - 2.0) / du_;
   const int k = std::clamp(static_cast<int>(u), 0, n - 2);
-  const double t = u - k;
+  return {k, u - k};
+}
+
+double TwoSphereTable::interpolate_at(const std::vector<double> &f, const Node &at) const
+{
+  const int n = static_cast<int>(f.size());
+  const int k = at.k;
+  const double t = at.t;
   // Catmull–Rom tangents (second-order one-sided at the ends).
   auto value = [&](int i) { return f[std::clamp(i, 0, n - 1)]; };
   const double m0 = (k == 0) ? 0.5 * (-3 * f[0] + 4 * f[1] - f[2]) : 0.5 * (f[k + 1] - f[k - 1]);
@@ -66,7 +73,9 @@ double TwoSphereTable::interpolate(const std::vector<double> &f, double D) const
 
 TwoSphereForce TwoSphereTable::correction(double D) const
 {
-  return {interpolate(par_, D), interpolate(perp_, D), interpolate(trans_, D), 0};
+  // (The three tables share their nodes: one square root for all three.)
+  const Node at = node(D);
+  return {interpolate_at(par_, at), interpolate_at(perp_, at), interpolate_at(trans_, at), 0};
 }
 
 TwoSphereForce TwoSphereTable::mutual(double D) const

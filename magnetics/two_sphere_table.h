@@ -35,7 +35,14 @@ public:
 private:
   double beta_, D_max_, du_;
   std::vector<double> par_, perp_, trans_;
-  double interpolate(const std::vector<double> &f, double D) const;
+  // Where D falls on the nodes (uniform in √(D − 2)): the interval k and the fraction t in it.
+  struct Node
+  {
+    int k;
+    double t;
+  };
+  Node node(double D) const;
+  double interpolate_at(const std::vector<double> &f, const Node &at) const;
 };
 
 } // namespace magbrush::magnetics

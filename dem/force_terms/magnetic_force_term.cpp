@@ -19,6 +19,10 @@
 namespace magbrush::magnetics {
 
 namespace {
+constexpr double no_change[3] = {0.0, 0.0, 0.0}; // (no live pair changes: hold_dipoles off)
+} // namespace
+
+namespace {
 MagneticSettings with_slab_tail(MagneticSettings s, const std::array<double, 3> &box, bool slab_tail)
 {
   const int periodic = (box[0] > 0) + (box[1] > 0) + (box[2] > 0);
@@ -286,14 +290,24 @@ void MagneticForceTerm::add_forces(const dem::ParticleState &state, dem::ForceBu
   last_scale_ = scale;
   add_waiting_forces(state, forces, t);
   const std::size_t m = carrier_.size(); // (the held-back exchanges may just have joined)
+  // Holding the dipoles: the close pairs' forces at the current positions (live_pairs.h).
+  const std::vector<double> *live = nullptr;
+  if (settings.hold_dipoles)
+  {
+    const double t0 = omp_get_wtime();
+    live = dipoles_.live_pair_changes(bead_arrays());
+    counts_.live_s += omp_get_wtime() - t0;
+  }
+  live_ = live && live->size() == 3 * m ? live : nullptr;
   for (std::size_t k = 0; k < m; ++k)
   {
     const std::size_t i = carrier_[k];
     if (i == kLeft)
       continue;
-    forces.fx[i] += scale * fx_[k];
-    forces.fy[i] += scale * fy_[k];
-    forces.fz[i] += scale * fz_[k];
+    const double *dF = live_ ? &(*live_)[3 * k] : no_change;
+    forces.fx[i] += scale * (fx_[k] + dF[0]);
+    forces.fy[i] += scale * (fy_[k] + dF[1]);
+    forces.fz[i] += scale * (fz_[k] + dF[2]);
   }
   if (dipoles_.settings().torque == TorqueModel::paper) // (otherwise no magnetic torque)
     for (std::size_t k = 0; k < m; ++k)
@@ -497,9 +511,10 @@ void MagneticForceTerm::last_forces(std::vector<double> &fx, std::vector<double>
   {
     if (carrier_[k] == kLeft)
       continue;
-    fx[carrier_[k]] = last_scale_ * fx_[k];
-    fy[carrier_[k]] = last_scale_ * fy_[k];
-    fz[carrier_[k]] = last_scale_ * fz_[k];
+    const double *dF = live_ && live_->size() == 3 * carrier_.size() ? &(*live_)[3 * k] : no_change;
+    fx[carrier_[k]] = last_scale_ * (fx_[k] + dF[0]);
+    fy[carrier_[k]] = last_scale_ * (fy_[k] + dF[1]);
+    fz[carrier_[k]] = last_scale_ * (fz_[k] + dF[2]);
   }
   for (std::size_t w = 0; w < waiting_.size(); ++w)
   {

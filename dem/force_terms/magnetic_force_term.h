@@ -105,6 +105,8 @@ public:
     long admitted = 0;
     double admit_s = 0.0;
     long admit_region_beads = 0;
+    // MagneticSettings::hold_dipoles: wall time [s] of the close pairs' per-step forces.
+    double live_s = 0.0;
   };
   const RefreshCounts &refresh_counts() const { return counts_; }
   const InducedDipoles &dipoles() const { return dipoles_; }
@@ -137,6 +139,9 @@ private:
   // compact bead k (updated on every engine re-sort).
   std::vector<std::uint32_t> carrier_;
   std::vector<double> x_, y_, z_, radius_, mu_r_, Ms_, fx_, fy_, fz_, tx_, ty_, tz_;
+  // hold_dipoles: this step's change of the close pairs' forces since their evaluation (3 per
+  // compact bead, InducedDipoles::live_pair_changes), or null.
+  const std::vector<double> *live_ = nullptr;
   bool must_refresh_ = true;
   // Engine indices of particles that entered since the last step (particles_changed), kept
   // through re-sorting; the carriers among them join the compact order at the next step.

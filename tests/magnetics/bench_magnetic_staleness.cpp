@@ -232,7 +232,8 @@ ModeResult run_mode(Case c, const std::string &mode, const std::string &restart,
   // "relative+R1+S0.6" = relative with local_region_limit 1 and the magnetic lists' skin 0.6
   // diameters; "+X0" = defer_exchange off (a full evaluation at every particle exchange);
   // "+A1" / "+A0" = admit_exchange on / off (admission without a rebuild at the next step);
-  // "+F0.1" = magnetic_staleness 0.1.
+  // "+F0.1" = magnetic_staleness 0.1; "+H1" = hold the dipoles (the close pairs' forces live),
+  // with "+L3" live pairs within 3 mean radii (+ skin), "+N10" their changes every 10 steps.
   const std::vector<std::string> parts = split(mode, '+');
   c.dem.magnetic_staleness_mode = parts[0];
   dem::RunOptions options;
@@ -272,6 +273,12 @@ ModeResult run_mode(Case c, const std::string &mode, const std::string &restart,
       settings.admit_exchange = v != 0.0;
     else if (parts[k][0] == 'F')
       settings.staleness_fraction = v;
+    else if (parts[k][0] == 'H')
+      settings.hold_dipoles = v != 0.0;
+    else if (parts[k][0] == 'L')
+      settings.live_pair_radius = v;
+    else if (parts[k][0] == 'N')
+      settings.live_pair_steps = static_cast<int>(v);
     else
       throw std::runtime_error("unknown mode variant " + parts[k]);
   }
@@ -329,10 +336,11 @@ void print(const char *title, const char *wall_name, const std::vector<ModeResul
                 r.counts.set_changed, r.counts.moved_lists, r.counts.moved_region, r.counts.cold_s, r.counts.lists_s, r.counts.tensors_s, r.counts.far_s, r.counts.sweeps_s, r.counts.forces_s);
   std::printf("\nHolding the dipoles instead of the forces (the held dipoles' forces at the current positions, "
               "InducedDipoles::forces_of_dipoles) against the same fresh solve:\n\n| staleness mode | held forces: RMS mean / max | "
-              "held dipoles, live geometry: RMS mean / max | worst bead: held forces / held dipoles (means) |\n|---|---|---|---|\n");
+              "held dipoles, live geometry: RMS mean / max | worst bead: held forces / held dipoles (means) | "
+              "the term's live close pairs (hold_dipoles) [s] |\n|---|---|---|---|---|\n");
   for (const ModeResult &r : results)
-    std::printf("| %s | %.2e / %.2e | %.2e / %.2e | %.2e / %.2e |\n", r.mode.c_str(), r.mean_rms, r.max_rms, r.mean_live_rms,
-                r.max_live_rms, r.mean_max, r.mean_live_max);
+    std::printf("| %s | %.2e / %.2e | %.2e / %.2e | %.2e / %.2e | %.2f |\n", r.mode.c_str(), r.mean_rms, r.max_rms,
+                r.mean_live_rms, r.max_live_rms, r.mean_max, r.mean_live_max, r.counts.live_s);
   std::printf("\nExchanges admitted without a full evaluation (admit_exchange):\n\n| staleness mode | admissions | wall [s] | mean region |\n|---|---|---|---|\n");
   for (const ModeResult &r : results)
     std::printf("| %s | %ld | %.2f | %.0f |\n", r.mode.c_str(), r.counts.admitted, r.counts.admit_s,

@@ -164,6 +164,7 @@ TEST(ModuleDefaults, DemSettingsOfADefaultCaseAreTheStructDefaults)
   EXPECT_SAME(from_case, built, magnetic_far_cell);
   EXPECT_SAME(from_case, built, magnetic_staleness);
   EXPECT_SAME_EXACT(from_case, built, magnetic_staleness_mode);
+  EXPECT_SAME_EXACT(from_case, built, magnetic_hold);
   EXPECT_SAME(from_case, built, air_viscosity);
   expect_same_vec3(from_case.gravity, built.gravity, "gravity");
   EXPECT_SAME_EXACT(from_case, built, seed);

@@ -23,14 +23,9 @@ void LivePairs::clear()
 void LivePairs::select(const BeadArrays &beads, const NearPairs &near, double reach_factor)
 {
   pair_.clear();
-  live_of_.assign(near.pairs().size(), -1);
-  for (std::size_t k = 0; k < near.pairs().size(); ++k)
-    consider(beads, near, k, reach_factor);
-  beads_ = beads.n;
-  base_.assign(3 * pair_.size(), 0.0);
-  build_incidence(near);
-  change_.resize(3 * pair_.size());
-  calls_ = 0;
+  live_of_.clear();
+  base_.clear();
+  append(beads, near, 0, reach_factor);
 }
 
 void LivePairs::append(const BeadArrays &beads, const NearPairs &near, std::size_t first_pair, double reach_factor)

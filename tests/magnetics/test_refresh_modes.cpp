@@ -113,6 +113,21 @@ ForceError force_error(const Beads &b, const std::vector<double> &fx, const std:
   return {std::sqrt(e2 / f2), std::sqrt(emax2 / (f2 / n))};
 }
 
+// Every bead of `b` displaced by up to `fraction` of its radius along each axis (a fixed,
+// irregular pattern).
+Beads shaken_by(const Beads &b, double fraction)
+{
+  Beads out = b;
+  for (std::size_t k = 0; k < out.size(); ++k)
+  {
+    const double f = fraction * out.r[k];
+    out.x[k] += f * std::sin(1.3 * k + 0.2);
+    out.y[k] += f * std::cos(2.1 * k + 0.7);
+    out.z[k] += f * std::sin(0.7 * k + 1.9);
+  }
+  return out;
+}
+
 // Forces of a fresh, cold evaluation of `b` with settings `s` (box `box`), field along ŷ.
 void fresh_forces(const Beads &b, const MagneticSettings &s, const std::array<double, 3> &box,
                   std::vector<double> &fx, std::vector<double> &fy, std::vector<double> &fz,
@@ -394,21 +409,10 @@ TEST(RefreshModes, HeldDipolesAtTheNewPositionsBeatHeldForces)
   EXPECT_LT(replayed.rms, 1e-7);
   EXPECT_LT(replayed.max, 5e-7);
 
-  Beads shaken = beads;
-  for (std::size_t k = 0; k < shaken.size(); ++k)
-  {
-    const double f = 0.05 * shaken.r[k];
-    shaken.x[k] += f * std::sin(1.3 * k + 0.2);
-    shaken.y[k] += f * std::cos(2.1 * k + 0.7);
-    shaken.z[k] += f * std::sin(0.7 * k + 1.9);
-  }
+  Beads shaken = shaken_by(beads, 0.05);
   std::vector<double> fx, fy, fz;
   fresh_forces(shaken, s, box, fx, fy, fz);
-  Beads held = shaken;
-  held.fx = at_solve.fx;
-  held.fy = at_solve.fy;
-  held.fz = at_solve.fz;
-  const ForceError holding_forces = force_error(held, fx, fy, fz);
+  const ForceError holding_forces = force_error(at_solve, fx, fy, fz); // (the forces held from the solve)
   InducedDipoles live(s, box);
   live.forces_of_dipoles(shaken.arrays(), uniform_field(0, B0, 0), 0.0, p, shaken.forces());
   const ForceError holding_dipoles = force_error(shaken, fx, fy, fz);
@@ -436,14 +440,7 @@ TEST(RefreshModes, HoldingTheDipolesLetsTheClosePairsFollowTheBeads)
   s.tolerance = 1e-10;
   s.hold_dipoles = true;
   s.live_pair_steps = 1; // (every call evaluates: the shaken positions are the second call)
-  Beads shaken = start;
-  for (std::size_t k = 0; k < shaken.size(); ++k)
-  {
-    const double f = 0.05 * shaken.r[k];
-    shaken.x[k] += f * std::sin(1.3 * k + 0.2);
-    shaken.y[k] += f * std::cos(2.1 * k + 0.7);
-    shaken.z[k] += f * std::sin(0.7 * k + 1.9);
-  }
+  const Beads shaken = shaken_by(start, 0.05);
   std::vector<double> live_forces[2][3];
   for (int threads : {1, 2})
   {
@@ -468,11 +465,7 @@ TEST(RefreshModes, HoldingTheDipolesLetsTheClosePairsFollowTheBeads)
     {
       std::vector<double> fx, fy, fz;
       fresh_forces(shaken, s, box, fx, fy, fz);
-      Beads holding = shaken;
-      holding.fx = held.fx;
-      holding.fy = held.fy;
-      holding.fz = held.fz;
-      const ForceError forces_held = force_error(holding, fx, fy, fz);
+      const ForceError forces_held = force_error(held, fx, fy, fz); // (the forces of the evaluation)
       const ForceError dipoles_held = force_error(moved, fx, fy, fz);
       std::printf("%zu beads shaken by up to 0.05 r, %zu live pairs: held forces RMS %.2e worst %.2e; held "
                   "dipoles with the close pairs live RMS %.2e worst %.2e\n",

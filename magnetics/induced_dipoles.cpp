@@ -100,20 +100,28 @@ MagneticStats InducedDipoles::compute(const BeadArrays &beads, const AppliedFiel
   evaluate_pair_tensors(beads, cutoff, stats);
   clock.lap(stats.time_tensors);
   solve_dipoles(beads, stats);
-  // Tables depend on the beads' β only: re-check when the list (hence the bead set) changed.
-  if (settings_.model == DipoleModel::corrected && (stats.list_rebuilt || !correction_.has_tables()))
-    correction_.prepare_tables(beta_);
   clock.restart();
-  evaluate_forces(beads, stats);
-  gather_forces(out);
+  hold_forces_of_dipoles(beads, time, stats, out);
   clock.lap(stats.time_forces);
-  remember_evaluation(beads, time);
   if (settings_.hold_dipoles)
   {
     live_.select(beads, near_, settings_.live_pair_radius);
     live_.rebase_all({beads, beta_, B_local_, p_}, near_, live_correction());
   }
   return stats;
+}
+
+// The end of an evaluation, once the dipoles and local fields are known: the correction's
+// tables, the pair forces, each bead's total (also added to `out`), the staleness references.
+void InducedDipoles::hold_forces_of_dipoles(const BeadArrays &beads, double time, MagneticStats &stats,
+                                            const ForceArrays &out)
+{
+  // Tables depend on the beads' β only: re-check when the list (hence the bead set) changed.
+  if (settings_.model == DipoleModel::corrected && (stats.list_rebuilt || !correction_.has_tables()))
+    correction_.prepare_tables(beta_);
+  evaluate_forces(beads, stats);
+  gather_forces(out);
+  remember_evaluation(beads, time);
 }
 
 MagneticStats InducedDipoles::forces_of_dipoles(const BeadArrays &beads, const AppliedFieldFunction &field,
@@ -138,11 +146,7 @@ MagneticStats InducedDipoles::forces_of_dipoles(const BeadArrays &beads, const A
 #pragma omp parallel for schedule(static) if (beads.n >= bead_parallel_threshold)
   for (long b = 0; b < static_cast<long>(beads.n); ++b)
     gather_local_field(static_cast<std::size_t>(b), p_, &B_local_[3 * b]);
-  if (settings_.model == DipoleModel::corrected && (stats.list_rebuilt || !correction_.has_tables()))
-    correction_.prepare_tables(beta_);
-  evaluate_forces(beads, stats);
-  gather_forces(out);
-  remember_evaluation(beads, time);
+  hold_forces_of_dipoles(beads, time, stats, out);
   return stats;
 }
 

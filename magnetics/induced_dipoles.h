@@ -252,6 +252,7 @@ private:
   // Bead b's local field from the dipoles p: applied + tail + far + near pairs.
   void gather_local_field(std::size_t b, const std::vector<double> &p, double B[3]) const;
   void evaluate_forces(const BeadArrays &beads, MagneticStats &stats);
+  void hold_forces_of_dipoles(const BeadArrays &beads, double time, MagneticStats &stats, const ForceArrays &out);
   const TwoSphereCorrection *near_pair_correction() const; // with a hard cutoff only
   bool far_corrections() const; // `corrected` with the far field: the correction's own list
   void gather_forces(const ForceArrays &out);

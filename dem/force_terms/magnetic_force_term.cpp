@@ -20,9 +20,7 @@ namespace magbrush::magnetics {
 
 namespace {
 constexpr double no_change[3] = {0.0, 0.0, 0.0}; // (no live pair changes: hold_dipoles off)
-} // namespace
 
-namespace {
 MagneticSettings with_slab_tail(MagneticSettings s, const std::array<double, 3> &box, bool slab_tail)
 {
   const int periodic = (box[0] > 0) + (box[1] > 0) + (box[2] > 0);

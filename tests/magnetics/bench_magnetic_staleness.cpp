@@ -75,6 +75,7 @@ public:
     settings.refresh_interval = 0.0;
     settings.staleness_mode = StalenessMode::absolute;
     settings.tolerance = 1e-6;
+    settings.hold_dipoles = false; // (the reference solves; nothing is held between samples)
     fresh_ = std::make_unique<InducedDipoles>(settings, box);
     live_ = std::make_unique<InducedDipoles>(settings, box);
     for (const Population &p : c.populations)

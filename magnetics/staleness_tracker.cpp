@@ -34,6 +34,7 @@ void StalenessTracker::evaluated_all(const BeadArrays &beads, double time)
 
 void StalenessTracker::evaluated(const BeadArrays &beads, std::size_t b)
 {
+  forget_pair_pass();
   x_last_.resize(3 * beads.n);
   x_last_[3 * b] = beads.x[b];
   x_last_[3 * b + 1] = beads.y[b];
@@ -42,6 +43,7 @@ void StalenessTracker::evaluated(const BeadArrays &beads, std::size_t b)
 
 void StalenessTracker::watch_close_pairs(const BeadArrays &beads, const NearPairs &near, double skin)
 {
+  forget_pair_pass();
   const auto &pairs = near.pairs();
   close_.clear();
   close_of_pair_.assign(pairs.size(), -1);
@@ -71,6 +73,7 @@ void StalenessTracker::watch_pair(const BeadArrays &beads, const NearPairs &near
 void StalenessTracker::admit(const BeadArrays &beads, std::size_t first, const NearPairs &near,
                              std::size_t first_pair, double skin, const std::vector<std::uint32_t> &inert)
 {
+  forget_pair_pass();
   limit2_.resize(beads.n);
   inv_radius2_.resize(beads.n);
   for (std::size_t b = first; b < beads.n; ++b)
@@ -86,9 +89,11 @@ void StalenessTracker::admit(const BeadArrays &beads, std::size_t first, const N
     return;
   const auto &begin = near.list().incident_begin();
   const auto &pair_of = near.list().incident_pair();
+  // (An inert bead's pairs include those a newcomer just formed with it, k ≥ first_pair,
+  // which are not watched yet: watch_pair() below skips them as inert.)
   for (const std::uint32_t b : inert)
     for (std::size_t q = begin[b]; q < begin[b + 1]; ++q)
-      if (close_of_pair_[pair_of[q]] >= 0)
+      if (pair_of[q] < first_pair && close_of_pair_[pair_of[q]] >= 0)
         close_[static_cast<std::size_t>(close_of_pair_[pair_of[q]])].limit2 = std::numeric_limits<double>::infinity();
   close_of_pair_.resize(near.pairs().size(), -1);
   for (std::size_t k = first_pair; k < near.pairs().size(); ++k)
@@ -97,6 +102,7 @@ void StalenessTracker::admit(const BeadArrays &beads, std::size_t first, const N
 
 void StalenessTracker::pair_reevaluated(const NearPairs &near, std::size_t k)
 {
+  forget_pair_pass();
   if (close_of_pair_.size() != near.pairs().size() || close_of_pair_[k] < 0)
     return;
   ClosePair &c = close_[static_cast<std::size_t>(close_of_pair_[k])];
@@ -124,8 +130,9 @@ StalenessCheck StalenessTracker::check(const BeadArrays &beads, double time, boo
   const bool relative = settings_.staleness_mode == StalenessMode::relative && list_current;
   if (relative)
     move2_.resize(beads.n);
+  const bool since_pass = relative && pass_margin_ > 0.0 && x_pass_.size() == 3 * beads.n;
   std::size_t stale = 0;
-  double worst2 = 0.0;
+  double worst2 = 0.0, pass_move2 = 0.0;
   for (std::size_t b = 0; b < beads.n; ++b)
   {
     const double move2 = squared_move(beads, b);
@@ -133,12 +140,21 @@ StalenessCheck StalenessTracker::check(const BeadArrays &beads, double time, boo
     worst2 = std::max(worst2, move2 * inv_radius2_[b]);
     if (relative)
       move2_[b] = move2;
+    if (since_pass) // (no minimum image: a wrapped bead's jump forces the pass, as it must)
+    {
+      const double d[3] = {beads.x[b] - x_pass_[3 * b], beads.y[b] - x_pass_[3 * b + 1],
+                           beads.z[b] - x_pass_[3 * b + 2]};
+      pass_move2 = std::max(pass_move2, d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    }
   }
   c.stale_beads = stale;
   c.max_move = std::sqrt(worst2);
-  // relative: a pair can only be stale if one of its beads moved half its limit: the pair
-  // loop is skipped while no bead has.
-  if (relative && 2.0 * c.max_move * max_radius_ > settings_.staleness_fraction * min_radius_)
+  // relative: a pair can only be stale if one of its beads moved half its limit since its
+  // evaluation, or if twice the largest move since the last pass used up the margin that
+  // pass left (the header). Otherwise the pass is skipped: it would count no pair.
+  const bool some_bead_moved = 2.0 * c.max_move * max_radius_ > settings_.staleness_fraction * min_radius_;
+  const bool margin_used = !since_pass || 4.0 * pass_move2 >= pass_margin_ * pass_margin_ * (1.0 - 1e-9);
+  if (relative && some_bead_moved && margin_used)
     c.stale_pairs = count_stale_pairs(beads);
   if (stale > 0 || c.stale_pairs > 0)
     c.reason = RefreshReason::moved;
@@ -147,11 +163,29 @@ StalenessCheck StalenessTracker::check(const BeadArrays &beads, double time, boo
 
 std::size_t StalenessTracker::count_stale_pairs(const BeadArrays &beads) const
 {
-  // Pairs of beads that have not moved half the pair's limit are skipped.
+  // Pairs of beads that have not moved half the pair's limit are not counted. Every pair's
+  // drift is measured all the same, for the margin: |Δr| ≤ sqrt(worst) L_p for the largest
+  // ratio worst = |Δr|² / L_p², so each pair is at least (1 − sqrt(worst)) L_min from its
+  // limit L_p ≥ L_min (one square root per pass, none per pair).
+  ++pair_passes_;
   std::size_t stale_pairs = 0;
+  double worst = 0.0, min_limit2 = std::numeric_limits<double>::infinity();
   for (const ClosePair &p : close_)
+  {
+    const double d2 = drift2(beads, p);
     if (4.0 * std::max(move2_[p.i], move2_[p.j]) > p.limit2)
-      stale_pairs += drift2(beads, p) > p.limit2;
+      stale_pairs += d2 > p.limit2;
+    worst = std::max(worst, d2 / p.limit2);
+    min_limit2 = std::min(min_limit2, p.limit2);
+  }
+  pass_margin_ = std::isfinite(min_limit2) ? (1.0 - std::sqrt(worst)) * std::sqrt(min_limit2) : -1.0;
+  x_pass_.resize(3 * beads.n);
+  for (std::size_t b = 0; b < beads.n; ++b)
+  {
+    x_pass_[3 * b] = beads.x[b];
+    x_pass_[3 * b + 1] = beads.y[b];
+    x_pass_[3 * b + 2] = beads.z[b];
+  }
   return stale_pairs;
 }
 
@@ -167,6 +201,7 @@ double StalenessTracker::squared_move(const BeadArrays &beads, std::size_t b) co
 
 void StalenessTracker::particles_reordered(const std::vector<std::int32_t> &order)
 {
+  forget_pair_pass();
   if (x_last_.size() == 3 * order.size())
   {
     const std::vector<double> old(x_last_);
@@ -192,6 +227,7 @@ void StalenessTracker::write_state(StateOut &out) const
 
 void StalenessTracker::read_state(StateIn &in)
 {
+  forget_pair_pass();
   in.get_array(x_last_);
   t_last_ = in.get<double>();
   in.get_array(limit2_);

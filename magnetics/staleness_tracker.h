@@ -15,7 +15,12 @@
 //                        moved absolute_factor times that.
 // Moves are minimum-image along periodic axes: a bead wrapped by the caller did not move.
 // A check costs one pass over the beads; the relative mode reads its watched pairs only
-// once some bead has moved half the limit (|Δr| ≤ |Δx_i| + |Δx_j|).
+// when one could be stale. |Δr| ≤ |Δx_i| + |Δx_j| bounds a pair's drift by its beads' moves
+// twice: since the pair's evaluation (no bead moved half the limit: no pair is stale), and
+// since the last pass over the pairs (their largest drift then plus twice the largest bead
+// move since is still below the limit). The second bound is what holds in a brush carried
+// along by the sleeve, where every bead soon moves half the limit but the pairs barely drift.
+// Both only skip work: the verdict is the pass's own.
 #pragma once
 
 #include "common/state_stream.h"
@@ -82,6 +87,8 @@ public:
   double squared_move(const BeadArrays &beads, std::size_t b) const;
   double limit2(std::size_t b) const { return limit2_[b]; }
   const std::vector<ClosePair> &close_pairs() const { return close_; }
+  // How many checks read the watched pairs (the rest were decided by the bead moves alone).
+  std::size_t pair_passes() const { return pair_passes_; }
   // relative: |Δr|² of a watched pair since its tensor was evaluated [m²].
   static double drift2(const BeadArrays &beads, const ClosePair &c)
   {
@@ -108,11 +115,19 @@ private:
   std::vector<std::int32_t> close_of_pair_; // the record of near pair k (−1 = not watched)
   double min_radius_ = 0.0, max_radius_ = 0.0;
   mutable std::vector<double> move2_; // per-check scratch: |Δx_b|²
+  // The last pass over the watched pairs: the bead positions then, and a lower bound on every
+  // pair's distance from its limit then [m] (< 0: no valid pass; anything that changes the
+  // watched pairs or their references invalidates it). A cache of check(), hence mutable.
+  mutable std::vector<double> x_pass_;
+  mutable double pass_margin_ = -1.0;
+  mutable std::size_t pair_passes_ = 0;
+  void forget_pair_pass() { pass_margin_ = -1.0; }
 
   // Bead b's limit on its absolute move [m]: staleness_fraction × radius, times
   // absolute_factor in the relative mode.
   double move_limit(const BeadArrays &beads, std::size_t b) const;
   void watch_pair(const BeadArrays &beads, const NearPairs &near, std::size_t k, double skin);
+  // Counts the stale watched pairs and records the pass (x_pass_, pass_margin_).
   std::size_t count_stale_pairs(const BeadArrays &beads) const;
 };
 

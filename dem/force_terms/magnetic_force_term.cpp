@@ -177,6 +177,21 @@ void MagneticForceTerm::full_refresh(const BeadArrays &beads, double t, double r
   ++evaluations_;
 }
 
+std::string MagneticForceTerm::cost_note() const
+{
+  const RefreshCounts &c = counts_;
+  char line[640];
+  std::snprintf(line, sizeof line,
+                "%ld full evaluations: %ld interval, %ld moved (lists expired %ld, region too large %ld), "
+                "%ld first or new set; %ld list rebuilds; %ld local refreshes; %ld admissions. "
+                "Time: full %.3g s (lists %.2g, tensors %.2g, far field %.2g, sweeps %.2g, forces %.2g), "
+                "local %.3g s, admissions %.3g s, live pairs %.3g s, checks %.3g s",
+                c.first + c.interval + c.moved, c.interval, c.moved, c.moved_lists, c.moved_region, c.first,
+                c.rebuilds, local_refreshes_, c.admitted, c.full_s, c.lists_s, c.tensors_s, c.far_s, c.sweeps_s,
+                c.forces_s, c.local_s, c.admit_s, c.live_s, c.check_s);
+  return line;
+}
+
 void MagneticForceTerm::add_forces(const dem::ParticleState &state, dem::ForceBuffers &forces,
                                    double t)
 {
@@ -782,6 +797,7 @@ void MagneticForceTerm::read_state(dem::CheckpointReader &in)
     counts.admit_s = block.get<double>();
     counts.admit_region_beads = block.get<long>();
   }
+
   state_size_ = static_cast<std::size_t>(state_size);
   carrier_ = std::move(carrier);
   newcomers_ = std::move(newcomers);

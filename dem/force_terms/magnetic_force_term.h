@@ -49,6 +49,10 @@ public:
                     const std::array<double, 3> &box, bool slab_tail = true);
 
   const char *name() const override { return "magnetic dipoles"; }
+  // For the engine's log, under the term's time: how often the magnetics were evaluated and
+  // why, and where their time went (full evaluations by phase, local refreshes, admissions,
+  // the close pairs' live forces, the staleness checks).
+  std::string cost_note() const override;
   void add_forces(const dem::ParticleState &state, dem::ForceBuffers &forces, double t) override;
   void particles_reordered(const std::vector<std::int32_t> &order) override;
   // Checkpoint: the carrier selection and order, the unwrapped positions, the held forces and

@@ -380,6 +380,59 @@ TEST(RefreshModes, StalePairCountEqualsAPassOverEveryWatchedPair)
   }
 }
 
+// The same guard for the skip that matters in a flowing brush: the whole brush carried along
+// (every bead soon past half its limit) while the pairs drift slowly apart, one small step at a
+// time. After a pass over the pairs, the next one waits until twice the largest bead move
+// since could have used up the margin the pass left; the count must still equal a plain pass
+// at every step, and most steps must skip the pass.
+TEST(RefreshModes, CarriedBrushSkipsThePairPassWithoutMissingAStalePair)
+{
+  const double L = 0.9e-3;
+  Beads beads = standing_brush(75, L, 11);
+  MagneticSettings s = exact_settings(StalenessMode::relative);
+  s.staleness_fraction = 0.2;
+  const std::array<double, 3> box = {L, 0.0, L};
+  NearPairs near;
+  const double skin = 0.3 * 2.0 * a;
+  near.list().build(beads.size(), beads.x.data(), beads.y.data(), beads.z.data(), box, 8.0 * a + skin);
+  near.evaluate_tensors(beads.arrays(), 8.0 * a);
+  StalenessTracker tracker(s, box);
+  tracker.evaluated_all(beads.arrays(), 0.0);
+  tracker.watch_close_pairs(beads.arrays(), near, skin);
+  const int steps = 400;
+  int refreshes = 0;
+  for (int step = 1; step <= steps; ++step)
+  {
+    // Carried by 0.5 % of a radius per step along y (no wrap: y is open), and each bead
+    // drifting on its own by up to 0.05 % of a radius per step in x and z.
+    for (std::size_t k = 0; k < beads.size(); ++k)
+    {
+      beads.y[k] += 5e-3 * beads.r[k];
+      beads.x[k] += 5e-4 * beads.r[k] * std::sin(1.7 * k);
+      beads.z[k] += 5e-4 * beads.r[k] * std::cos(2.3 * k);
+    }
+    const StalenessCheck c = tracker.check(beads.arrays(), 1e-6, true);
+    std::size_t every = 0;
+    for (const StalenessTracker::ClosePair &p : tracker.close_pairs())
+      every += StalenessTracker::drift2(beads.arrays(), p) > p.limit2;
+    ASSERT_EQ(c.stale_pairs, every) << "step " << step;
+    if (every == 0)
+      continue;
+    // A refresh: every pair's tensor and every bead's reference renewed (as a full
+    // evaluation that keeps its lists does).
+    ++refreshes;
+    near.evaluate_tensors(beads.arrays(), 8.0 * a);
+    tracker.evaluated_all(beads.arrays(), 0.0);
+    tracker.watch_close_pairs(beads.arrays(), near, skin);
+  }
+  std::printf("carried brush: %zu pair passes in %d checks, %d refreshes for stale pairs\n",
+              tracker.pair_passes(), steps, refreshes);
+  EXPECT_GE(refreshes, 2) << "the drift must reach the limit more than once";
+  // Passing over the pairs whenever some bead moved half its limit since its evaluation (the
+  // skip before) passes at ~80 % of these checks.
+  EXPECT_LT(tracker.pair_passes(), static_cast<std::size_t>(0.4 * steps));
+}
+
 // InducedDipoles::forces_of_dipoles: the forces of given dipoles at given positions, no solve.
 // (1) At the positions they were solved at, the solved dipoles give the solve's forces. (2) After
 // every bead of a periodic brush is shaken by up to 5 % of its radius, the held dipoles'

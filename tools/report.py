@@ -123,8 +123,12 @@ def sump_row(flow):
     must stay constant, whatever leaves returning to the sump."""
     if not flow or not flow.get("sump_mass_kg") or not flow.get("time_s"):
         return None
-    totals = [float(p) + float(s) for p, s in zip(flow["present_mass_kg"], flow["sump_mass_kg"])]
-    if totals[0] <= 0.0 or float(flow["sump_mass_kg"][0]) == 0.0 and float(flow["sump_mass_kg"][-1]) == 0.0:
+    stock = [float(s) for s in flow["sump_mass_kg"]]
+    # (The engine writes nan without a finite sump: inflow.supply fixed, or an unlimited sump.)
+    if not all(math.isfinite(s) for s in stock) or stock[0] == 0.0 and stock[-1] == 0.0:
+        return None
+    totals = [float(p) + s for p, s in zip(flow["present_mass_kg"], stock)]
+    if totals[0] <= 0.0:
         return None
     worst = max(abs(t - totals[0]) for t in totals) / totals[0]
     return ("developer in the scene + the sump", f"{totals[0]:.6g} kg → {totals[-1]:.6g} kg",

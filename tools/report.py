@@ -102,7 +102,19 @@ def steady_state_rows(run_summary):
     note = f"drift: {worst}"
     if math.isfinite(resolution):
         note += f"; this window resolves drifts down to {100 * resolution:.1f} % (2 standard errors)"
+        tolerance = drift_tolerance(verdict["meaning"])
+        if not reached and trend == "0" and math.isfinite(tolerance) and resolution > tolerance:
+            # Block standard errors fall as 1/sqrt(window): (resolution / tolerance)² windows.
+            note += (f"; to decide at {100 * tolerance:g} % average over ~{(resolution / tolerance) ** 2:.1f}× "
+                     "this window (a longer run, or a deeper slab)")
     return [("steady state", state, verdict["meaning"], note)]
+
+
+def drift_tolerance(meaning):
+    """The steady-state tolerance from the verdict's text ("... drift < 2 % between ..."), as a
+    fraction; nan when the text does not state it."""
+    m = re.search(r"drift < ([0-9.]+) %", meaning)
+    return float(m.group(1)) / 100.0 if m else float("nan")
 
 
 def budget_row(flow):

@@ -141,6 +141,29 @@ void fresh_forces(const Beads &b, const MagneticSettings &s, const std::array<do
   fz = copy.fz;
 }
 
+// The watched pairs of a ~900-bead periodic standing brush, as a full evaluation leaves them:
+// the near list within 8 radii + a 0.3-diameter skin, its tensors, every bead's reference.
+struct WatchedBrush
+{
+  static constexpr double L = 0.9e-3;
+  Beads beads = standing_brush(75, L, 11);
+  NearPairs near;
+  StalenessTracker tracker;
+  const double skin = 0.3 * 2.0 * a;
+  explicit WatchedBrush(const MagneticSettings &s) : tracker(s, {L, 0.0, L})
+  {
+    near.list().build(beads.size(), beads.x.data(), beads.y.data(), beads.z.data(), {L, 0.0, L}, 8.0 * a + skin);
+    evaluate();
+  }
+  // Every pair's tensor and every bead's reference renewed at the current positions.
+  void evaluate()
+  {
+    near.evaluate_tensors(beads.arrays(), 8.0 * a);
+    tracker.evaluated_all(beads.arrays(), 0.0);
+    tracker.watch_close_pairs(beads.arrays(), near, skin);
+  }
+};
+
 } // namespace
 
 TEST(RefreshModes, RigidTranslationTriggersOnlyTheAbsoluteCriterion)
@@ -350,17 +373,9 @@ TEST(RefreshModes, RampRescalesTheHeldStateExactly)
 // in a fixed pattern (many past half a limit, some pairs past it), three times over.
 TEST(RefreshModes, StalePairCountEqualsAPassOverEveryWatchedPair)
 {
-  const double L = 0.9e-3;
-  Beads beads = standing_brush(75, L, 11);
-  MagneticSettings s = exact_settings(StalenessMode::relative);
-  const std::array<double, 3> box = {L, 0.0, L};
-  NearPairs near;
-  const double skin = 0.3 * 2.0 * a;
-  near.list().build(beads.size(), beads.x.data(), beads.y.data(), beads.z.data(), box, 8.0 * a + skin);
-  near.evaluate_tensors(beads.arrays(), 8.0 * a);
-  StalenessTracker tracker(s, box);
-  tracker.evaluated_all(beads.arrays(), 0.0);
-  tracker.watch_close_pairs(beads.arrays(), near, skin);
+  WatchedBrush w(exact_settings(StalenessMode::relative));
+  Beads &beads = w.beads;
+  StalenessTracker &tracker = w.tracker;
   for (int round = 0; round < 3; ++round)
   {
     for (std::size_t k = 0; k < beads.size(); ++k)
@@ -387,18 +402,11 @@ TEST(RefreshModes, StalePairCountEqualsAPassOverEveryWatchedPair)
 // at every step, and most steps must skip the pass.
 TEST(RefreshModes, CarriedBrushSkipsThePairPassWithoutMissingAStalePair)
 {
-  const double L = 0.9e-3;
-  Beads beads = standing_brush(75, L, 11);
   MagneticSettings s = exact_settings(StalenessMode::relative);
   s.staleness_fraction = 0.2;
-  const std::array<double, 3> box = {L, 0.0, L};
-  NearPairs near;
-  const double skin = 0.3 * 2.0 * a;
-  near.list().build(beads.size(), beads.x.data(), beads.y.data(), beads.z.data(), box, 8.0 * a + skin);
-  near.evaluate_tensors(beads.arrays(), 8.0 * a);
-  StalenessTracker tracker(s, box);
-  tracker.evaluated_all(beads.arrays(), 0.0);
-  tracker.watch_close_pairs(beads.arrays(), near, skin);
+  WatchedBrush w(s);
+  Beads &beads = w.beads;
+  StalenessTracker &tracker = w.tracker;
   const int steps = 400;
   int refreshes = 0;
   for (int step = 1; step <= steps; ++step)
@@ -421,9 +429,7 @@ TEST(RefreshModes, CarriedBrushSkipsThePairPassWithoutMissingAStalePair)
     // A refresh: every pair's tensor and every bead's reference renewed (as a full
     // evaluation that keeps its lists does).
     ++refreshes;
-    near.evaluate_tensors(beads.arrays(), 8.0 * a);
-    tracker.evaluated_all(beads.arrays(), 0.0);
-    tracker.watch_close_pairs(beads.arrays(), near, skin);
+    w.evaluate();
   }
   std::printf("carried brush: %zu pair passes in %d checks, %d refreshes for stale pairs\n",
               tracker.pair_passes(), steps, refreshes);

@@ -1,5 +1,6 @@
-"""Rows of the run report (tools/report.py) from synthetic measurement files: the particle
-budget and the closed sump of a fed scene. Stdlib only, so any Python 3 runs it."""
+"""Rows of the run report (tools/report.py) from synthetic measurement files: the steady-state
+verdict, the particle budget and the closed sump of a fed scene. Stdlib only, so any Python 3
+runs it."""
 
 import math
 import os
@@ -33,6 +34,34 @@ class SumpRow(unittest.TestCase):
     def test_a_leak_is_reported(self):
         f = flow([10, 11], [0, 3], [0, 2], [1e-6, 1.1e-6], [2e-6, 2.0e-6])
         self.assertTrue(report.sump_row(f)[3].startswith("NOT conserved"))
+
+
+def summary(drift_nf, se_nf, resolution, significant, reached):
+    """dem/summary.csv rows as report.py reads them (one tested mean)."""
+    return [{"key": "normal_force_per_length_N_m", "value": "0.53", "drift": repr(drift_nf),
+             "drift_standard_error": repr(se_nf), "meaning": "normal force"},
+            {"key": "steady_state", "value": "1" if reached else "0", "drift": "nan",
+             "meaning": f"{1 if reached else 0} of 1 tested means drift < 2 % between the halves of their window"},
+            {"key": "significant_drift", "value": "1" if significant else "0", "drift": "nan", "meaning": ""},
+            {"key": "drift_resolution", "value": repr(resolution), "drift": "nan", "meaning": ""}]
+
+
+class SteadyStateRow(unittest.TestCase):
+    def test_undecided_says_how_much_longer(self):
+        # Resolution 4 % against a 2 % tolerance: block errors fall as 1/sqrt(window), so 4x.
+        row = report.steady_state_rows(summary(0.025, 0.017, 0.04, False, False))[0]
+        self.assertTrue(row[1].startswith("undecided"), row)
+        self.assertIn("~4.0× this window", row[3])
+
+    def test_a_trend_is_not_a_matter_of_samples(self):
+        row = report.steady_state_rows(summary(0.10, 0.02, 0.04, True, False))[0]
+        self.assertTrue(row[1].startswith("NOT reached"), row)
+        self.assertNotIn("this window (a longer run", row[3])
+
+    def test_reached_needs_no_advice(self):
+        row = report.steady_state_rows(summary(0.005, 0.004, 0.008, False, True))[0]
+        self.assertEqual(row[1], "reached")
+        self.assertNotIn("× this window", row[3])
 
 
 class BudgetRow(unittest.TestCase):

@@ -797,7 +797,6 @@ void MagneticForceTerm::read_state(dem::CheckpointReader &in)
     counts.admit_s = block.get<double>();
     counts.admit_region_beads = block.get<long>();
   }
-
   state_size_ = static_cast<std::size_t>(state_size);
   carrier_ = std::move(carrier);
   newcomers_ = std::move(newcomers);

@@ -1,5 +1,5 @@
 """Rows of the run report (tools/report.py) from synthetic measurement files: the steady-state
-verdict, the particle budget and the closed sump of a fed scene. Stdlib only, so any Python 3
+verdict, the particle budget and the closed sump of a fed scene, the nip window's budget. Stdlib only, so any Python 3
 runs it."""
 
 import math
@@ -72,6 +72,21 @@ class BudgetRow(unittest.TestCase):
     def test_a_lost_particle_shows(self):
         f = flow([10, 10], [0, 3], [0, 2], [1e-6, 1.1e-6], [math.nan, math.nan])
         self.assertEqual(report.budget_row(f)[3], "NOT conserved")
+
+
+def nip_series(inside, entered, left):
+    return {"time_s": ["0", "1e-3"], "in_window": [str(v) for v in inside],
+            "entered": ["0", str(entered)], "left": ["0", str(left)]}
+
+
+class WindowBudgetRow(unittest.TestCase):
+    def test_a_window_between_inflow_and_outflow_closes(self):
+        self.assertEqual(report.window_budget_row(nip_series([3765, 3911], 3626, 3480))[3], "holds")
+
+    def test_an_outflow_inside_the_window_shows(self):
+        # 20 beads removed inside the window never crossed its downstream edge.
+        row = report.window_budget_row(nip_series([3765, 3891], 3626, 3480))
+        self.assertTrue(row[3].startswith("does NOT hold (off by -20)"), row)
 
 
 if __name__ == "__main__":

@@ -47,6 +47,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -90,6 +91,14 @@ public:
 
   void sample(const dem::DemSystem &system) override
   {
+    if (!started_) // the window's counters start here (a restored term brings the settling's)
+    {
+      started_ = true;
+      start_time_ = system.time();
+      start_counts_ = term_->refresh_counts();
+      start_full_ = term_->evaluations();
+      start_local_ = term_->local_refreshes();
+    }
     const auto &s = system.particles();
     std::vector<double> hx, hy, hz;
     term_->last_forces(hx, hy, hz);
@@ -185,6 +194,11 @@ public:
   }
 
   long samples_ = 0;
+  // The term's counters at the first sample, and its time: the table counts from there.
+  bool started_ = false;
+  double start_time_ = 0.0;
+  MagneticForceTerm::RefreshCounts start_counts_;
+  long start_full_ = 0, start_local_ = 0;
   double sum_rms_ = 0, sum_max_ = 0, sum_wall_ = 0, max_rms_ = 0, max_max_ = 0, max_wall_ = 0;
   double sum_live_rms_ = 0, sum_live_max_ = 0, max_live_rms_ = 0;
 
@@ -224,6 +238,27 @@ struct ModeResult
   double mean_rms = 0, mean_max = 0, mean_wall = 0, max_rms = 0, max_max = 0, max_wall = 0;
   double mean_live_rms = 0, mean_live_max = 0, max_live_rms = 0; // held dipoles, live geometry
 };
+
+// The counts accumulated between two readings of a term's counters.
+MagneticForceTerm::RefreshCounts since(const MagneticForceTerm::RefreshCounts &now,
+                                       const MagneticForceTerm::RefreshCounts &then)
+{
+  using Counts = MagneticForceTerm::RefreshCounts;
+  const std::array<long Counts::*, 11> counts = {&Counts::first, &Counts::interval, &Counts::moved,
+                                                 &Counts::zero_field, &Counts::region_beads, &Counts::rebuilds,
+                                                 &Counts::moved_lists, &Counts::moved_region, &Counts::set_changed,
+                                                 &Counts::admitted, &Counts::admit_region_beads};
+  const std::array<double Counts::*, 10> seconds = {&Counts::full_s, &Counts::local_s, &Counts::check_s,
+                                                    &Counts::lists_s, &Counts::tensors_s, &Counts::far_s,
+                                                    &Counts::sweeps_s, &Counts::forces_s, &Counts::admit_s,
+                                                    &Counts::live_s};
+  Counts d = now;
+  for (const auto m : counts)
+    d.*m -= then.*m;
+  for (const auto m : seconds)
+    d.*m -= then.*m;
+  return d;
+}
 
 // One run of `c` (fresh, or from `restart`) to its dem.duration with the magnetics in `mode`.
 ModeResult run_mode(Case c, const std::string &mode, const std::string &restart, const fs::path &dir,
@@ -292,10 +327,15 @@ ModeResult run_mode(Case c, const std::string &mode, const std::string &restart,
   run.run();
   ModeResult r;
   r.mode = mode;
-  r.simulated_ms = (c.dem.duration - t0) * 1e3;
-  r.full = term->evaluations();
-  r.local = term->local_refreshes();
-  r.counts = term->refresh_counts();
+  // The counters from the first sample on: a term restored from the settling run's checkpoint
+  // (the mode it was written under) brings that run's counts along. The cold first evaluation
+  // is this run's only when the term started afresh.
+  const double from = error->started_ ? error->start_time_ : t0;
+  r.simulated_ms = (c.dem.duration - from) * 1e3;
+  r.full = term->evaluations() - error->start_full_;
+  r.local = term->local_refreshes() - error->start_local_;
+  r.counts = since(term->refresh_counts(), error->start_counts_);
+  r.counts.cold_s = term->restored_state() ? 0.0 : term->refresh_counts().cold_s;
   const dem::PhaseTimes p = system.phase_times();
   for (std::size_t k = 0; k < system.force_terms().size(); ++k)
     (system.force_terms()[k].get() == term ? r.magnetic_s : r.rest_s) += p.terms[k];

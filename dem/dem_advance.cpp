@@ -10,8 +10,10 @@
 //   ── barrier P ──      every pair force is in its slot
 //   column sums         −F of the pairs where the particle is the partner   static share
 //   wall contacts       cylinders, planes, prisms                           static share
-//   force terms         gravity, drag: inside the team (static share); magnetics, ...: a
-//                       serial call outside the team (they parallelise themselves)
+//   force terms         gravity, drag: inside the team (static share); magnetics, ...:
+//                       inside the team on the steps where they hold their forces
+//                       (shared loops), else a serial call outside the team (they
+//                       parallelise themselves)
 //   final kick          v += (dt/2) F/m                                      static share
 //
 // When the team goes straight on to the next step, the final kick and the next step's kick
@@ -156,7 +158,7 @@ void DemSystem::advance_steps(long steps)
       from = Resume::contacts;
       break;
     case Pause::force_terms: // contacts and team terms done; the others add theirs, then the final kick
-      for (std::size_t t = team_terms_; t < terms_.size(); ++t)
+      for (std::size_t t = serial_from_; t < terms_.size(); ++t)
       {
         PhaseTimer timer(times_.terms[t]);
         terms_[t]->add_forces(particles_, forces_, time_);
@@ -182,7 +184,6 @@ DemSystem::Pause DemSystem::run_team(long &steps_left, Resume from)
 {
   Pause why = Pause::done;
   long left_at_exit = steps_left;
-  const bool serial_terms = team_terms_ < terms_.size();
 #pragma omp parallel if (parallel())
   {
     PhaseClock clock;
@@ -238,8 +239,17 @@ DemSystem::Pause DemSystem::run_team(long &steps_left, Resume from)
           terms_[t]->add_forces_in_team(particles_, forces_, time_);
           clock.charge(times_.terms[t]);
         }
-        if (serial_terms) // the caller runs them and resumes at the final kick
+        // The other terms in order, inside the team while each can hold its forces; from
+        // the first that cannot, the caller runs them and resumes at the final kick.
+        std::size_t serial_from = team_terms_;
+        while (serial_from < terms_.size() &&
+               terms_[serial_from]->add_forces_in_team_if_held(particles_, forces_, time_))
+          clock.charge(times_.terms[serial_from++]);
+        if (serial_from < terms_.size())
         {
+          clock.charge(times_.terms[serial_from]); // (what it did before it gave up)
+#pragma omp master
+          serial_from_ = serial_from;
           stop = Pause::force_terms;
           break;
         }

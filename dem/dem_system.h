@@ -182,6 +182,7 @@ private:
   };
   std::vector<StepFlags> thread_flags_; // one per thread of the team
   std::size_t team_terms_ = 0;           // leading force terms that run inside the team
+  std::size_t serial_from_ = 0;          // this step's first force term that runs outside the team
   // Where a team (re)starts within a step, and why it stopped.
   enum class Resume { step_start, contacts, final_kick };
   enum class Pause { done, rebuild, force_terms, energy_guard, alarm };

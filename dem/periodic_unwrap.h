@@ -14,6 +14,14 @@
 
 namespace magbrush::dem {
 
+// The image of the engine coordinate `raw` nearest to the previous unwrapped coordinate
+// `last`, along an axis of period L (0: not periodic, `raw` itself).
+inline double nearest_image(double raw, double last, double L)
+{
+  const double jump = last - raw; // a multiple of L after a wrap, else a step's move
+  return (L > 0.0 && std::abs(jump) > 0.5 * L) ? raw + L * std::round(jump / L) : raw;
+}
+
 // unwrapped[d][k] ← the image of the engine coordinate d of particle index[k] nearest to
 // unwrapped[d][k] (d = x, y, z; a box length of 0 means not periodic: the engine coordinate).
 inline void follow_unwrapped(const ParticleState &state, const std::vector<std::uint32_t> &index,
@@ -27,11 +35,7 @@ inline void follow_unwrapped(const ParticleState &state, const std::vector<std::
     double *to = unwrapped[d]->data();
     if (L > 0.0)
       for (std::size_t k = 0; k < index.size(); ++k)
-      {
-        const double raw = from[index[k]];
-        const double jump = to[k] - raw; // a multiple of L after a wrap, else a step's move
-        to[k] = std::abs(jump) > 0.5 * L ? raw + L * std::round(jump / L) : raw;
-      }
+        to[k] = nearest_image(from[index[k]], to[k], L);
     else
       for (std::size_t k = 0; k < index.size(); ++k)
         to[k] = from[index[k]];

@@ -512,11 +512,23 @@ StalenessCheck InducedDipoles::check_staleness(const BeadArrays &beads, double t
   return staleness_.check(beads, time, list.built() && list.particle_count() == beads.n);
 }
 
+bool InducedDipoles::live_pairs_held(const BeadArrays &beads) const
+{
+  return settings_.hold_dipoles && live_.size() > 0 && p_.size() == 3 * beads.n && B_local_.size() == 3 * beads.n;
+}
+
 const std::vector<double> *InducedDipoles::live_pair_changes(const BeadArrays &beads)
 {
-  if (!settings_.hold_dipoles || live_.size() == 0 || p_.size() != 3 * beads.n || B_local_.size() != 3 * beads.n)
+  if (!live_pairs_held(beads))
     return nullptr;
   return &live_.update({beads, beta_, B_local_, p_}, near_, live_correction());
+}
+
+const std::vector<double> *InducedDipoles::live_pair_changes_in_team(const BeadArrays &beads)
+{
+  if (!live_pairs_held(beads))
+    return nullptr;
+  return &live_.update_in_team({beads, beta_, B_local_, p_}, near_, live_correction());
 }
 
 void InducedDipoles::add_live_pair_changes(const BeadArrays &beads, const ForceArrays &out)

@@ -101,6 +101,8 @@ public:
   // interval has elapsed since the last compute(), or some bead moved more than
   // staleness_fraction × its radius since its force was evaluated (minimum image: a
   // periodic wrap is no move). check_staleness() says which, and how many beads moved.
+  // check_staleness() may be called by every thread of a team (its passes are shared, all
+  // get the verdict) or by one thread outside a parallel region.
   bool needs_refresh(const BeadArrays &beads, double time) const;
   StalenessCheck check_staleness(const BeadArrays &beads, double time) const;
 
@@ -111,6 +113,8 @@ public:
   // dipoles (live_pairs.h); null when nothing is live. `beads` = the held state's beads.
   // Call once per step: the changes are evaluated every live_pair_steps calls.
   const std::vector<double> *live_pair_changes(const BeadArrays &beads);
+  // The same, called by every thread of a team (the passes shared with `omp for`).
+  const std::vector<double> *live_pair_changes_in_team(const BeadArrays &beads);
   // The same, added to `out` (tests).
   void add_live_pair_changes(const BeadArrays &beads, const ForceArrays &out);
   std::size_t live_pairs() const { return live_.size(); }
@@ -261,6 +265,7 @@ private:
   void remember_evaluation(const BeadArrays &beads, double time);
   // hold_dipoles: the correction the live pairs apply (the `corrected` model's), or null.
   const TwoSphereCorrection *live_correction() const;
+  bool live_pairs_held(const BeadArrays &beads) const; // hold_dipoles, with live pairs for these beads
 
   // admit(), step by step.
   bool can_admit(const BeadArrays &beads, std::size_t first) const;

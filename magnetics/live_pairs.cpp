@@ -119,43 +119,59 @@ void LivePairs::rebase(const InducedState &s, const NearPairs &near, const TwoSp
 const std::vector<double> &LivePairs::update(const InducedState &s, const NearPairs &near,
                                              const TwoSphereCorrection *correction)
 {
-  const long n = static_cast<long>(pair_.size());
   // The changes are evaluated every `every_` calls (and at the first call after a rebase) and
   // held in between: in one step a pair moves ~10⁻⁴ of a radius, far below the staleness
   // limit that sets the dipoles' own refresh.
-  const bool evaluate = calls_ % every_ == 0;
-  ++calls_;
-  if (!evaluate)
-    return bead_change_;
-  const long nb = static_cast<long>(beads_);
-  bead_change_.resize(3 * beads_);
-#pragma omp parallel if (n >= static_cast<long>(bead_parallel_threshold))
+  if (due())
   {
-#pragma omp for schedule(static)
-    for (long m = 0; m < n; ++m)
-    {
-      double F[3];
-      pair_force(s, near, correction, static_cast<std::size_t>(m), F);
-      for (int d = 0; d < 3; ++d)
-        change_[3 * m + d] = F[d] - base_[3 * m + d];
-    }
-#pragma omp for schedule(static)
-    for (long b = 0; b < nb; ++b)
-    {
-      double f[3] = {0.0, 0.0, 0.0};
-      for (std::uint32_t e = start_[b]; e < start_[b + 1]; ++e)
-      {
-        const std::int32_t v = entry_[e];
-        const double sign = v > 0 ? 1.0 : -1.0;
-        const std::size_t m = static_cast<std::size_t>(v > 0 ? v - 1 : -v - 1);
-        for (int d = 0; d < 3; ++d)
-          f[d] += sign * change_[3 * m + d];
-      }
-      for (int d = 0; d < 3; ++d)
-        bead_change_[3 * b + d] = f[d];
-    }
+#pragma omp parallel if (pair_.size() >= bead_parallel_threshold)
+    evaluate_changes(s, near, correction);
   }
+  ++calls_;
   return bead_change_;
+}
+
+const std::vector<double> &LivePairs::update_in_team(const InducedState &s, const NearPairs &near,
+                                                     const TwoSphereCorrection *correction)
+{
+  if (due())
+    evaluate_changes(s, near, correction);
+  // (Every thread has read the count, in due(), before it advances.)
+#pragma omp barrier
+#pragma omp single nowait
+  ++calls_;
+  return bead_change_;
+}
+
+void LivePairs::evaluate_changes(const InducedState &s, const NearPairs &near, const TwoSphereCorrection *correction)
+{
+  const long n = static_cast<long>(pair_.size());
+  const long nb = static_cast<long>(beads_);
+#pragma omp single
+  bead_change_.resize(3 * beads_);
+#pragma omp for schedule(static)
+  for (long m = 0; m < n; ++m)
+  {
+    double F[3];
+    pair_force(s, near, correction, static_cast<std::size_t>(m), F);
+    for (int d = 0; d < 3; ++d)
+      change_[3 * m + d] = F[d] - base_[3 * m + d];
+  }
+#pragma omp for schedule(static)
+  for (long b = 0; b < nb; ++b)
+  {
+    double f[3] = {0.0, 0.0, 0.0};
+    for (std::uint32_t e = start_[b]; e < start_[b + 1]; ++e)
+    {
+      const std::int32_t v = entry_[e];
+      const double sign = v > 0 ? 1.0 : -1.0;
+      const std::size_t m = static_cast<std::size_t>(v > 0 ? v - 1 : -v - 1);
+      for (int d = 0; d < 3; ++d)
+        f[d] += sign * change_[3 * m + d];
+    }
+    for (int d = 0; d < 3; ++d)
+      bead_change_[3 * b + d] = f[d];
+  }
 }
 
 void LivePairs::scale(double ratio2)

@@ -52,6 +52,10 @@ public:
   // `steps`-th call since the last rebase and held in between (set_steps).
   const std::vector<double> &update(const InducedState &s, const NearPairs &near,
                                     const TwoSphereCorrection *correction);
+  // The same, called by EVERY thread of a team (the engine's, between its phases): the
+  // passes are shared with `omp for`; the same bits as update().
+  const std::vector<double> &update_in_team(const InducedState &s, const NearPairs &near,
+                                            const TwoSphereCorrection *correction);
   // The held state was scaled by the applied-field ratio (p, B ∝ ratio): base forces × ratio².
   void scale(double ratio2);
   void clear();
@@ -75,6 +79,10 @@ private:
   std::size_t beads_ = 0;
 
   void consider(const BeadArrays &beads, const NearPairs &near, std::size_t k, double reach_factor);
+  bool due() const { return calls_ % every_ == 0; }
+  // The changes at the current positions and each bead's sum: every thread of the current
+  // team (or one outside a parallel region) shares the passes.
+  void evaluate_changes(const InducedState &s, const NearPairs &near, const TwoSphereCorrection *correction);
   void build_incidence(const NearPairs &near);
   // The pair law at the current positions: the force on j of live pair m.
   void pair_force(const InducedState &s, const NearPairs &near, const TwoSphereCorrection *correction,

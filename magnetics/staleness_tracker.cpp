@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include <omp.h>
+
 namespace magbrush::magnetics {
 
 StalenessTracker::StalenessTracker(const MagneticSettings &settings, const std::array<double, 3> &box)
@@ -112,6 +114,10 @@ void StalenessTracker::pair_reevaluated(const NearPairs &near, std::size_t k)
 
 StalenessCheck StalenessTracker::check(const BeadArrays &beads, double time, bool list_current) const
 {
+  // (Every thread of the calling team runs this, or one thread outside a parallel region: the
+  // passes are shared with `omp for`, each thread keeps its partial results, and every thread
+  // combines them in thread order, so all return the same verdict on any number of threads.
+  // The early returns depend on shared data only: every thread takes them alike.)
   StalenessCheck c;
   if (x_last_.size() != 3 * beads.n)
   {
@@ -128,24 +134,37 @@ StalenessCheck StalenessTracker::check(const BeadArrays &beads, double time, boo
   // minimum image: a bead wrapped across a periodic face by the caller did not move (the
   // neighbour lists see the jump and are rebuilt at the next full evaluation).
   const bool relative = settings_.staleness_mode == StalenessMode::relative && list_current;
-  if (relative)
-    move2_.resize(beads.n);
   const bool since_pass = relative && pass_margin_ > 0.0 && x_pass_.size() == 3 * beads.n;
-  std::size_t stale = 0;
-  double worst2 = 0.0, pass_move2 = 0.0;
-  for (std::size_t b = 0; b < beads.n; ++b)
+#pragma omp single
   {
+    if (relative)
+      move2_.resize(beads.n);
+    partial_.assign(static_cast<std::size_t>(omp_get_num_threads()), CheckPartial());
+  }
+  CheckPartial &mine = partial_[static_cast<std::size_t>(omp_get_thread_num())];
+#pragma omp for schedule(static)
+  for (long bl = 0; bl < static_cast<long>(beads.n); ++bl)
+  {
+    const auto b = static_cast<std::size_t>(bl);
     const double move2 = squared_move(beads, b);
-    stale += move2 > limit2_[b];
-    worst2 = std::max(worst2, move2 * inv_radius2_[b]);
+    mine.stale += move2 > limit2_[b];
+    mine.worst2 = std::max(mine.worst2, move2 * inv_radius2_[b]);
     if (relative)
       move2_[b] = move2;
     if (since_pass) // (no minimum image: a wrapped bead's jump forces the pass, as it must)
     {
       const double d[3] = {beads.x[b] - x_pass_[3 * b], beads.y[b] - x_pass_[3 * b + 1],
                            beads.z[b] - x_pass_[3 * b + 2]};
-      pass_move2 = std::max(pass_move2, d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+      mine.pass_move2 = std::max(mine.pass_move2, d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
     }
+  }
+  std::size_t stale = 0;
+  double worst2 = 0.0, pass_move2 = 0.0;
+  for (const CheckPartial &p : partial_)
+  {
+    stale += p.stale;
+    worst2 = std::max(worst2, p.worst2);
+    pass_move2 = std::max(pass_move2, p.pass_move2);
   }
   c.stale_beads = stale;
   c.max_move = std::sqrt(worst2);
@@ -166,22 +185,38 @@ std::size_t StalenessTracker::count_stale_pairs(const BeadArrays &beads) const
   // Pairs of beads that have not moved half the pair's limit are not counted. Every pair's
   // drift is measured all the same, for the margin: |Δr| ≤ sqrt(worst) L_p for the largest
   // ratio worst = |Δr|² / L_p², so each pair is at least (1 − sqrt(worst)) L_min from its
-  // limit L_p ≥ L_min (one square root per pass, none per pair).
-  ++pair_passes_;
-  std::size_t stale_pairs = 0;
-  double worst = 0.0, min_limit2 = std::numeric_limits<double>::infinity();
-  for (const ClosePair &p : close_)
+  // limit L_p ≥ L_min (one square root per pass, none per pair). Shared like check().
+  CheckPartial &mine = partial_[static_cast<std::size_t>(omp_get_thread_num())];
+#pragma omp for schedule(static)
+  for (long k = 0; k < static_cast<long>(close_.size()); ++k)
   {
+    const ClosePair &p = close_[static_cast<std::size_t>(k)];
     const double d2 = drift2(beads, p);
     if (4.0 * std::max(move2_[p.i], move2_[p.j]) > p.limit2)
-      stale_pairs += d2 > p.limit2;
-    worst = std::max(worst, d2 / p.limit2);
-    min_limit2 = std::min(min_limit2, p.limit2);
+      mine.stale_pairs += d2 > p.limit2;
+    mine.pair_worst = std::max(mine.pair_worst, d2 / p.limit2);
+    mine.min_limit2 = std::min(mine.min_limit2, p.limit2);
   }
-  pass_margin_ = std::isfinite(min_limit2) ? (1.0 - std::sqrt(worst)) * std::sqrt(min_limit2) : -1.0;
-  x_pass_.resize(3 * beads.n);
-  for (std::size_t b = 0; b < beads.n; ++b)
+  std::size_t stale_pairs = 0;
+  double worst = 0.0, min_limit2 = std::numeric_limits<double>::infinity();
+  for (const CheckPartial &p : partial_)
   {
+    stale_pairs += p.stale_pairs;
+    worst = std::max(worst, p.pair_worst);
+    min_limit2 = std::min(min_limit2, p.min_limit2);
+  }
+  // The pass's record. (Every thread has read x_pass_ and pass_margin_ in check()'s bead
+  // loop, before the barrier that ended the loop above.)
+#pragma omp single
+  {
+    ++pair_passes_;
+    pass_margin_ = std::isfinite(min_limit2) ? (1.0 - std::sqrt(worst)) * std::sqrt(min_limit2) : -1.0;
+    x_pass_.resize(3 * beads.n);
+  }
+#pragma omp for schedule(static)
+  for (long bl = 0; bl < static_cast<long>(beads.n); ++bl)
+  {
+    const auto b = static_cast<std::size_t>(bl);
     x_pass_[3 * b] = beads.x[b];
     x_pass_[3 * b + 1] = beads.y[b];
     x_pass_[3 * b + 2] = beads.z[b];

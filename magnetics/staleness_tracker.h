@@ -32,6 +32,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace magbrush::magnetics {
@@ -79,7 +80,9 @@ public:
   void pair_reevaluated(const NearPairs &near, std::size_t k);
 
   // The interval and the moves since the reference (not "first": the caller knows whether it
-  // ever evaluated). `list_current`: the near pairs still refer to these beads.
+  // ever evaluated). `list_current`: the near pairs still refer to these beads. Called by
+  // every thread of a team (the passes are shared, every thread gets the verdict) or by one
+  // thread outside a parallel region.
   StalenessCheck check(const BeadArrays &beads, double time, bool list_current) const;
 
   std::size_t reference_count() const { return x_last_.size() / 3; }
@@ -115,6 +118,14 @@ private:
   std::vector<std::int32_t> close_of_pair_; // the record of near pair k (−1 = not watched)
   double min_radius_ = 0.0, max_radius_ = 0.0;
   mutable std::vector<double> move2_; // per-check scratch: |Δx_b|²
+  // Per-check scratch: each thread's partial results of the shared passes (own cache line).
+  struct alignas(64) CheckPartial
+  {
+    std::size_t stale = 0, stale_pairs = 0;
+    double worst2 = 0.0, pass_move2 = 0.0; // the bead pass: largest |Δx|²/a², largest move² since the pair pass
+    double pair_worst = 0.0, min_limit2 = std::numeric_limits<double>::infinity(); // the pair pass
+  };
+  mutable std::vector<CheckPartial> partial_;
   // The last pass over the watched pairs: the bead positions then, and a lower bound on every
   // pair's distance from its limit then [m] (< 0: no valid pass; anything that changes the
   // watched pairs or their references invalidates it). A cache of check(), hence mutable.

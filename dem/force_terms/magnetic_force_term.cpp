@@ -98,26 +98,19 @@ void MagneticForceTerm::select_carriers(const dem::ParticleState &state)
 
 void MagneticForceTerm::gather_positions(const dem::ParticleState &state)
 {
-  std::vector<double> *const mine[3] = {&x_, &y_, &z_};
-  if (left_ == 0)
-  {
-    dem::follow_unwrapped(state, carrier_, box_, mine); // dem/periodic_unwrap.h
-    return;
-  }
-  // As follow_unwrapped, the carriers that left keeping their last position.
+  // Each carrier keeps the image of its engine position nearest to its last one
+  // (dem/periodic_unwrap.h); the carriers that left keep their last position. Shared with
+  // `omp for` by the threads of the calling team, or run by one thread outside a team.
   const std::vector<double> *engine[3] = {&state.x, &state.y, &state.z};
-  for (int d = 0; d < 3; ++d)
+  std::vector<double> *const mine[3] = {&x_, &y_, &z_};
+#pragma omp for schedule(static)
+  for (long kl = 0; kl < static_cast<long>(carrier_.size()); ++kl)
   {
-    const double L = box_[static_cast<std::size_t>(d)];
-    std::vector<double> &to = *mine[d];
-    for (std::size_t k = 0; k < carrier_.size(); ++k)
-    {
-      if (carrier_[k] == kLeft)
-        continue;
-      const double raw = (*engine[d])[carrier_[k]];
-      const double jump = to[k] - raw;
-      to[k] = (L > 0.0 && std::abs(jump) > 0.5 * L) ? raw + L * std::round(jump / L) : raw;
-    }
+    const auto k = static_cast<std::size_t>(kl);
+    if (carrier_[k] == kLeft)
+      continue;
+    for (int d = 0; d < 3; ++d)
+      (*mine[d])[k] = dem::nearest_image((*engine[d])[carrier_[k]], (*mine[d])[k], box_[static_cast<std::size_t>(d)]);
   }
 }
 
@@ -185,10 +178,11 @@ std::string MagneticForceTerm::cost_note() const
                 "%ld full evaluations: %ld interval, %ld moved (lists expired %ld, region too large %ld), "
                 "%ld first or new set; %ld list rebuilds; %ld local refreshes; %ld admissions. "
                 "Time: full %.3g s (lists %.2g, tensors %.2g, far field %.2g, sweeps %.2g, forces %.2g), "
-                "local %.3g s, admissions %.3g s, live pairs %.3g s, checks %.3g s",
+                "local %.3g s, admissions %.3g s, live pairs %.3g s, checks %.3g s; "
+                "%ld of %ld steps held inside the engine's team",
                 c.first + c.interval + c.moved, c.interval, c.moved, c.moved_lists, c.moved_region, c.first,
                 c.rebuilds, local_refreshes_, c.admitted, c.full_s, c.lists_s, c.tensors_s, c.far_s, c.sweeps_s,
-                c.forces_s, c.local_s, c.admit_s, c.live_s, c.check_s);
+                c.forces_s, c.local_s, c.admit_s, c.live_s, c.check_s, steps_in_team_, steps_);
   return line;
 }
 
@@ -197,6 +191,11 @@ void MagneticForceTerm::add_forces(const dem::ParticleState &state, dem::ForceBu
 {
   if (!enabled_)
     return;
+  ++steps_;
+  // The team's held path may have gathered and checked this step already (and found that it
+  // must evaluate): its verdict stands.
+  const bool checked_in_team = checked_in_team_;
+  checked_in_team_ = false;
   const bool set_changed = changed_ && !must_refresh_;
   if (must_refresh_ || state.size() != state_size_)
   {
@@ -216,7 +215,8 @@ void MagneticForceTerm::add_forces(const dem::ParticleState &state, dem::ForceBu
                           // so many newcomers that their per-step sums would cost more
   if (carrier_.empty())
     return;
-  gather_positions(state);
+  if (!checked_in_team)
+    gather_positions(state);
   const double ramp = field_.ramp(t);
   const MagneticSettings &settings = dipoles_.settings();
   if (pending_ && !must_refresh_ && settings.admit_exchange && settings.far_field == FarField::cell_multipole &&
@@ -238,6 +238,8 @@ void MagneticForceTerm::add_forces(const dem::ParticleState &state, dem::ForceBu
   StalenessCheck check;
   if (must_refresh_)
     check.reason = RefreshReason::first;
+  else if (checked_in_team)
+    check = team_check_;
   else
   {
     const double t0 = omp_get_wtime();
@@ -302,7 +304,6 @@ void MagneticForceTerm::add_forces(const dem::ParticleState &state, dem::ForceBu
                          ? (ramp / held_ramp_) * (ramp / held_ramp_) : 1.0;
   last_scale_ = scale;
   add_waiting_forces(state, forces, t);
-  const std::size_t m = carrier_.size(); // (the held-back exchanges may just have joined)
   // Holding the dipoles: the close pairs' forces at the current positions (live_pairs.h).
   const std::vector<double> *live = nullptr;
   if (settings.hold_dipoles)
@@ -311,27 +312,81 @@ void MagneticForceTerm::add_forces(const dem::ParticleState &state, dem::ForceBu
     live = dipoles_.live_pair_changes(bead_arrays());
     counts_.live_s += omp_get_wtime() - t0;
   }
-  live_ = live && live->size() == 3 * m ? live : nullptr;
-  for (std::size_t k = 0; k < m; ++k)
+  live_ = usable_live_changes(live);
+  add_held_forces(forces, scale, live_);
+}
+
+// The steps that only hold: inside the engine's team, every thread sharing the same loops as
+// add_forces() runs alone (gather, staleness check, close pairs, held forces), so the team
+// need not stop and restart around the magnetics. A step that must evaluate, admit or follow a
+// ramp goes to add_forces(), which takes over the check made here.
+bool MagneticForceTerm::add_forces_in_team_if_held(const dem::ParticleState &state, dem::ForceBuffers &forces,
+                                                   double t)
+{
+  // (All of this is written outside the team only: every thread decides alike.)
+  if (!held_steps_in_team_ || !enabled_ || carrier_.empty() || must_refresh_ || changed_ || pending_ ||
+      !newcomers_.empty() || state.size() != state_size_ || held_ramp_ == 0.0 || field_.ramp(t) != held_ramp_)
+    return false;
+  gather_positions(state); // (its loop's barrier also ends the team's per-particle phases)
+  const BeadArrays beads = bead_arrays();
+  const double t0 = omp_get_wtime();
+  const StalenessCheck check = dipoles_.check_staleness(beads, t);
+  const double t1 = omp_get_wtime();
+#pragma omp master
+  counts_.check_s += t1 - t0;
+  if (check.reason != RefreshReason::none)
   {
+#pragma omp master
+    {
+      team_check_ = check; // for add_forces(), after the team
+      checked_in_team_ = true;
+    }
+    return false;
+  }
+  const std::vector<double> *live =
+    dipoles_.settings().hold_dipoles ? usable_live_changes(dipoles_.live_pair_changes_in_team(beads)) : nullptr;
+  const double t2 = omp_get_wtime();
+#pragma omp master
+  {
+    counts_.live_s += t2 - t1;
+    live_ = live;
+    last_scale_ = 1.0;
+    ++steps_in_team_;
+    ++steps_;
+  }
+  add_held_forces(forces, 1.0, live);
+  return true;
+}
+
+const std::vector<double> *MagneticForceTerm::usable_live_changes(const std::vector<double> *live) const
+{
+  // (the held-back exchanges may just have joined: the changes must cover every bead)
+  return live && live->size() == 3 * carrier_.size() ? live : nullptr;
+}
+
+void MagneticForceTerm::add_held_forces(dem::ForceBuffers &forces, double scale, const std::vector<double> *live)
+{
+  // Shared with `omp for` by the threads of the calling team, or one thread outside a team;
+  // each carrier writes its own particle.
+  const bool torque = dipoles_.settings().torque == TorqueModel::paper; // (otherwise no magnetic torque)
+#pragma omp for schedule(static)
+  for (long kl = 0; kl < static_cast<long>(carrier_.size()); ++kl)
+  {
+    const auto k = static_cast<std::size_t>(kl);
     const std::size_t i = carrier_[k];
     if (i == kLeft)
       continue;
-    const double *dF = live_ ? &(*live_)[3 * k] : no_change;
+    const double *dF = live ? &(*live)[3 * k] : no_change;
     forces.fx[i] += scale * (fx_[k] + dF[0]);
     forces.fy[i] += scale * (fy_[k] + dF[1]);
     forces.fz[i] += scale * (fz_[k] + dF[2]);
-  }
-  if (dipoles_.settings().torque == TorqueModel::paper) // (otherwise no magnetic torque)
-    for (std::size_t k = 0; k < m; ++k)
+    if (torque)
     {
-      const std::size_t i = carrier_[k];
-      if (i == kLeft)
-        continue;
       forces.tx[i] += scale * tx_[k];
       forces.ty[i] += scale * ty_[k];
       forces.tz[i] += scale * tz_[k];
     }
+  }
 }
 
 // MagneticSettings::admit_exchange: the exchanges since the last step join the held state

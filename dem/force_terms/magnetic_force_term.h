@@ -54,6 +54,8 @@ public:
   // the close pairs' live forces, the staleness checks).
   std::string cost_note() const override;
   void add_forces(const dem::ParticleState &state, dem::ForceBuffers &forces, double t) override;
+  // The steps that hold (no evaluation, exchange or ramp due) run inside the engine's team.
+  bool add_forces_in_team_if_held(const dem::ParticleState &state, dem::ForceBuffers &forces, double t) override;
   void particles_reordered(const std::vector<std::int32_t> &order) override;
   // Checkpoint: the carrier selection and order, the unwrapped positions, the held forces and
   // ramp, the counters, and the magnetics' whole held state (InducedDipoles::write_state), as
@@ -75,6 +77,11 @@ public:
   const MagneticStats &last_admission_stats() const { return admit_stats_; }
   // A disabled term adds nothing (benchmarks compare settings in one system).
   void set_enabled(bool enabled) { enabled_ = enabled; }
+  // With false, every step goes through add_forces() outside the engine's team, as before the
+  // held steps ran inside it (benchmarks and tests compare the two: the same bits).
+  void set_held_steps_in_team(bool on) { held_steps_in_team_ = on; }
+  // Steps whose forces were added inside the team so far (this process; not checkpointed).
+  long steps_held_in_team() const { return steps_in_team_; }
   // Full evaluations (compute) and local refreshes so far.
   long evaluations() const { return evaluations_; }
   long local_refreshes() const { return local_refreshes_; }
@@ -194,6 +201,14 @@ private:
   void apply_pending(const dem::ParticleState &state);
   BeadArrays bead_arrays() const;
   void gather_positions(const dem::ParticleState &state);
+  // The held forces (scaled, plus the close pairs' changes `live` or none) added to `forces`.
+  void add_held_forces(dem::ForceBuffers &forces, double scale, const std::vector<double> *live);
+  const std::vector<double> *usable_live_changes(const std::vector<double> *live) const;
+  // add_forces_in_team_if_held() found that this step must evaluate: its check, for add_forces().
+  StalenessCheck team_check_;
+  bool checked_in_team_ = false;
+  bool held_steps_in_team_ = true;
+  long steps_in_team_ = 0, steps_ = 0; // steps held inside the team, all steps (the log's note)
   AppliedFieldFunction lookup_at(double t) const;
   void full_refresh(const BeadArrays &beads, double t, double ramp);
   void take_held_forces();

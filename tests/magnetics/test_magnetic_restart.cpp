@@ -6,6 +6,8 @@
 // cutoff with the slab tail, the mutual and the corrected model. The control: the same
 // restart under magnetic settings that differ in an irrelevant knob restores nothing (the
 // held state is for other settings) and is NOT bit-identical, so the comparison can fail.
+// Also bit for bit: the held steps run inside the engine's thread team against the same steps
+// through the serial path, and on one thread (MagneticTeamSteps).
 #include "dem/force_terms/magnetic_force_term.h"
 
 #include "coupling/case_parser.h"
@@ -15,6 +17,8 @@
 #include "tests/test_temp_dir.h"
 
 #include <gtest/gtest.h>
+
+#include <omp.h>
 
 #include <cmath>
 #include <cstdio>
@@ -29,10 +33,14 @@ using namespace magbrush::magnetics;
 
 namespace {
 
-// 160 carriers of 60 µm in a periodic 0.6 mm × 0.6 mm slab over a stage; the field ramps up
-// over 4 µs (the held forces follow the ramp), refresh interval 3 µs, 20 ns steps.
-std::string brush_case(const std::string &mode, const std::string &far_field, const std::string &model)
+// 160 carriers of 60 µm in a periodic 0.6 mm × 0.6 mm slab over a stage (`scale` 2: 640 on
+// 1.2 mm × 1.2 mm, enough for the engine to run a thread team); the field ramps up over 4 µs
+// (the held forces follow the ramp), refresh interval 3 µs, 20 ns steps. `more`: further
+// dem keys.
+std::string brush_case(const std::string &mode, const std::string &far_field, const std::string &model,
+                       int scale = 1, const std::string &more = "")
 {
+  const std::string side = std::to_string(0.6 * scale) + " mm", count = std::to_string(160 * scale * scale);
   return R"(
 name: magnetic_restart
 scene: box
@@ -40,13 +48,16 @@ materials:
   carrier: {youngs_modulus: 1e3 MPa, poisson_ratio: 0.35, density: 2200 kg/m^3, mu_r: 3.9, friction: 0.45, damping: 0.6}
   wall: {youngs_modulus: 5e4 MPa, poisson_ratio: 0.3, friction: 0.35, damping: 0.6}
 populations:
-  - {name: carrier, kind: carrier, material: carrier, diameter: 60 um, count: 160, insert_box: [[0 mm, 0 mm, 0.03 mm], [0.6 mm, 0.6 mm, 0.5 mm]]}
+  - {name: carrier, kind: carrier, material: carrier, diameter: 60 um, count: )" +
+         count + ", insert_box: [[0 mm, 0 mm, 0.03 mm], [" + side + ", " + side + R"(, 0.5 mm]]}
 planes:
   - {name: stage, point: [0 mm, 0 mm, 0 mm], normal: [0, 0, 1], material: wall}
 applied_field: {kind: uniform, direction: [0.3, 0, 1], magnitude: 130 mT, ramp_time: 4 us}
-dem: {time_step: 2e-8 s, periodic_length_x: 0.6 mm, periodic_length_y: 0.6 mm, air_viscosity: 0 Pa*s,
+dem: {time_step: 2e-8 s, periodic_length_x: )" +
+         side + ", periodic_length_y: " + side + R"(, air_viscosity: 0 Pa*s,
       magnetic_refresh: 3 us, magnetic_staleness_mode: )" +
-         mode + ", magnetic_far_field: " + far_field + ", magnetic_model: " + model + R"(, magnetic_cutoff: 4}
+         mode + ", magnetic_far_field: " + far_field + ", magnetic_model: " + model + ", magnetic_cutoff: 4" + more +
+         R"(}
 )";
 }
 
@@ -211,3 +222,42 @@ INSTANTIATE_TEST_SUITE_P(
   [](const auto &info) {
     return std::string(std::get<0>(info.param)) + "_" + std::get<1>(info.param) + "_" + std::get<2>(info.param);
   });
+
+// The steps that hold their magnetic forces run inside the engine's thread team (shared
+// loops: gather, staleness check, the close pairs' changes, the held forces), the others go
+// through add_forces() outside it. Both ways give the same bits: 640 carriers, the held
+// forces and the held dipoles, on 2 threads with the held steps in the team and without, and
+// on 1 thread. The run mixes held steps with local refreshes, full evaluations and rebuilds.
+TEST(MagneticTeamSteps, HeldStepsInsideTheTeamGiveTheBitsOfTheSerialPath)
+{
+  const int threads_before = omp_get_max_threads();
+  for (const char *hold : {"forces", "dipoles"})
+  {
+    const Case c = parse_case_text(
+      brush_case("relative", "cell_multipole", "corrected", 2, std::string(", magnetic_hold: ") + hold),
+      "magnetic_team_steps.yaml");
+    auto run = [&](int threads, bool in_team) {
+      omp_set_num_threads(threads);
+      auto s = make_system(c, true);
+      for (const auto &t : s->force_terms())
+        if (auto *m = dynamic_cast<MagneticForceTerm *>(t.get()))
+          m->set_held_steps_in_team(in_team);
+      for (int k = 0; k < 400; ++k)
+        s->step();
+      return s;
+    };
+    const auto team = run(2, true), serial = run(2, false), one = run(1, true);
+    const MagneticForceTerm &m = magnetics_of(*team);
+    std::printf("hold %-7s: %ld of 400 steps held inside the team; %ld full evaluations, %ld local refreshes, "
+                "%ld list rebuilds; %zu live pairs\n",
+                hold, m.steps_held_in_team(), m.evaluations(), m.local_refreshes(), m.refresh_counts().rebuilds,
+                m.dipoles().live_pairs());
+    EXPECT_TRUE(bit_identical(state_by_id(*team), state_by_id(*serial))) << hold;
+    EXPECT_TRUE(bit_identical(state_by_id(*team), state_by_id(*one))) << hold;
+    // Both paths were taken (the first 200 steps follow the field's ramp: serial).
+    EXPECT_GT(m.steps_held_in_team(), 150) << hold;
+    EXPECT_GT(m.evaluations() + m.local_refreshes(), 10) << hold;
+    EXPECT_EQ(magnetics_of(*serial).steps_held_in_team(), 0) << hold;
+  }
+  omp_set_num_threads(threads_before);
+}

@@ -48,23 +48,26 @@ void ChainInclination::sample(const DemSystem &system)
   if (t_first_ < 0.0)
     t_first_ = system.time();
   t_last_ = system.time();
-  // The carriers within the angular window (with a margin of two bins for pairs whose
-  // midpoint falls inside while one bead is outside).
+  // The touching pairs are the engine's: its contact list marks each pair with
+  // |x_j − x_i| < r_i + r_j at the positions of this step's contacts (the test add_sample()
+  // makes), so no search of our own (it was ~5 ms a sample on the quick default's 4,300 beads).
+  ++samples_;
   const ParticleState &p = system.particles();
-  const double reach = settings_.chain_half_angle + 2.0 * settings_.chain_bin_angle;
-  positions_.clear();
-  radii_.clear();
-  for (std::size_t i = 0; i < p.size(); ++i)
-  {
+  const NeighbourList &list = system.neighbour_list();
+  auto carrier = [&](std::size_t i) {
     const auto s = static_cast<std::size_t>(p.species[i]);
-    if (s < species_is_carrier_.size() && !species_is_carrier_[s])
+    return s >= species_is_carrier_.size() || species_is_carrier_[s];
+  };
+  for (std::size_t q = 0; q < list.pairs(); ++q)
+  {
+    if (!list.touching[q])
       continue;
-    if (std::abs(frame_.sleeve_angle(p.x[i], p.y[i])) > reach)
+    const auto i = static_cast<std::size_t>(list.owner[q]), j = static_cast<std::size_t>(list.partner[q]);
+    if (!carrier(i) || !carrier(j))
       continue;
-    positions_.push_back(p.position(i));
-    radii_.push_back(p.radius[i]);
+    const Vector3 a = p.position(i);
+    add_contact(a, p.position(j) - a + list.shift(q));
   }
-  add_sample(positions_, radii_);
 }
 
 void ChainInclination::add_contact(const Vector3 &a, const Vector3 &d)

@@ -265,6 +265,30 @@ TEST(ChainInclination, HandPlacedPairsGiveTheirBranchAngle)
   EXPECT_NEAR(at(-16).contacts, 1.0, 0.0); // found through the periodic image
   EXPECT_NEAR(at(-16).inclination, 0.0, 1e-9);
   EXPECT_TRUE(std::isnan(at(18).inclination)); // no contact there
+  // In a run the touching pairs are the engine's (its contact list): the same beads in a
+  // DemSystem give the same fabric.
+  Case ce = c;
+  ce.nip.average_from = 0.0;
+  ce.dem.max_overlap_fraction = 0.5; // (the pair through the periodic image overlaps by 32 %)
+  DemSystem system(ce);
+  for (std::size_t k = 0; k < x.size(); ++k)
+    system.particles().add(x[k], radii[k], ce.material("carrier").density, 0, 0.0);
+  system.initialize();
+  ChainInclination engine(ce);
+  engine.sample(system);
+  ASSERT_EQ(engine.samples(), 1);
+  const auto from_engine = engine.bins();
+  for (std::size_t k = 0; k < bins.size(); ++k)
+  {
+    EXPECT_EQ(from_engine[k].contacts, bins[k].contacts) << "bin " << k;
+    if (std::isnan(bins[k].inclination))
+      EXPECT_TRUE(std::isnan(from_engine[k].inclination)) << "bin " << k;
+    else
+    {
+      EXPECT_NEAR(from_engine[k].inclination, bins[k].inclination, 1e-12) << "bin " << k;
+      EXPECT_NEAR(from_engine[k].anisotropy, bins[k].anisotropy, 1e-12) << "bin " << k;
+    }
+  }
   // Pairs farther apart than the sum of radii are not contacts.
   ChainInclination apart(c);
   apart.add_sample({{12.7e-3, 0, 0.5e-3}, {12.7e-3 + 61e-6, 0, 0.5e-3}}, {r, r});

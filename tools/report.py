@@ -66,11 +66,13 @@ def read_run_summary(path):
     return list(csv.DictReader(lines))
 
 
-def steady_state_rows(run_summary):
+def steady_state_rows(run_summary, supplied=True):
     """The steady-state verdict (the run's own: every tested mean drifts less than
     statistics.steady_drift between the halves of its averaging window), the drift of each
     tested mean, worst first, and what a failed test means: a trend (a drift beyond two of its
-    standard errors: run longer) or a window too noisy to decide (average more samples)."""
+    standard errors: run longer) or a window too noisy to decide (average more samples).
+    `supplied`: particles enter the scene (an inflow); without one the load in the scene only
+    drains, so more samples must come from a deeper slab, not a longer run."""
     if not run_summary:
         return []
     by_key = {r["key"]: r for r in run_summary}
@@ -105,8 +107,10 @@ def steady_state_rows(run_summary):
         tolerance = drift_tolerance(verdict["meaning"])
         if not reached and trend == "0" and math.isfinite(tolerance) and resolution > tolerance:
             # Block standard errors fall as 1/sqrt(window): (resolution / tolerance)² windows.
+            how = ("a longer run, or a deeper slab" if supplied else
+                   "a deeper slab: nothing is supplied, the load drains, so a longer run adds its trend")
             note += (f"; to decide at {100 * tolerance:g} % average over ~{(resolution / tolerance) ** 2:.1f}× "
-                     "this window (a longer run, or a deeper slab)")
+                     f"this window ({how})")
     return [("steady state", state, verdict["meaning"], note)]
 
 
@@ -406,7 +410,7 @@ def series_plot(plt, series, nip_series, out):
 
 def key_numbers(summary, nip_series, series, flux, run_summary=None, flow=None):
     """[(what, value, reference, verdict)] for the summary table."""
-    rows = steady_state_rows(run_summary)
+    rows = steady_state_rows(run_summary, supplied=flow is not None)
 
     def val(key):
         v = summary.get(key, (float("nan"), ""))[0]

@@ -53,6 +53,12 @@ class SteadyStateRow(unittest.TestCase):
         self.assertTrue(row[1].startswith("undecided"), row)
         self.assertIn("~4.0× this window", row[3])
 
+    def test_a_placed_load_is_told_to_deepen_the_slab(self):
+        # Nothing supplied: the load drains, so more samples must come from a deeper slab.
+        row = report.steady_state_rows(summary(0.025, 0.017, 0.04, False, False), supplied=False)[0]
+        self.assertIn("(a deeper slab: nothing is supplied", row[3])
+        self.assertNotIn("a longer run, or", row[3])
+
     def test_a_trend_is_not_a_matter_of_samples(self):
         row = report.steady_state_rows(summary(0.10, 0.02, 0.04, True, False))[0]
         self.assertTrue(row[1].startswith("NOT reached"), row)

@@ -49,8 +49,8 @@ void ChainInclination::sample(const DemSystem &system)
     t_first_ = system.time();
   t_last_ = system.time();
   // The touching pairs are the engine's: its contact list marks each pair with
-  // |x_j − x_i| < r_i + r_j at the positions of this step's contacts (the test add_sample()
-  // makes), so no search of our own (it was ~5 ms a sample on the quick default's 4,300 beads).
+  // |x_j − x_i| < r_i + r_j at the positions of this step's contacts, so no search of our own
+  // (a cell list of its own cost ~9 ms a sample on the quick default's 4,300 beads).
   ++samples_;
   const ParticleState &p = system.particles();
   const NeighbourList &list = system.neighbour_list();
@@ -87,84 +87,6 @@ void ChainInclination::add_contact(const Vector3 &a, const Vector3 &d)
   fnn_[k] += un * un;
   ftn_[k] += ut * un;
   count_[k] += 1.0;
-}
-
-void ChainInclination::add_sample(const std::vector<Vector3> &x, const std::vector<double> &r)
-{
-  ++samples_;
-  if (x.empty())
-    return;
-  // Touching pairs through a cell list (cells of the largest diameter; z periodic), binned by
-  // a counting sort into reused buffers: a sample every 2 µs must not cost a sort and a
-  // binary search per neighbour cell (it was 5 % of the quick default's DEM time).
-  double cell = 2.0 * *std::max_element(r.begin(), r.end());
-  const double Lz = frame_.slab_depth;
-  double x0 = x[0].x, y0 = x[0].y, x1 = x0, y1 = y0;
-  for (const auto &q : x)
-  {
-    x0 = std::min(x0, q.x), x1 = std::max(x1, q.x);
-    y0 = std::min(y0, q.y), y1 = std::max(y1, q.y);
-  }
-  // (A stray bead far from the brush would make the grid huge: larger cells find the same
-  // pairs, so the cells grow until there are at most ~64 per bead.)
-  const double most_cells = 64.0 * static_cast<double>(x.size()) + 4096.0;
-  while (((x1 - x0) / cell + 1.0) * ((y1 - y0) / cell + 1.0) > most_cells)
-    cell *= 2.0;
-  const auto nx = static_cast<std::int64_t>((x1 - x0) / cell) + 1;
-  const auto ny = static_cast<std::int64_t>((y1 - y0) / cell) + 1;
-  const std::int64_t nz = Lz > 0.0 ? std::max<std::int64_t>(1, static_cast<std::int64_t>(Lz / cell)) : 1;
-  auto cell_z = [&](double z) {
-    if (Lz <= 0.0)
-      return std::int64_t{0};
-    const double w = z - Lz * std::floor(z / Lz);
-    return std::min(nz - 1, static_cast<std::int64_t>(w / (Lz / static_cast<double>(nz))));
-  };
-  auto key = [&](std::int64_t ix, std::int64_t iy, std::int64_t iz) { return (ix * ny + iy) * nz + iz; };
-  const std::size_t n = x.size(), cells = static_cast<std::size_t>(nx * ny * nz);
-  cell_of_.resize(n);
-  cell_start_.assign(cells + 1, 0);
-  for (std::size_t i = 0; i < n; ++i)
-  {
-    const std::int64_t k = key(static_cast<std::int64_t>((x[i].x - x0) / cell),
-                               static_cast<std::int64_t>((x[i].y - y0) / cell), cell_z(x[i].z));
-    cell_of_[i] = static_cast<std::size_t>(k);
-    ++cell_start_[cell_of_[i] + 1];
-  }
-  for (std::size_t c = 0; c < cells; ++c)
-    cell_start_[c + 1] += cell_start_[c];
-  in_cell_.resize(n);
-  fill_.assign(cell_start_.begin(), cell_start_.end() - 1);
-  for (std::size_t i = 0; i < n; ++i) // ascending index within each cell
-    in_cell_[fill_[cell_of_[i]]++] = i;
-  // Neighbour z-cell offsets without duplicates when the slab has fewer than 3 cells.
-  std::int64_t dzs[3] = {0, 1, -1};
-  const int n_dz = nz >= 3 ? 3 : (nz >= 2 ? 2 : 1);
-  for (std::size_t i = 0; i < n; ++i)
-  {
-    const auto ix = static_cast<std::int64_t>((x[i].x - x0) / cell), iy = static_cast<std::int64_t>((x[i].y - y0) / cell);
-    const std::int64_t iz = cell_z(x[i].z);
-    for (std::int64_t dx = -1; dx <= 1; ++dx)
-      for (std::int64_t dy = -1; dy <= 1; ++dy)
-        for (int m = 0; m < n_dz; ++m)
-        {
-          const std::int64_t jx = ix + dx, jy = iy + dy, jz = ((iz + dzs[m]) % nz + nz) % nz;
-          if (jx < 0 || jy < 0 || jx >= nx || jy >= ny)
-            continue;
-          const auto k = static_cast<std::size_t>(key(jx, jy, jz));
-          for (std::size_t s = cell_start_[k]; s < cell_start_[k + 1]; ++s)
-          {
-            const std::size_t j = in_cell_[s];
-            if (j <= i)
-              continue; // each pair once
-            Vector3 d = x[j] - x[i];
-            if (Lz > 0.0)
-              d.z -= Lz * std::round(d.z / Lz);
-            const double reach = r[i] + r[j];
-            if (dot(d, d) < reach * reach)
-              add_contact(x[i], d);
-          }
-        }
-  }
 }
 
 std::vector<ChainBin> ChainInclination::bins() const

@@ -47,10 +47,6 @@ public:
   void sample(const DemSystem &system) override;
   void write(const std::string &directory) const override;
 
-  // The same from plain arrays (tests): positions, radii; z is periodic with the slab depth.
-  // The touching pairs are found by a cell list here (sample() takes the engine's).
-  void add_sample(const std::vector<Vector3> &positions, const std::vector<double> &radii);
-
   long samples() const { return samples_; }
   std::vector<ChainBin> bins() const;
   std::string csv() const;
@@ -62,9 +58,6 @@ private:
   std::vector<double> ftt_, fnn_, ftn_, count_;
   long samples_ = 0;
   double t_first_ = -1.0, t_last_ = -1.0;
-  // add_sample()'s cell list, kept between samples: each bead's cell, the cells' first slots
-  // (one past the last cell at the end), the beads by cell, a fill cursor per cell.
-  std::vector<std::size_t> cell_of_, cell_start_, in_cell_, fill_;
   std::vector<bool> species_is_carrier_; // by population index: toner is not part of the chains
 
   int bin_of(double theta) const;

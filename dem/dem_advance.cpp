@@ -59,6 +59,14 @@ double DemSystem::max_drift2_of_team() const
   return m;
 }
 
+double DemSystem::max_step_move_of_team() const
+{
+  double m = 0.0;
+  for (int t = 0; t < omp_get_num_threads(); ++t)
+    m = std::max(m, thread_flags_[static_cast<std::size_t>(t)].max_step2);
+  return std::sqrt(m);
+}
+
 bool DemSystem::team_has_state_alarm() const
 {
   for (int t = 0; t < omp_get_num_threads(); ++t)
@@ -220,6 +228,9 @@ DemSystem::Pause DemSystem::run_team(long &steps_left, Resume from)
       }
       if (at != Resume::final_kick)
       {
+        // This step's largest drift, for the terms that hold their forces (read before
+        // barrier P: no thread drifts again before every thread has passed it).
+        const double step_move = max_step_move_of_team();
         pair_and_row_phase(mine); // ends with barrier P
         clock.charge(times_.particle_contacts);
         if (team_has_overlap_alarm())
@@ -243,7 +254,7 @@ DemSystem::Pause DemSystem::run_team(long &steps_left, Resume from)
         // the first that cannot, the caller runs them and resumes at the final kick.
         std::size_t serial_from = team_terms_;
         while (serial_from < terms_.size() &&
-               terms_[serial_from]->add_forces_in_team_if_held(particles_, forces_, time_))
+               terms_[serial_from]->add_forces_in_team_if_held(particles_, forces_, time_, step_move))
           clock.charge(times_.terms[serial_from++]);
         if (serial_from < terms_.size())
         {

@@ -250,13 +250,15 @@ static inline void half_kick(ParticleState &s, const ForceBuffers &f, std::size_
 }
 
 // Velocity Verlet's drift x += dt v(t + dt/2); returns the squared displacement since the
-// last list build.
-inline double DemSystem::drift(std::size_t i, double dt)
+// last list build, and raises `step2` to the squared displacement of this drift.
+inline double DemSystem::drift(std::size_t i, double dt, double &step2)
 {
   ParticleState &s = particles_;
-  s.x[i] += dt * s.vx[i];
-  s.y[i] += dt * s.vy[i];
-  s.z[i] += dt * s.vz[i];
+  const double ux = dt * s.vx[i], uy = dt * s.vy[i], uz = dt * s.vz[i];
+  step2 = std::max(step2, ux * ux + uy * uy + uz * uz);
+  s.x[i] += ux;
+  s.y[i] += uy;
+  s.z[i] += uz;
   const double dx = s.x[i] - x0_[i], dy = s.y[i] - y0_[i], dz = s.z[i] - z0_[i];
   return dx * dx + dy * dy + dz * dz;
 }
@@ -272,7 +274,7 @@ static inline bool state_is_finite(const ParticleState &s, std::size_t i)
 // barrier every thread reads every thread's (max_drift2_of_team).
 void DemSystem::kick_and_drift_phase(StepFlags &mine)
 {
-  double max_drift2 = 0.0;
+  double max_drift2 = 0.0, max_step2 = 0.0;
   const long n = static_cast<long>(particles_.size());
   const double h = 0.5 * dt_, dt = dt_;
   ParticleState &s = particles_;
@@ -282,9 +284,10 @@ void DemSystem::kick_and_drift_phase(StepFlags &mine)
   {
     const std::size_t i = static_cast<std::size_t>(k);
     half_kick(s, f, i, h);
-    max_drift2 = std::max(max_drift2, drift(i, dt));
+    max_drift2 = std::max(max_drift2, drift(i, dt, max_step2));
   }
   mine.max_drift2 = max_drift2;
+  mine.max_step2 = max_step2;
 #pragma omp barrier
 }
 
@@ -320,7 +323,7 @@ void DemSystem::final_kick_phase(StepFlags &mine)
 void DemSystem::final_kick_and_next_drift_phase(StepFlags &mine)
 {
   ParticleAlarm not_finite;
-  double max_drift2 = 0.0;
+  double max_drift2 = 0.0, max_step2 = 0.0;
   const long n = static_cast<long>(particles_.size());
   const double h = 0.5 * dt_, dt = dt_;
   ParticleState &s = particles_;
@@ -333,11 +336,12 @@ void DemSystem::final_kick_and_next_drift_phase(StepFlags &mine)
     if (!state_is_finite(s, i) && not_finite.particle < 0)
       not_finite.set(k, s.position(i));
     half_kick(s, f, i, h);
-    max_drift2 = std::max(max_drift2, drift(i, dt));
+    max_drift2 = std::max(max_drift2, drift(i, dt, max_step2));
   }
   if (mine.not_finite.particle < 0)
     mine.not_finite = not_finite;
   mine.max_drift2 = max_drift2;
+  mine.max_step2 = max_step2;
 #pragma omp barrier
 }
 

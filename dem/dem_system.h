@@ -178,6 +178,7 @@ private:
   struct alignas(64) StepFlags : StepAlarms
   {
     double max_drift2 = 0.0;   // largest squared displacement since the list build
+    double max_step2 = 0.0;    // largest squared displacement in this step's drift
     std::vector<double> row_torques; // scratch of the pair phase (kept: no allocation per step)
   };
   std::vector<StepFlags> thread_flags_; // one per thread of the team
@@ -211,12 +212,14 @@ private:
   // final_kick_phase, then the next step's kick_and_drift_phase, in one pass over the
   // particles (dem_advance.cpp: when the team goes straight on to the next step).
   void final_kick_and_next_drift_phase(StepFlags &mine);
-  double drift(std::size_t i, double dt); // x += dt v of particle i; its squared drift since the build
+  // x += dt v of particle i; its squared drift since the build (and `step2` raised to this drift's)
+  double drift(std::size_t i, double dt, double &step2);
   void begin_step(); // the clock and the walls' pose at the new time (one thread)
   // advance(): the team's loop over steps, from `from` until it needs serial work.
   Pause run_team(long &steps_left, Resume from);
   StepFlags &my_flags();
   double max_drift2_of_team() const;   // after the drift's barrier
+  double max_step_move_of_team() const; // after the drift's barrier, before the next drift
   bool team_has_state_alarm() const;   // the last step's wall / NaN alarms, after a barrier
   bool team_has_overlap_alarm() const; // this step's pair alarm, after the pair barrier
   StepAlarms team_alarms() const;       // all threads' alarms combined (serial)

@@ -52,8 +52,13 @@ public:
   // The answer must be the same on every thread (decided from data they all see). This saves
   // the team's stop and restart around the term at every step: the idle thread would go to
   // sleep and be woken again (~25 µs per hand-over on a virtual machine, measured).
+  // `step_move` [m] is the largest displacement of any particle in this step's drift
+  // (dt |v(t + dt/2)|): summed over the steps since some moment, it bounds how far every
+  // particle can have moved since, so a term can tell without looking that nothing it holds
+  // has gone stale. It covers the steps of the team only: a step outside it (add_forces())
+  // must be looked at.
   virtual bool add_forces_in_team_if_held(const ParticleState & /*state*/, ForceBuffers & /*forces*/,
-                                          double /*t*/)
+                                          double /*t*/, double /*step_move*/)
   {
     return false;
   }

@@ -924,7 +924,8 @@ void CellMultipoleField::build_near_pairs(const double *const coord[3])
       }
     }
   };
-  MagneticNeighbourList::collect_pairs(n_, for_each_neighbour, xw_.data(), coord, parallel_threshold, near_pairs_);
+  MagneticNeighbourList::collect_pairs(n_, for_each_neighbour, xw_.data(), coord, parallel_threshold, near_pairs_,
+                                      near_pair_blocks_);
 }
 
 std::size_t CellMultipoleField::interactions() const

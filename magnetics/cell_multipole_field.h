@@ -177,6 +177,7 @@ private:
   std::vector<std::uint32_t> bead_begin_;  // per fine cell, into bead_order_
   std::vector<std::uint32_t> bead_cell_;   // fine cell of every bead
   std::vector<MagneticNeighbourList::Pair> near_pairs_;
+  MagneticNeighbourList::PairBlocks near_pair_blocks_; // build_near_pairs(): per-block buffers
   std::vector<std::uint32_t> order_scratch_, begin_scratch_; // add_beads()
   // Bead b's fine cell index vector from its wrapped position; false when it lies below the
   // origin along an open axis.

@@ -118,6 +118,15 @@ public:
   // The same, added to `out` (tests).
   void add_live_pair_changes(const BeadArrays &beads, const ForceArrays &out);
   std::size_t live_pairs() const { return live_.size(); }
+  // The next live_pair_changes() reads the beads' positions (otherwise it returns the held
+  // changes without looking at them).
+  bool live_pair_changes_due() const { return live_.due(); }
+
+  // After a check_staleness() whose verdict was "none": how far every bead may move from
+  // where it saw them before a check could say anything else, the interval aside [m]
+  // (StalenessTracker::quiet_distance); and whether the refresh interval has elapsed.
+  double quiet_distance() const { return staleness_.quiet_distance(); }
+  bool interval_due(double time) const { return staleness_.interval_due(time); }
 
   // The local refresh (StalenessMode::local): re-evaluates the magnetics around the beads
   // that moved more than staleness_fraction × their radius since their forces were last

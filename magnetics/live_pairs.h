@@ -61,6 +61,9 @@ public:
   void clear();
   void set_steps(int steps) { every_ = steps > 0 ? steps : 1; }
   std::size_t size() const { return pair_.size(); }
+  // The next update() evaluates the changes (it reads the positions); otherwise it returns
+  // the held ones.
+  bool due() const { return calls_ % every_ == 0; }
 
   // Restart: the live pairs and their base forces (the incidence is rebuilt).
   void write_state(StateOut &out) const;
@@ -79,7 +82,6 @@ private:
   std::size_t beads_ = 0;
 
   void consider(const BeadArrays &beads, const NearPairs &near, std::size_t k, double reach_factor);
-  bool due() const { return calls_ % every_ == 0; }
   // The changes at the current positions and each bead's sum: every thread of the current
   // team (or one outside a parallel region) shares the passes.
   void evaluate_changes(const InducedState &s, const NearPairs &near, const TwoSphereCorrection *correction);

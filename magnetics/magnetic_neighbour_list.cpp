@@ -178,7 +178,7 @@ void MagneticNeighbourList::build(std::size_t n, const double *x, const double *
         }
   };
 
-  collect_pairs(n, for_each_neighbour, xw.data(), coord, 512, pairs_);
+  collect_pairs(n, for_each_neighbour, xw.data(), coord, 512, pairs_, blocks_);
 
   build_incidence(n, coord);
 }

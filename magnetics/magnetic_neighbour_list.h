@@ -21,6 +21,7 @@
 
 #include <omp.h>
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -75,17 +76,27 @@ public:
   // next build fills the same buffers. built() is false afterwards.
   void clear();
 
+  // Per-block pair buffers of collect_pairs(), kept by the caller between builds so that a
+  // rebuild allocates nothing once the buffers have grown.
+  struct PairBlocks
+  {
+    std::vector<std::vector<Pair>> block;
+    std::vector<std::size_t> begin;
+  };
+
   // Fills `pairs` in bead order from a neighbour enumerator: the same pairs in the same order
   // on any number of threads. for_each_neighbour(i, emit) calls emit(j, shift) for each
   // partner j of bead i, `shift` (3 doubles) referring to the wrapped coordinates xw (x, y, z
   // interleaved); the stored shift refers to the raw coordinates coord[d][·]:
-  // r = x_j − x_i + shift. On one thread a single pass appends the pairs; on several, two
-  // parallel passes (count, then fill at the prefix offsets) — the enumeration (cell lookups,
-  // distances) then runs twice, which on one thread was half the cost of a list build.
+  // r = x_j − x_i + shift. On one thread a single pass appends the pairs. On several, the
+  // beads are cut into fixed blocks (independent of the thread count); each block appends
+  // its pairs to a buffer of its own in one pass, and the buffers are then copied to `pairs`
+  // in block order. (The enumeration — cell lookups, distances — costs several times the
+  // copy: an earlier version ran it twice, to count and then to fill.)
   template <typename ForEachNeighbour>
   static void collect_pairs(std::size_t n, ForEachNeighbour &&for_each_neighbour, const double *xw,
                             const double *const coord[3], std::size_t parallel_threshold,
-                            std::vector<Pair> &pairs)
+                            std::vector<Pair> &pairs, PairBlocks &scratch)
   {
     auto make_pair = [&](std::size_t i, std::uint32_t j, const double *shift) {
       Pair p;
@@ -102,22 +113,32 @@ public:
         for_each_neighbour(i, [&](std::uint32_t j, const double *shift) { pairs.push_back(make_pair(i, j, shift)); });
       return;
     }
-    std::vector<std::size_t> begin(n + 1, 0);
-#pragma omp parallel for schedule(dynamic, 64)
-    for (long i = 0; i < static_cast<long>(n); ++i)
+    constexpr std::size_t block_beads = 128;
+    const long blocks = static_cast<long>((n + block_beads - 1) / block_beads);
+    if (scratch.block.size() < static_cast<std::size_t>(blocks))
+      scratch.block.resize(blocks);
+    scratch.begin.resize(blocks + 1);
+#pragma omp parallel
     {
-      std::size_t count = 0;
-      for_each_neighbour(i, [&](std::uint32_t, const double *) { ++count; });
-      begin[i + 1] = count;
-    }
-    for (std::size_t i = 0; i < n; ++i)
-      begin[i + 1] += begin[i];
-    pairs.resize(begin[n]);
-#pragma omp parallel for schedule(dynamic, 64)
-    for (long i = 0; i < static_cast<long>(n); ++i)
-    {
-      std::size_t k = begin[i];
-      for_each_neighbour(i, [&](std::uint32_t j, const double *shift) { pairs[k++] = make_pair(i, j, shift); });
+#pragma omp for schedule(dynamic, 1)
+      for (long b = 0; b < blocks; ++b)
+      {
+        std::vector<Pair> &out = scratch.block[b];
+        out.clear();
+        const std::size_t i1 = std::min(n, (b + 1) * block_beads);
+        for (std::size_t i = b * block_beads; i < i1; ++i)
+          for_each_neighbour(i, [&](std::uint32_t j, const double *shift) { out.push_back(make_pair(i, j, shift)); });
+      }
+#pragma omp single
+      {
+        scratch.begin[0] = 0;
+        for (long b = 0; b < blocks; ++b)
+          scratch.begin[b + 1] = scratch.begin[b] + scratch.block[b].size();
+        pairs.resize(scratch.begin[blocks]);
+      }
+#pragma omp for schedule(static)
+      for (long b = 0; b < blocks; ++b)
+        std::copy(scratch.block[b].begin(), scratch.block[b].end(), pairs.begin() + scratch.begin[b]);
     }
   }
 
@@ -158,6 +179,7 @@ private:
   std::vector<std::uint8_t> incident_first_;
 
   std::vector<std::size_t> fill_; // build_pair_incidence(): scratch
+  PairBlocks blocks_;             // build(): collect_pairs()' per-block buffers
   void build_incidence(std::size_t n, const double *const coord[3]);
   void build_pair_incidence(std::size_t n);
 };

@@ -19,16 +19,21 @@ double StalenessTracker::move_limit(const BeadArrays &beads, std::size_t b) cons
   return factor * settings_.staleness_fraction * beads.radius[b];
 }
 
+void StalenessTracker::set_limit(const BeadArrays &beads, std::size_t b)
+{
+  const double limit = move_limit(beads, b);
+  limit2_[b] = limit * limit;
+  inv_two_limit_[b] = limit > 0.0 ? 0.5 / limit : 0.0;
+  inv_radius2_[b] = 1.0 / (beads.radius[b] * beads.radius[b]);
+}
+
 void StalenessTracker::evaluated_all(const BeadArrays &beads, double time)
 {
   limit2_.resize(beads.n);
+  inv_two_limit_.resize(beads.n);
   inv_radius2_.resize(beads.n);
   for (std::size_t b = 0; b < beads.n; ++b)
-  {
-    const double limit = move_limit(beads, b);
-    limit2_[b] = limit * limit;
-    inv_radius2_[b] = 1.0 / (beads.radius[b] * beads.radius[b]);
-  }
+    set_limit(beads, b);
   for (std::size_t b = 0; b < beads.n; ++b)
     evaluated(beads, b);
   t_last_ = time;
@@ -77,12 +82,11 @@ void StalenessTracker::admit(const BeadArrays &beads, std::size_t first, const N
 {
   forget_pair_pass();
   limit2_.resize(beads.n);
+  inv_two_limit_.resize(beads.n);
   inv_radius2_.resize(beads.n);
   for (std::size_t b = first; b < beads.n; ++b)
   {
-    const double limit = move_limit(beads, b);
-    limit2_[b] = limit * limit;
-    inv_radius2_[b] = 1.0 / (beads.radius[b] * beads.radius[b]);
+    set_limit(beads, b);
     evaluated(beads, b);
     min_radius_ = std::min(min_radius_, beads.radius[b]);
     max_radius_ = std::max(max_radius_, beads.radius[b]);
@@ -124,8 +128,7 @@ StalenessCheck StalenessTracker::check(const BeadArrays &beads, double time, boo
     c.reason = RefreshReason::bead_count;
     return c;
   }
-  if (settings_.refresh_interval <= 0.0 ||
-      time - t_last_ >= settings_.refresh_interval * (1.0 - 1e-9))
+  if (interval_due(time))
   {
     c.reason = RefreshReason::interval;
     return c;
@@ -149,6 +152,8 @@ StalenessCheck StalenessTracker::check(const BeadArrays &beads, double time, boo
     const double move2 = squared_move(beads, b);
     mine.stale += move2 > limit2_[b];
     mine.worst2 = std::max(mine.worst2, move2 * inv_radius2_[b]);
+    // limit − |Δx| ≥ (limit² − |Δx|²) / (2 limit) while |Δx| ≤ limit: no square root per bead.
+    mine.slack = std::min(mine.slack, (limit2_[b] - move2) * inv_two_limit_[b]);
     if (relative)
       move2_[b] = move2;
     if (since_pass) // (no minimum image: a wrapped bead's jump forces the pass, as it must)
@@ -159,12 +164,13 @@ StalenessCheck StalenessTracker::check(const BeadArrays &beads, double time, boo
     }
   }
   std::size_t stale = 0;
-  double worst2 = 0.0, pass_move2 = 0.0;
+  double worst2 = 0.0, pass_move2 = 0.0, slack = std::numeric_limits<double>::infinity();
   for (const CheckPartial &p : partial_)
   {
     stale += p.stale;
     worst2 = std::max(worst2, p.worst2);
     pass_move2 = std::max(pass_move2, p.pass_move2);
+    slack = std::min(slack, p.slack);
   }
   c.stale_beads = stale;
   c.max_move = std::sqrt(worst2);
@@ -173,10 +179,27 @@ StalenessCheck StalenessTracker::check(const BeadArrays &beads, double time, boo
   // pass left (the header). Otherwise the pass is skipped: it would count no pair.
   const bool some_bead_moved = 2.0 * c.max_move * max_radius_ > settings_.staleness_fraction * min_radius_;
   const bool margin_used = !since_pass || 4.0 * pass_move2 >= pass_margin_ * pass_margin_ * (1.0 - 1e-9);
-  if (relative && some_bead_moved && margin_used)
+  const bool pair_pass = relative && some_bead_moved && margin_used;
+  if (pair_pass)
     c.stale_pairs = count_stale_pairs(beads);
   if (stale > 0 || c.stale_pairs > 0)
     c.reason = RefreshReason::moved;
+  // How far every bead may move from here before a check could say anything else: the
+  // beads' slack, and (relative) the distance before the pair pass could be due — before a
+  // bead reaches half the pairs' limit (it moves at most d / a_min radii more), or before
+  // twice the moves since the last pass use up its margin (a pass now: from its new margin).
+  double quiet = c.reason == RefreshReason::none ? slack : 0.0;
+  if (relative && quiet > 0.0)
+  {
+    const double half_pair_limit = 0.5 * settings_.staleness_fraction * min_radius_ / max_radius_; // [radii]
+    const double before_half = min_radius_ * (half_pair_limit - c.max_move);
+    const double margin = pair_pass ? pass_margin_ : since_pass ? pass_margin_ : -1.0;
+    const double before_margin = margin > 0.0 ? 0.5 * margin * std::sqrt(1.0 - 1e-9) - (pair_pass ? 0.0 : std::sqrt(pass_move2)) : 0.0;
+    quiet = std::min(quiet, std::max({before_half, before_margin, 0.0}));
+  }
+  // (Every thread has the same value; the next step reads it, after the barriers between.)
+#pragma omp master
+  quiet_distance_ = std::max(0.0, quiet * (1.0 - 1e-6));
   return c;
 }
 
@@ -266,6 +289,9 @@ void StalenessTracker::read_state(StateIn &in)
   in.get_array(x_last_);
   t_last_ = in.get<double>();
   in.get_array(limit2_);
+  inv_two_limit_.resize(limit2_.size());
+  for (std::size_t b = 0; b < limit2_.size(); ++b)
+    inv_two_limit_[b] = limit2_[b] > 0.0 ? 0.5 / std::sqrt(limit2_[b]) : 0.0;
   in.get_array(inv_radius2_);
   in.get_array(close_);
   in.get_array(close_of_pair_);

@@ -84,6 +84,20 @@ public:
   // every thread of a team (the passes are shared, every thread gets the verdict) or by one
   // thread outside a parallel region.
   StalenessCheck check(const BeadArrays &beads, double time, bool list_current) const;
+  // After a check() whose verdict was "none": how far every bead may still move from where
+  // that check saw it (each by at most this much) before a check could say anything else,
+  // the refresh interval aside [m]. The bead pass's slack (every bead's distance from its
+  // limit), and in the relative mode the distance before the pair pass could be due (no bead
+  // moved half the pairs' limit, or the last pair pass's margin not used up). 0 after
+  // anything that changes the references (and before any check). A caller that knows a bound
+  // on every bead's move since that check (the engine's largest drift per step, summed) may
+  // skip the checks until the bound reaches it: they would all say "none".
+  double quiet_distance() const { return quiet_distance_; }
+  // The refresh interval has elapsed since the last full evaluation (check() says "interval").
+  bool interval_due(double time) const
+  {
+    return settings_.refresh_interval <= 0.0 || time - t_last_ >= settings_.refresh_interval * (1.0 - 1e-9);
+  }
 
   std::size_t reference_count() const { return x_last_.size() / 3; }
   // |x_b − x_last,b|² (minimum image along periodic axes) and its limit [m²].
@@ -124,6 +138,7 @@ private:
     std::size_t stale = 0, stale_pairs = 0;
     double worst2 = 0.0, pass_move2 = 0.0; // the bead pass: largest |Δx|²/a², largest move² since the pair pass
     double pair_worst = 0.0, min_limit2 = std::numeric_limits<double>::infinity(); // the pair pass
+    double slack = std::numeric_limits<double>::infinity(); // the bead pass: min (limit² − |Δx|²) / 2 limit
   };
   mutable std::vector<CheckPartial> partial_;
   // The last pass over the watched pairs: the bead positions then, and a lower bound on every
@@ -132,7 +147,14 @@ private:
   mutable std::vector<double> x_pass_;
   mutable double pass_margin_ = -1.0;
   mutable std::size_t pair_passes_ = 0;
-  void forget_pair_pass() { pass_margin_ = -1.0; }
+  mutable double quiet_distance_ = 0.0; // the last check's (quiet_distance())
+  std::vector<double> inv_two_limit_;    // per bead: 1 / (2 × its move limit) [1/m]
+  void forget_pair_pass()
+  {
+    pass_margin_ = -1.0;
+    quiet_distance_ = 0.0;
+  }
+  void set_limit(const BeadArrays &beads, std::size_t b);
 
   // Bead b's limit on its absolute move [m]: staleness_fraction × radius, times
   // absolute_factor in the relative mode.

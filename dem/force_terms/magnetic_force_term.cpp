@@ -179,10 +179,10 @@ std::string MagneticForceTerm::cost_note() const
                 "%ld first or new set; %ld list rebuilds; %ld local refreshes; %ld admissions. "
                 "Time: full %.3g s (lists %.2g, tensors %.2g, far field %.2g, sweeps %.2g, forces %.2g), "
                 "local %.3g s, admissions %.3g s, live pairs %.3g s, checks %.3g s; "
-                "%ld of %ld steps held inside the engine's team",
+                "%ld of %ld steps held inside the engine's team (%ld of them quiet: no check needed)",
                 c.first + c.interval + c.moved, c.interval, c.moved, c.moved_lists, c.moved_region, c.first,
                 c.rebuilds, local_refreshes_, c.admitted, c.full_s, c.lists_s, c.tensors_s, c.far_s, c.sweeps_s,
-                c.forces_s, c.local_s, c.admit_s, c.live_s, c.check_s, steps_in_team_, steps_);
+                c.forces_s, c.local_s, c.admit_s, c.live_s, c.check_s, steps_in_team_, steps_, quiet_steps_);
   return line;
 }
 
@@ -192,6 +192,10 @@ void MagneticForceTerm::add_forces(const dem::ParticleState &state, dem::ForceBu
   if (!enabled_)
     return;
   ++steps_;
+  // A step outside the team is not in the engine's sum of drifts: the next team step looks.
+  quiet_valid_ = false;
+  if (quiet_moved_.size() < static_cast<std::size_t>(omp_get_max_threads()))
+    quiet_moved_.resize(static_cast<std::size_t>(omp_get_max_threads()));
   // The team's held path may have gathered and checked this step already (and found that it
   // must evaluate): its verdict stands.
   const bool checked_in_team = checked_in_team_;
@@ -321,12 +325,29 @@ void MagneticForceTerm::add_forces(const dem::ParticleState &state, dem::ForceBu
 // need not stop and restart around the magnetics. A step that must evaluate, admit or follow a
 // ramp goes to add_forces(), which takes over the check made here.
 bool MagneticForceTerm::add_forces_in_team_if_held(const dem::ParticleState &state, dem::ForceBuffers &forces,
-                                                   double t)
+                                                   double t, double step_move)
 {
   // (All of this is written outside the team only: every thread decides alike.)
   if (!held_steps_in_team_ || !enabled_ || carrier_.empty() || must_refresh_ || changed_ || pending_ ||
       !newcomers_.empty() || state.size() != state_size_ || held_ramp_ == 0.0 || field_.ramp(t) != held_ramp_)
     return false;
+  // A quiet step: the last check (in the team) found nothing stale, and the engine's largest
+  // drift per step, summed since, bounds every bead's move below the distance that check
+  // certified (StalenessTracker::quiet_distance): every check until then would say "none",
+  // so none is made and the positions are not even gathered. Each thread keeps its own copy
+  // of the sum (the same on all); the flag is written outside the team or after a barrier.
+  const auto me = static_cast<std::size_t>(omp_get_thread_num());
+  const bool tracked = quiet_valid_ && static_cast<std::size_t>(omp_get_num_threads()) <= quiet_moved_.size();
+  if (tracked && quiet_steps_on_)
+  {
+    const double moved = quiet_moved_[me].moved + step_move;
+    if (moved < dipoles_.quiet_distance() && !dipoles_.interval_due(t))
+    {
+      quiet_moved_[me].moved = moved;
+      add_held_step(state, forces, false);
+      return true;
+    }
+  }
   gather_positions(state); // (its loop's barrier also ends the team's per-particle phases)
   const BeadArrays beads = bead_arrays();
   const double t0 = omp_get_wtime();
@@ -340,11 +361,38 @@ bool MagneticForceTerm::add_forces_in_team_if_held(const dem::ParticleState &sta
     {
       team_check_ = check; // for add_forces(), after the team
       checked_in_team_ = true;
+      quiet_valid_ = false;
     }
     return false;
   }
-  const std::vector<double> *live =
-    dipoles_.settings().hold_dipoles ? usable_live_changes(dipoles_.live_pair_changes_in_team(beads)) : nullptr;
+  // (Every thread read quiet_valid_ above, before the gather's barrier.)
+  if (static_cast<std::size_t>(omp_get_num_threads()) <= quiet_moved_.size())
+  {
+    quiet_moved_[me].moved = 0.0;
+#pragma omp master
+    quiet_valid_ = true;
+  }
+  add_held_step(state, forces, true);
+  return true;
+}
+
+void MagneticForceTerm::add_held_step(const dem::ParticleState &state, dem::ForceBuffers &forces, bool gathered)
+{
+  // Called by every thread of the team. The close pairs' changes read the positions only
+  // when they are due: a quiet step gathers them then.
+  const bool hold = dipoles_.settings().hold_dipoles;
+  if (hold && !gathered && dipoles_.live_pair_changes_due())
+    gather_positions(state);
+  const BeadArrays beads = bead_arrays();
+  const double t1 = omp_get_wtime();
+  const std::vector<double> *live = hold ? usable_live_changes(dipoles_.live_pair_changes_in_team(beads)) : nullptr;
+  // The held forces go to the carriers' engine indices, split otherwise than the engine's
+  // per-particle phases before (their loops end without a barrier): the gather's loop, or
+  // the close pairs' update, ends them; with neither, this barrier does.
+  if (!gathered && !hold)
+  {
+#pragma omp barrier
+  }
   const double t2 = omp_get_wtime();
 #pragma omp master
   {
@@ -353,9 +401,9 @@ bool MagneticForceTerm::add_forces_in_team_if_held(const dem::ParticleState &sta
     last_scale_ = 1.0;
     ++steps_in_team_;
     ++steps_;
+    quiet_steps_ += gathered ? 0 : 1;
   }
   add_held_forces(forces, 1.0, live);
-  return true;
 }
 
 const std::vector<double> *MagneticForceTerm::usable_live_changes(const std::vector<double> *live) const
@@ -805,6 +853,7 @@ void MagneticForceTerm::read_state(dem::CheckpointReader &in)
 {
   MemoryStateIn block(in.get_string(), "checkpoint '" + in.path() + "', magnetic state,");
   restored_ = false;
+  quiet_valid_ = false;
   const auto state_size = block.get<std::uint64_t>();
   std::vector<std::uint32_t> carrier;
   block.get_array(carrier);

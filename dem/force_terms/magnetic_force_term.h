@@ -55,7 +55,10 @@ public:
   std::string cost_note() const override;
   void add_forces(const dem::ParticleState &state, dem::ForceBuffers &forces, double t) override;
   // The steps that hold (no evaluation, exchange or ramp due) run inside the engine's team.
-  bool add_forces_in_team_if_held(const dem::ParticleState &state, dem::ForceBuffers &forces, double t) override;
+  // A step whose last look found nothing stale, and whose beads cannot have moved enough
+  // since to change that (`step_move` summed), does not look again (a quiet step).
+  bool add_forces_in_team_if_held(const dem::ParticleState &state, dem::ForceBuffers &forces, double t,
+                                  double step_move) override;
   void particles_reordered(const std::vector<std::int32_t> &order) override;
   // Checkpoint: the carrier selection and order, the unwrapped positions, the held forces and
   // ramp, the counters, and the magnetics' whole held state (InducedDipoles::write_state), as
@@ -80,8 +83,13 @@ public:
   // With false, every step goes through add_forces() outside the engine's team, as before the
   // held steps ran inside it (benchmarks and tests compare the two: the same bits).
   void set_held_steps_in_team(bool on) { held_steps_in_team_ = on; }
-  // Steps whose forces were added inside the team so far (this process; not checkpointed).
+  // Steps whose forces were added inside the team so far (this process; not checkpointed),
+  // and of those the quiet ones (no gather, no check: their moves were bounded).
   long steps_held_in_team() const { return steps_in_team_; }
+  long quiet_steps() const { return quiet_steps_; }
+  // With false, every step in the team gathers and checks (benchmarks and tests compare: the
+  // same bits).
+  void set_quiet_steps(bool on) { quiet_steps_on_ = on; }
   // Full evaluations (compute) and local refreshes so far.
   long evaluations() const { return evaluations_; }
   long local_refreshes() const { return local_refreshes_; }
@@ -209,6 +217,16 @@ private:
   bool checked_in_team_ = false;
   bool held_steps_in_team_ = true;
   long steps_in_team_ = 0, steps_ = 0; // steps held inside the team, all steps (the log's note)
+  // Quiet steps: the drift summed since the last check in the team, per thread (each keeps
+  // the same value; own cache line), and whether that check found nothing stale.
+  struct alignas(64) QuietMove
+  {
+    double moved = 0.0;
+  };
+  std::vector<QuietMove> quiet_moved_;
+  bool quiet_valid_ = false, quiet_steps_on_ = true;
+  long quiet_steps_ = 0;
+  void add_held_step(const dem::ParticleState &state, dem::ForceBuffers &forces, bool gathered);
   AppliedFieldFunction lookup_at(double t) const;
   void full_refresh(const BeadArrays &beads, double t, double ramp);
   void take_held_forces();

@@ -7,7 +7,8 @@
 // restart under magnetic settings that differ in an irrelevant knob restores nothing (the
 // held state is for other settings) and is NOT bit-identical, so the comparison can fail.
 // Also bit for bit: the held steps run inside the engine's thread team against the same steps
-// through the serial path, and on one thread (MagneticTeamSteps).
+// through the serial path, and on one thread, with and without the quiet steps that skip the
+// check (MagneticTeamSteps).
 #include "dem/force_terms/magnetic_force_term.h"
 
 #include "coupling/case_parser.h"
@@ -227,7 +228,9 @@ INSTANTIATE_TEST_SUITE_P(
 // loops: gather, staleness check, the close pairs' changes, the held forces), the others go
 // through add_forces() outside it. Both ways give the same bits: 640 carriers, the held
 // forces and the held dipoles, on 2 threads with the held steps in the team and without, and
-// on 1 thread. The run mixes held steps with local refreshes, full evaluations and rebuilds.
+// on 1 thread; and with the team's quiet steps (no gather, no check while the engine's
+// drifts bound every move below what the last check certified) against checking every step.
+// The run mixes held steps with local refreshes, full evaluations and rebuilds.
 TEST(MagneticTeamSteps, HeldStepsInsideTheTeamGiveTheBitsOfTheSerialPath)
 {
   const int threads_before = omp_get_max_threads();
@@ -236,26 +239,34 @@ TEST(MagneticTeamSteps, HeldStepsInsideTheTeamGiveTheBitsOfTheSerialPath)
     const Case c = parse_case_text(
       brush_case("relative", "cell_multipole", "corrected", 2, std::string(", magnetic_hold: ") + hold),
       "magnetic_team_steps.yaml");
-    auto run = [&](int threads, bool in_team) {
+    auto run = [&](int threads, bool in_team, bool quiet = true) {
       omp_set_num_threads(threads);
       auto s = make_system(c, true);
       for (const auto &t : s->force_terms())
         if (auto *m = dynamic_cast<MagneticForceTerm *>(t.get()))
+        {
           m->set_held_steps_in_team(in_team);
+          m->set_quiet_steps(quiet);
+        }
       for (int k = 0; k < 400; ++k)
         s->step();
       return s;
     };
-    const auto team = run(2, true), serial = run(2, false), one = run(1, true);
+    const auto team = run(2, true), serial = run(2, false), one = run(1, true), looking = run(2, true, false);
     const MagneticForceTerm &m = magnetics_of(*team);
-    std::printf("hold %-7s: %ld of 400 steps held inside the team; %ld full evaluations, %ld local refreshes, "
-                "%ld list rebuilds; %zu live pairs\n",
-                hold, m.steps_held_in_team(), m.evaluations(), m.local_refreshes(), m.refresh_counts().rebuilds,
-                m.dipoles().live_pairs());
+    std::printf("hold %-7s: %ld of 400 steps held inside the team, %ld of them quiet; %ld full evaluations, "
+                "%ld local refreshes, %ld list rebuilds; %zu live pairs\n",
+                hold, m.steps_held_in_team(), m.quiet_steps(), m.evaluations(), m.local_refreshes(),
+                m.refresh_counts().rebuilds, m.dipoles().live_pairs());
     EXPECT_TRUE(bit_identical(state_by_id(*team), state_by_id(*serial))) << hold;
     EXPECT_TRUE(bit_identical(state_by_id(*team), state_by_id(*one))) << hold;
-    // Both paths were taken (the first 200 steps follow the field's ramp: serial).
+    EXPECT_TRUE(bit_identical(state_by_id(*team), state_by_id(*looking))) << hold;
+    // Both paths were taken (the first 200 steps follow the field's ramp: serial), and the
+    // quiet steps (no check, their moves bounded by the engine's drifts) on both thread counts.
     EXPECT_GT(m.steps_held_in_team(), 150) << hold;
+    EXPECT_GT(m.quiet_steps(), 20) << hold;
+    EXPECT_GT(magnetics_of(*one).quiet_steps(), 20) << hold;
+    EXPECT_EQ(magnetics_of(*looking).quiet_steps(), 0) << hold;
     EXPECT_GT(m.evaluations() + m.local_refreshes(), 10) << hold;
     EXPECT_EQ(magnetics_of(*serial).steps_held_in_team(), 0) << hold;
   }

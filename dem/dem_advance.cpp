@@ -253,6 +253,14 @@ DemSystem::Pause DemSystem::run_team(long &steps_left, Resume from)
         // The other terms in order, inside the team while each can hold its forces; from
         // the first that cannot, the caller runs them and resumes at the final kick.
         std::size_t serial_from = team_terms_;
+        if (serial_from < terms_.size())
+        {
+          // The per-particle phases above end without a barrier; the terms below add forces
+          // to particles of other threads' shares. The wait for the slowest thread is charged
+          // to the contacts, whose imbalance it is, not to the term that happens to come next.
+#pragma omp barrier
+          clock.charge(walls_.size() > 0 ? times_.wall_contacts : times_.particle_contacts);
+        }
         while (serial_from < terms_.size() &&
                terms_[serial_from]->add_forces_in_team_if_held(particles_, forces_, time_, step_move))
           clock.charge(times_.terms[serial_from++]);

@@ -49,7 +49,8 @@ public:
   // EVERY thread of the team calls add_forces_in_team_if_held() where add_forces() would
   // come; it returns true when it added the forces there (the same bits as add_forces()),
   // false when this step needs add_forces(), which the engine then calls outside the team.
-  // The answer must be the same on every thread (decided from data they all see). This saves
+  // The answer must be the same on every thread (decided from data they all see). The
+  // engine's per-particle phases are complete when it is called (a barrier). This saves
   // the team's stop and restart around the term at every step: the idle thread would go to
   // sleep and be woken again (~25 µs per hand-over on a virtual machine, measured).
   // `step_move` [m] is the largest displacement of any particle in this step's drift

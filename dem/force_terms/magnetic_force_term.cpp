@@ -348,7 +348,7 @@ bool MagneticForceTerm::add_forces_in_team_if_held(const dem::ParticleState &sta
       return true;
     }
   }
-  gather_positions(state); // (its loop's barrier also ends the team's per-particle phases)
+  gather_positions(state);
   const BeadArrays beads = bead_arrays();
   const double t0 = omp_get_wtime();
   const StalenessCheck check = dipoles_.check_staleness(beads, t);
@@ -386,13 +386,6 @@ void MagneticForceTerm::add_held_step(const dem::ParticleState &state, dem::Forc
   const BeadArrays beads = bead_arrays();
   const double t1 = omp_get_wtime();
   const std::vector<double> *live = hold ? usable_live_changes(dipoles_.live_pair_changes_in_team(beads)) : nullptr;
-  // The held forces go to the carriers' engine indices, split otherwise than the engine's
-  // per-particle phases before (their loops end without a barrier): the gather's loop, or
-  // the close pairs' update, ends them; with neither, this barrier does.
-  if (!gathered && !hold)
-  {
-#pragma omp barrier
-  }
   const double t2 = omp_get_wtime();
 #pragma omp master
   {

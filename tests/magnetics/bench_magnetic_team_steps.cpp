@@ -9,7 +9,11 @@
 // magnetics holding dipoles at staleness 0.2 and 20 µs), settled and turned for `turning_us`
 // first, so that the brush flows; its roller field is computed by `magbrush field` here.
 //
-//   bench_magnetic_team_steps [windows per way (20)] [window_steps (250)] [turning_us (200)]
+// The second way can instead be the team's steps without the quiet steps (`quiet` as the
+// fourth argument: MagneticForceTerm::set_quiet_steps, every held step gathers the positions
+// and checks them) against the quiet ones: the same bits too.
+//
+//   bench_magnetic_team_steps [windows per way (20)] [window_steps (250)] [turning_us (200)] [serial|quiet]
 //
 // Prints each way's wall time, the ratio, and where the difference sits (the engine's phases).
 #include "dem/dem_run.h"
@@ -80,6 +84,7 @@ int main(int argc, char **argv)
   const int windows = argc > 1 ? std::atoi(argv[1]) : 20;
   const long window_steps = argc > 2 ? std::atol(argv[2]) : 250;
   const double turning_us = argc > 3 ? std::atof(argv[3]) : 200.0;
+  const bool against_looking = argc > 4 && std::string(argv[4]) == "quiet";
   const fs::path dir = fs::temp_directory_path() / ("magbrush_bench_team_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   const std::string file = std::string(MAGBRUSH_SOURCE_DIR) + "/cases/kawamoto_nip.yaml";
@@ -112,30 +117,34 @@ int main(int argc, char **argv)
                 omp_get_max_threads(), dem::openmp_waiting_description().c_str(), system.particles().size(), windows,
                 window_steps, turning_us);
     Phases way[2];
-    long in_team = 0;
+    long in_team = 0, quiet = 0;
     for (int w = 0; w < 2 * windows; ++w)
     {
       const int k = (w + w / 2) % 2; // in_team, serial, serial, in_team, ...: neither always first
-      term.set_held_steps_in_team(k == 0);
-      const long before_team = term.steps_held_in_team();
+      term.set_held_steps_in_team(against_looking || k == 0);
+      term.set_quiet_steps(k == 0);
+      const long before_team = term.steps_held_in_team(), before_quiet = term.quiet_steps();
       const Phases before = clocks(system);
       const double t0 = omp_get_wtime();
       system.advance(window_steps);
       const double wall = omp_get_wtime() - t0;
       add_difference(way[k], clocks(system), before, wall);
       if (k == 0)
+      {
         in_team += term.steps_held_in_team() - before_team;
+        quiet += term.quiet_steps() - before_quiet;
+      }
     }
     const long steps = windows * window_steps;
     std::printf("| way | wall [s] | per step [us] | integration | contacts | magnetics | other terms |\n");
     std::printf("|---|---|---|---|---|---|---|\n");
-    const char *names[2] = {"held steps in the team", "serial path"};
+    const char *names[2] = {"held steps in the team", against_looking ? "in the team, every step checked" : "serial path"};
     for (int k = 0; k < 2; ++k)
       std::printf("| %s | %.3f | %.1f | %.3f | %.3f | %.3f | %.3f |\n", names[k], way[k].wall,
                   1e6 * way[k].wall / static_cast<double>(steps), way[k].integration, way[k].contacts,
                   way[k].magnetics, way[k].other_terms);
-    std::printf("in the team: %ld of %ld steps; serial / in the team: %.3f\n", in_team, steps,
-                way[1].wall / way[0].wall);
+    std::printf("in the team: %ld of %ld steps (%ld quiet); %s / in the team: %.3f\n", in_team, steps, quiet,
+                against_looking ? "checked every step" : "serial", way[1].wall / way[0].wall);
   }
   catch (const std::exception &e)
   {

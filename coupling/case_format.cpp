@@ -275,6 +275,8 @@ std::vector<ResolvedEntry> resolved_entries(const Case &c)
   e.q("dem.magnetic_staleness", "dem.magnetic_staleness", d.magnetic_staleness);
   e.s("dem.magnetic_staleness_mode", "dem.magnetic_staleness_mode", d.magnetic_staleness_mode);
   e.s("dem.magnetic_hold", "dem.magnetic_hold", d.magnetic_hold);
+  e.q("dem.magnetic_skin", "dem.magnetic_skin", d.magnetic_skin);
+  e.i("dem.magnetic_live_steps", "dem.magnetic_live_steps", d.magnetic_live_steps);
   e.q("dem.air_viscosity", "dem.air_viscosity", d.air_viscosity);
   e.v3("dem.gravity", "dem.gravity", d.gravity);
   e.i("dem.seed", "dem.seed", static_cast<long long>(d.seed));

@@ -1,7 +1,7 @@
 // Case keys of module "magnetics" (the list of modules and why it is explicit: case_keys.h).
 // The carrier magnetics: every dem.magnetic_* key. Read by magnetics/magnetic_settings
 // (MagneticSettings::from_case), which also takes dem.verlet_skin (declared by the DEM) for its
-// own neighbour list.
+// own lists unless dem.magnetic_skin sets theirs.
 //
 // These defaults are what a user's case runs. MagneticSettings' member initialisers (the
 // settings a test or a bench builds by hand) must equal them: tests/coupling/case/test_module_defaults
@@ -30,6 +30,8 @@ std::vector<KeySpec> magnetic_keys()
       choice("dem.magnetic_hold", {"forces", "dipoles"},
              "What the magnetics hold between evaluations: forces (each carrier's magnetic force as last evaluated) or dipoles (the dipoles and local fields; the forces of the pairs within 3 mean radii follow the beads, evaluated every 20 steps from the held dipoles). Holding dipoles is the more accurate for a given magnetic_staleness and magnetic_refresh, so both can be larger (flowing nip at 0.2 and 20 us: 0.27 % RMS held-force error against 1.07 % holding forces; docs/magnetics.md).")
           .def("forces"),
+      number("dem.magnetic_skin", "Skin of the magnetic lists (the far field's cells and near pairs, the two-sphere correction's pairs) in mean carrier diameters; they are rebuilt, with a full evaluation, when a carrier moved half of it (0 = dem.verlet_skin, the contact list's). A larger skin means fewer rebuilds in a flowing brush but longer correction lists (quick nip: 1 diameter with magnetic_staleness 0.6 and magnetic_refresh 40 us, docs/magnetics.md).").def("0").non_negative().max(10.0),
+      integer("dem.magnetic_live_steps", "With magnetic_hold: dipoles, the close pairs' forces follow the beads every this many steps (held in between).").def("20").positive().max(1000),
       number("dem.magnetic_far_cell", "Fine cell size of the magnetic far field in mean carrier diameters (1.5 with order 2: 0.6 % RMS force error on an open brush, 1.1 % on a periodic strip, against brute-force sums; docs/verification.md).").def("1.5").positive().max(10.0),
   };
 }

@@ -235,6 +235,8 @@ struct DemSettings
   // What the magnetics hold between evaluations: "forces", or "dipoles" (the close pairs'
   // forces follow the beads; docs/magnetics.md "Holding the dipoles instead of the forces").
   std::string magnetic_hold = "forces";
+  double magnetic_skin = 0.0;        // magnetic lists' skin in mean diameters (0 = verlet_skin)
+  int magnetic_live_steps = 20;      // hold dipoles: the close pairs' forces every this many steps
   double air_viscosity = 1.81e-5;    // η [Pa s] for Stokes drag (0 = no drag)
   Vec3 gravity{{0.0, -9.81, 0.0}};    // [m/s²]
   unsigned long seed = 1;

@@ -1083,6 +1083,8 @@ private:
     d.magnetic_staleness = q(s, "magnetic_staleness");
     d.magnetic_staleness_mode = str(s, "magnetic_staleness_mode");
     d.magnetic_hold = str(s, "magnetic_hold");
+    d.magnetic_skin = q(s, "magnetic_skin");
+    d.magnetic_live_steps = static_cast<int>(integer(s, "magnetic_live_steps"));
     d.air_viscosity = q(s, "air_viscosity");
     d.gravity = vec3(s, "gravity");
     d.seed = static_cast<unsigned long>(integer(s, "seed"));

@@ -75,7 +75,8 @@ MagneticSettings MagneticSettings::from_case(const DemSettings &dem)
   s.cutoff_diameters = dem.magnetic_cutoff;
   s.tolerance = dem.magnetic_tolerance;
   s.refresh_interval = dem.magnetic_refresh;
-  s.skin_fraction = dem.verlet_skin;
+  s.skin_fraction = dem.magnetic_skin > 0.0 ? dem.magnetic_skin : dem.verlet_skin;
+  s.live_pair_steps = dem.magnetic_live_steps;
   s.far_field = parse_far_field(dem.magnetic_far_field);
   s.far_order = dem.magnetic_far_order;
   s.far_cell_diameters = dem.magnetic_far_cell;

@@ -6,7 +6,8 @@
 // shared 2-core machine) then falls on both alike, which two separate runs cannot promise.
 //
 // Scene: tools/run's quick default (cases/kawamoto_nip.yaml, 4,300 beads, 40 ns steps, the
-// magnetics holding dipoles at staleness 0.2 and 20 µs), settled and turned for `turning_us`
+// magnetics holding dipoles at staleness 0.6 and 40 µs, skin 1 diameter, close pairs every 40
+// steps), settled and turned for `turning_us`
 // first, so that the brush flows; its roller field is computed by `magbrush field` here.
 //
 // The second way can instead be the team's steps without the quiet steps (`quiet` as the
@@ -90,7 +91,8 @@ int main(int argc, char **argv)
   const std::string file = std::string(MAGBRUSH_SOURCE_DIR) + "/cases/kawamoto_nip.yaml";
   const std::vector<std::string> overrides = {
     "populations.carrier.count=4300", "populations.carrier.insert_box=[[12.1mm,-2.5mm,0mm],[13.0mm,1.5mm,1mm]]",
-    "dem.time_step=40ns", "dem.magnetic_hold=dipoles", "dem.magnetic_staleness=0.2", "dem.magnetic_refresh=20us",
+    "dem.time_step=40ns", "dem.magnetic_hold=dipoles", "dem.magnetic_staleness=0.6", "dem.magnetic_refresh=40us",
+    "dem.magnetic_skin=1", "dem.magnetic_live_steps=40",
     "dem.output_interval=0 s", "field.output_dir=" + (dir / "fields").string(), "output.directory=" + dir.string()};
   std::string cmd = "cd '" + dir.string() + "' && OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 '" +
                     std::string(MAGBRUSH_BINARY_DIR) + "/bin/magbrush' field '" + file + "'";

@@ -120,6 +120,49 @@ TEST(MagneticForceTerm, HoldKey)
   EXPECT_THROW(MagneticSettings::from_case(c.dem), std::invalid_argument);
 }
 
+// dem.magnetic_skin (0: the contact list's dem.verlet_skin) and dem.magnetic_live_steps reach
+// the magnetics, and the skin is the lists': a bead moved by a quarter diameter expires them
+// under the default skin (0.3 diameters: rebuilt at 0.15) but not under a skin of one diameter.
+TEST(MagneticForceTerm, SkinAndLiveStepsKeys)
+{
+  Case c = parse_case_text(scene, "magnetic_pair.yaml");
+  EXPECT_EQ(c.dem.magnetic_skin, DemSettings{}.magnetic_skin);
+  EXPECT_EQ(MagneticSettings::from_case(c.dem).skin_fraction, c.dem.verlet_skin);
+  EXPECT_EQ(MagneticSettings::from_case(c.dem).live_pair_steps, 20);
+  long rebuilds[2] = {0, 0};
+  for (const int k : {0, 1})
+  {
+    std::string text = scene;
+    if (k)
+      text.replace(text.find("gravity: [0, 0, 0]}"), 19, "gravity: [0, 0, 0], magnetic_skin: 1, magnetic_live_steps: 40}");
+    Case ck = parse_case_text(text, "magnetic_pair.yaml");
+    if (k)
+    {
+      EXPECT_EQ(MagneticSettings::from_case(ck.dem).skin_fraction, 1.0);
+      EXPECT_EQ(MagneticSettings::from_case(ck.dem).live_pair_steps, 40);
+    }
+    dem::DemSystem system(ck);
+    auto &p = system.particles();
+    const double a = 30e-6;
+    p.add({0.5e-3, 0.5e-3, 0.4e-3}, a, 2200.0, 0, 0.0);
+    p.add({0.5e-3, 0.5e-3, 0.4e-3 + 2.5 * a}, a, 2200.0, 0, 0.0);
+    system.initialize();
+    MagneticForceTerm term(ck, MagneticSettings::from_case(ck.dem), AppliedMagneticField::uniform({0, 0, 1}, 0.13),
+                           system.box().length);
+    dem::ForceBuffers f;
+    f.resize(2);
+    f.clear();
+    term.add_forces(p, f, 0.0);
+    p.x[0] += 0.5 * a; // a quarter diameter
+    f.clear();
+    term.add_forces(p, f, 6e-6); // past the 5 us interval: a full evaluation
+    EXPECT_EQ(term.evaluations(), 2);
+    rebuilds[k] = term.refresh_counts().rebuilds;
+  }
+  EXPECT_EQ(rebuilds[0], 2); // the first build, and the expired lists
+  EXPECT_EQ(rebuilds[1], 1); // the first build only
+}
+
 // Holding the dipoles through the engine: a pair of carriers in a uniform field, the upper one
 // pulled by 4 % of a radius, below the staleness limit (no refresh). Holding the forces keeps
 // the force at the old separation; holding the dipoles evaluates the pair's force at the new

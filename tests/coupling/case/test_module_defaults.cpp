@@ -165,6 +165,8 @@ TEST(ModuleDefaults, DemSettingsOfADefaultCaseAreTheStructDefaults)
   EXPECT_SAME(from_case, built, magnetic_staleness);
   EXPECT_SAME_EXACT(from_case, built, magnetic_staleness_mode);
   EXPECT_SAME_EXACT(from_case, built, magnetic_hold);
+  EXPECT_SAME(from_case, built, magnetic_skin);
+  EXPECT_SAME_EXACT(from_case, built, magnetic_live_steps);
   EXPECT_SAME(from_case, built, air_viscosity);
   expect_same_vec3(from_case.gravity, built.gravity, "gravity");
   EXPECT_SAME_EXACT(from_case, built, seed);

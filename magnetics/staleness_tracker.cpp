@@ -193,8 +193,10 @@ StalenessCheck StalenessTracker::check(const BeadArrays &beads, double time, boo
   {
     const double half_pair_limit = 0.5 * settings_.staleness_fraction * min_radius_ / max_radius_; // [radii]
     const double before_half = min_radius_ * (half_pair_limit - c.max_move);
-    const double margin = pair_pass ? pass_margin_ : since_pass ? pass_margin_ : -1.0;
-    const double before_margin = margin > 0.0 ? 0.5 * margin * std::sqrt(1.0 - 1e-9) - (pair_pass ? 0.0 : std::sqrt(pass_move2)) : 0.0;
+    // (After a pass now the moves count from here; otherwise from the last pass.)
+    const double margin = (pair_pass || since_pass) ? pass_margin_ : -1.0;
+    const double moved_since_pass = pair_pass ? 0.0 : std::sqrt(pass_move2);
+    const double before_margin = margin > 0.0 ? 0.5 * margin * std::sqrt(1.0 - 1e-9) - moved_since_pass : 0.0;
     quiet = std::min(quiet, std::max({before_half, before_margin, 0.0}));
   }
   // (Every thread has the same value; the next step reads it, after the barriers between.)

@@ -376,12 +376,13 @@ bool MagneticForceTerm::add_forces_in_team_if_held(const dem::ParticleState &sta
   return true;
 }
 
-void MagneticForceTerm::add_held_step(const dem::ParticleState &state, dem::ForceBuffers &forces, bool gathered)
+void MagneticForceTerm::add_held_step(const dem::ParticleState &state, dem::ForceBuffers &forces, bool checked)
 {
-  // Called by every thread of the team. The close pairs' changes read the positions only
-  // when they are due: a quiet step gathers them then.
+  // Called by every thread of the team, after a check (the positions gathered) or on a quiet
+  // step (nothing looked at). The close pairs' changes read the positions only when they are
+  // due: a quiet step gathers them then.
   const bool hold = dipoles_.settings().hold_dipoles;
-  if (hold && !gathered && dipoles_.live_pair_changes_due())
+  if (hold && !checked && dipoles_.live_pair_changes_due())
     gather_positions(state);
   const BeadArrays beads = bead_arrays();
   const double t1 = omp_get_wtime();
@@ -394,7 +395,7 @@ void MagneticForceTerm::add_held_step(const dem::ParticleState &state, dem::Forc
     last_scale_ = 1.0;
     ++steps_in_team_;
     ++steps_;
-    quiet_steps_ += gathered ? 0 : 1;
+    quiet_steps_ += checked ? 0 : 1;
   }
   add_held_forces(forces, 1.0, live);
 }

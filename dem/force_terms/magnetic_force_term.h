@@ -226,7 +226,9 @@ private:
   std::vector<QuietMove> quiet_moved_;
   bool quiet_valid_ = false, quiet_steps_on_ = true;
   long quiet_steps_ = 0;
-  void add_held_step(const dem::ParticleState &state, dem::ForceBuffers &forces, bool gathered);
+  // The held forces of a step in the team; `checked`: its positions were gathered and checked
+  // (otherwise a quiet step).
+  void add_held_step(const dem::ParticleState &state, dem::ForceBuffers &forces, bool checked);
   AppliedFieldFunction lookup_at(double t) const;
   void full_refresh(const BeadArrays &beads, double t, double ramp);
   void take_held_forces();

@@ -35,7 +35,13 @@
 // Environment (knobs without a case key): MAGBRUSH_LOCAL_REGION_LIMIT, MAGBRUSH_LOCAL_BATCH,
 // MAGBRUSH_ABSOLUTE_FACTOR, MAGBRUSH_MAGNETIC_SKIN (MagneticSettings local_region_limit,
 // local_batch_fraction, absolute_factor, skin_fraction: the magnetic lists' skin, otherwise
-// dem.verlet_skin).
+// dem.verlet_skin). MAGBRUSH_BENCH_REFERENCE_FAR_PASSES (4): far-field passes of the reference
+// solve; MAGBRUSH_BENCH_WORST=1: per sample, the five beads farthest from the reference.
+//
+// The reference is a fresh solve at tolerance 1e-6 with its far field evaluated again until it
+// no longer lags the dipoles, started cold whenever the set of beads changed (until 2026-12-03
+// it started warm from its previous solve by position in the id order, which an exchange shifts,
+// and evaluated its far field once: in a fed brush that reference itself was off by 1-10 %).
 #include "dem/force_terms/magnetic_force_term.h"
 
 #include "coupling/applied_magnetic_field.h"
@@ -65,6 +71,13 @@ namespace fs = std::filesystem;
 namespace {
 
 // Held magnetic forces against a fresh full evaluation, sampled during the run.
+// Far-field passes of the reference solve (MAGBRUSH_BENCH_REFERENCE_FAR_PASSES, default 4).
+int reference_far_passes()
+{
+  const char *v = std::getenv("MAGBRUSH_BENCH_REFERENCE_FAR_PASSES");
+  return v ? std::atoi(v) : 4;
+}
+
 class HeldForceError : public dem::Measurement
 {
 public:
@@ -77,6 +90,11 @@ public:
     settings.staleness_mode = StalenessMode::absolute;
     settings.tolerance = 1e-6;
     settings.hold_dipoles = false; // (the reference solves; nothing is held between samples)
+    // The reference's far field is evaluated again until it no longer lags the dipoles (one
+    // pass lags them by ~1e-3 of the force in a brush, more after a cold start).
+    settings.far_passes = reference_far_passes();
+    reference_settings_ = settings;
+    box_ = box;
     fresh_ = std::make_unique<InducedDipoles>(settings, box);
     live_ = std::make_unique<InducedDipoles>(settings, box);
     for (const Population &p : c.populations)
@@ -125,7 +143,15 @@ public:
     }
     const double t = system.time();
     const AppliedMagneticField &field = field_;
-    fresh_->compute({n, x_.data(), y_.data(), z_.data(), r_.data(), mu_r_.data(), nullptr},
+    // The reference starts warm from its last solve only when the beads are the same ones:
+    // its dipoles are indexed by position in the id order, which an exchange shifts.
+    ids_now_.assign(n, 0);
+    for (std::size_t k = 0; k < n; ++k)
+      ids_now_[k] = s.id[order_[k]];
+    if (ids_now_ != ids_last_)
+      fresh_ = std::make_unique<InducedDipoles>(reference_settings_, box_);
+    ids_last_.swap(ids_now_);
+    const MagneticStats fs = fresh_->compute({n, x_.data(), y_.data(), z_.data(), r_.data(), mu_r_.data(), nullptr},
                     [&field, t](const double x[3], double B[3], double g[3][3]) { field.evaluate(x, t, B, g); },
                     t, {fx_.data(), fy_.data(), fz_.data()});
     double e2 = 0.0, f2 = 0.0, emax2 = 0.0;
@@ -140,6 +166,8 @@ public:
     if (!(f2 > 0.0))
       return; // no field yet
     const double rms = std::sqrt(e2 / f2), worst = std::sqrt(emax2 / (f2 / n));
+    if (std::getenv("MAGBRUSH_BENCH_WORST"))
+      print_worst_beads(s, hx, hy, hz, t, rms, f2, fs);
     // Held dipoles, live geometry: the same error measure.
     term_->held_dipoles(held_p_);
     live_p_.assign(3 * n, 0.0);
@@ -193,6 +221,38 @@ public:
     max_wall_ = std::max(max_wall_, wall_err);
   }
 
+  // MAGBRUSH_BENCH_WORST: where the error sits. Per sample the reference solve's own state
+  // (sweeps, residual, far-field passes) and the five beads farthest from it: id, angle about
+  // the z axis (the roller's), distance from it, speed, error and force in units of the RMS
+  // force, the held and the fresh force.
+  void print_worst_beads(const dem::ParticleState &s, const std::vector<double> &hx, const std::vector<double> &hy,
+                         const std::vector<double> &hz, double t, double rms, double f2,
+                         const MagneticStats &reference) const
+  {
+    const std::size_t n = order_.size();
+    std::vector<std::pair<double, std::size_t>> err(n);
+    for (std::size_t k = 0; k < n; ++k)
+    {
+      const std::size_t i = order_[k];
+      err[k] = {std::pow(hx[i] - fx_[k], 2) + std::pow(hy[i] - fy_[k], 2) + std::pow(hz[i] - fz_[k], 2), k};
+    }
+    std::sort(err.rbegin(), err.rend());
+    std::printf("t %.4f ms: RMS error %.4f; reference: %d sweeps, residual %.2e, %d far-field passes\n", t * 1e3, rms,
+                reference.sweeps, reference.residual, reference.far_passes);
+    const double f_rms = std::sqrt(f2 / n);
+    for (std::size_t q = 0; q < std::min<std::size_t>(5, n); ++q)
+    {
+      const std::size_t k = err[q].second, i = order_[k];
+      const double angle = std::fmod(std::atan2(s.y[i], s.x[i]) * 180.0 / M_PI + 360.0, 360.0);
+      std::printf("  id %d at %.2f deg, %.4f mm from the axis, speed %.3f m/s: error %.3f, force %.3f (RMS force); "
+                  "held (%.3e, %.3e, %.3e) fresh (%.3e, %.3e, %.3e) N\n",
+                  static_cast<int>(s.id[i]), angle, std::hypot(s.x[i], s.y[i]) * 1e3,
+                  std::sqrt(s.vx[i] * s.vx[i] + s.vy[i] * s.vy[i] + s.vz[i] * s.vz[i]), std::sqrt(err[q].first) / f_rms,
+                  std::sqrt(fx_[k] * fx_[k] + fy_[k] * fy_[k] + fz_[k] * fz_[k]) / f_rms, hx[i], hy[i], hz[i], fx_[k],
+                  fy_[k], fz_[k]);
+    }
+  }
+
   long samples_ = 0;
   // The term's counters at the first sample, and its time: the table counts from there.
   bool started_ = false;
@@ -208,6 +268,9 @@ private:
   std::size_t wall_;
   double interval_;
   std::unique_ptr<InducedDipoles> fresh_;
+  MagneticSettings reference_settings_;
+  std::array<double, 3> box_{};
+  std::vector<std::int32_t> ids_now_, ids_last_;
   // The held dipoles' forces at the current positions (InducedDipoles::forces_of_dipoles):
   // what holding the dipoles instead of the forces would give.
   std::unique_ptr<InducedDipoles> live_;

@@ -476,7 +476,19 @@ bool MagneticForceTerm::admit_pending(const dem::ParticleState &state, double t)
     return true;
   }
   const double t0 = omp_get_wtime();
-  const bool admitted = dipoles_.admit(bead_arrays(), first, leavers_, lookup_at(t), admit_stats_);
+  bool admitted = dipoles_.admit(bead_arrays(), first, leavers_, lookup_at(t), admit_stats_);
+  bool leavers_only = false;
+  if (!admitted && carrier_.size() > first && !leavers_.empty())
+  {
+    // The newcomers cannot join now (one is larger than every bead the two-sphere
+    // correction's list was built for, or that list's reach with the skin comes to a period):
+    // the leavers still can. Kept as frozen sources until the next full evaluation, they
+    // would go on pulling at the beads they left (at an outflow: the front of the layer).
+    for (auto *v : {&x_, &y_, &z_, &radius_, &mu_r_, &Ms_})
+      v->resize(first);
+    carrier_.resize(first);
+    admitted = leavers_only = dipoles_.admit(bead_arrays(), first, leavers_, lookup_at(t), admit_stats_);
+  }
   counts_.admit_s += omp_get_wtime() - t0;
   if (!admitted)
   {
@@ -493,7 +505,8 @@ bool MagneticForceTerm::admit_pending(const dem::ParticleState &state, double t)
   ++counts_.admitted;
   holes_ += leavers_.size();
   counts_.admit_region_beads += static_cast<long>(admit_stats_.local_region);
-  newcomers_.swap(still_waiting_);
+  if (!leavers_only) // (otherwise every newcomer still waits)
+    newcomers_.swap(still_waiting_);
   pending_ = !newcomers_.empty();
   for (auto *v : {&fx_, &fy_, &fz_, &tx_, &ty_, &tz_})
     v->resize(carrier_.size());

@@ -331,7 +331,7 @@ ModeResult run_mode(Case c, const std::string &mode, const std::string &restart,
   // "relative+R1+S0.6" = relative with local_region_limit 1 and the magnetic lists' skin 0.6
   // diameters; "+X0" = defer_exchange off (a full evaluation at every particle exchange);
   // "+A1" / "+A0" = admit_exchange on / off (admission without a rebuild at the next step);
-  // "+F0.1" = magnetic_staleness 0.1; "+H1" = hold the dipoles (the close pairs' forces live),
+  // "+Q0" = no quiet steps, "+T0" = no held steps inside the engine's team; "+F0.1" = magnetic_staleness 0.1; "+H1" = hold the dipoles (the close pairs' forces live),
   // with "+L3" live pairs within 3 mean radii (+ skin), "+N10" their changes every 10 steps.
   const std::vector<std::string> parts = split(mode, '+');
   c.dem.magnetic_staleness_mode = parts[0];
@@ -378,10 +378,19 @@ ModeResult run_mode(Case c, const std::string &mode, const std::string &restart,
       settings.live_pair_radius = v;
     else if (parts[k][0] == 'N')
       settings.live_pair_steps = static_cast<int>(v);
+    else if (parts[k][0] == 'Q' || parts[k][0] == 'T')
+      continue; // (the term's switches, below)
     else
       throw std::runtime_error("unknown mode variant " + parts[k]);
   }
   auto owned = std::make_unique<MagneticForceTerm>(c, settings, field, system.box().length);
+  // "+Q0": no quiet steps (every held step in the team checks); "+T0": no held steps inside
+  // the engine's team at all.
+  for (std::size_t k = 1; k < parts.size(); ++k)
+    if (parts[k][0] == 'Q')
+      owned->set_quiet_steps(std::atof(parts[k].c_str() + 1) != 0.0);
+    else if (parts[k][0] == 'T')
+      owned->set_held_steps_in_team(std::atof(parts[k].c_str() + 1) != 0.0);
   const MagneticForceTerm *term = owned.get();
   system.replace_force_term("magnetic dipoles", std::move(owned));
   auto probe = std::make_unique<HeldForceError>(c, term, settings, field, system.box().length, wall, sample);

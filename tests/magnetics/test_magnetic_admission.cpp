@@ -291,3 +291,70 @@ TEST(MagneticAdmission, ThreadsAndRestartGiveTheSameBits)
   EXPECT_EQ(state_in_id_order(*b), end_state[1]) << "restart";
 }
 
+
+namespace {
+// The largest |F − F_fresh| of the carriers within `reach` of `at`, relative to the RMS of
+// |F_fresh| over all carriers (a fresh full solve of the same state, tolerance 1e-10).
+double worst_near(const Case &c, const dem::DemSystem &system, const MagneticForceTerm &term,
+                  const std::array<double, 3> &at, double reach)
+{
+  std::vector<double> fx, fy, fz;
+  term.last_forces(fx, fy, fz);
+  MagneticSettings settings = MagneticSettings::from_case(c.dem);
+  settings.tolerance = 1e-10;
+  settings.far_passes = far_passes;
+  MagneticForceTerm fresh(c, settings, field, system.box().length);
+  dem::ForceBuffers f;
+  f.resize(system.particles().size());
+  fresh.add_forces(system.particles(), f, system.time());
+  const auto &p = system.particles();
+  double sum_f2 = 0.0, worst2 = 0.0;
+  long carriers = 0;
+  for (std::size_t i = 0; i < p.size(); ++i)
+  {
+    if (p.species[i] != 0)
+      continue;
+    sum_f2 += f.fx[i] * f.fx[i] + f.fy[i] * f.fy[i] + f.fz[i] * f.fz[i];
+    ++carriers;
+    if (std::hypot(p.x[i] - at[0], p.y[i] - at[1], p.z[i] - at[2]) < reach)
+      worst2 = std::max(worst2, std::pow(fx[i] - f.fx[i], 2) + std::pow(fy[i] - f.fy[i], 2) +
+                                    std::pow(fz[i] - f.fz[i], 2));
+  }
+  return std::sqrt(worst2) / std::sqrt(sum_f2 / carriers);
+}
+} // namespace
+
+// A newcomer the two-sphere correction cannot take in without a rebuild (larger than every bead
+// its list was built for) waits for the next full evaluation; the carriers that left at the
+// same exchange are admitted all the same, as holes. Kept as frozen sources instead, they went
+// on pulling at the beads they left behind (found at the regulation cell's outflow: the front
+// of the layer off by 2-3 times the RMS force until the next full evaluation).
+TEST(MagneticAdmission, LeaversAreAdmittedWhenTheNewcomersMustWait)
+{
+  omp_set_num_threads(2);
+  const Case c = parse_case_text(scene, "magnetic_admission.yaml");
+  const MagneticForceTerm *term = nullptr;
+  auto system = make_system(c, true, term);
+  system->insert_particles();
+  system->initialize();
+  system->advance(40);
+  std::vector<Spot> spots;
+  exchange(*system, inflow, 12, {}, &spots); // free spots in occupied fine cells
+  system->step();
+  until_full_evaluation(*system, *term);
+  const long evaluations = term->evaluations(), admitted = term->refresh_counts().admitted;
+  double largest = 0.0;
+  for (std::size_t i = 0; i < system->particles().size(); ++i)
+    largest = std::max(largest, system->particles().radius[i]);
+  Spot big = spots[0];
+  big.radius = 1.2 * largest;
+  exchange(*system, outflow, 6, {big});
+  system->step();
+  EXPECT_EQ(term->evaluations(), evaluations) << "no full evaluation for the exchange";
+  EXPECT_EQ(term->refresh_counts().admitted, admitted + 1) << "the leavers are admitted";
+  // Measured (2 threads): 3.8e-3 with the leavers admitted; 1.42 when they waited as frozen
+  // sources with the newcomer.
+  const double worst = worst_near(c, *system, *term, outflow, 0.15e-3);
+  std::printf("the carriers near the leavers: worst |F - F_fresh| / RMS |F_fresh| %.2e\n", worst);
+  EXPECT_LT(worst, 2e-2);
+}

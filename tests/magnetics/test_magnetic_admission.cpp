@@ -115,6 +115,19 @@ struct Difference
   double newcomer_rms = 0.0, newcomer_worst = 0.0; // the newcomers only, / RMS |F_fresh| of all
 };
 
+// The magnetic forces of a fresh full solve of the system's state (tolerance 1e-10).
+dem::ForceBuffers fresh_solve(const Case &c, const dem::DemSystem &system)
+{
+  MagneticSettings settings = MagneticSettings::from_case(c.dem);
+  settings.tolerance = 1e-10;
+  settings.far_passes = far_passes;
+  MagneticForceTerm fresh(c, settings, field, system.box().length);
+  dem::ForceBuffers f;
+  f.resize(system.particles().size());
+  fresh.add_forces(system.particles(), f, system.time());
+  return f;
+}
+
 // The term's last magnetic forces against a fresh full solve of the same state (tolerance
 // 1e-10): RMS over the carriers of |F − F_fresh| and the worst bead, both relative to the RMS
 // of |F_fresh|; the same over the newcomers (particles with id ≥ first_new_id).
@@ -123,13 +136,7 @@ Difference against_fresh_solve(const Case &c, const dem::DemSystem &system, cons
 {
   std::vector<double> fx, fy, fz;
   term.last_forces(fx, fy, fz);
-  MagneticSettings settings = MagneticSettings::from_case(c.dem);
-  settings.tolerance = 1e-10;
-  settings.far_passes = far_passes;
-  MagneticForceTerm fresh(c, settings, field, system.box().length);
-  dem::ForceBuffers f;
-  f.resize(system.particles().size());
-  fresh.add_forces(system.particles(), f, system.time());
+  const dem::ForceBuffers f = fresh_solve(c, system);
   const auto &p = system.particles();
   double sum_f2 = 0.0, sum_d2 = 0.0, sum_new_d2 = 0.0, worst2 = 0.0, new_worst2 = 0.0;
   long carriers = 0, newcomers = 0;
@@ -300,13 +307,7 @@ double worst_near(const Case &c, const dem::DemSystem &system, const MagneticFor
 {
   std::vector<double> fx, fy, fz;
   term.last_forces(fx, fy, fz);
-  MagneticSettings settings = MagneticSettings::from_case(c.dem);
-  settings.tolerance = 1e-10;
-  settings.far_passes = far_passes;
-  MagneticForceTerm fresh(c, settings, field, system.box().length);
-  dem::ForceBuffers f;
-  f.resize(system.particles().size());
-  fresh.add_forces(system.particles(), f, system.time());
+  const dem::ForceBuffers f = fresh_solve(c, system);
   const auto &p = system.particles();
   double sum_f2 = 0.0, worst2 = 0.0;
   long carriers = 0;

@@ -70,13 +70,16 @@ then compares the nip profiles of all points:
   sweep_summary.csv    one row per point: the varied values (as given and in SI), the bead
                        count, every key number the point's measurements report (dem/summary.csv:
                        e.g. slip at the gap centre, normal force per length, TMA, DMA) with its
-                       standard error, steady_state (1: every tested mean drifts < 2 %),
+                       standard error (<key>_stderr) and, for the keys the steady-state test
+                       looked at, the drift between the halves of the averaging window with its
+                       standard error (<key>_drift, <key>_drift_stderr), steady_state (1: every tested mean drifts < 2 %),
                        significant_drift (1: a drift beyond two of its standard errors, a
                        trend; 0: noise) and drift_resolution, the run time of the point, and with --measured the measured value, the
                        relative error and a within-tolerance flag
   sweep_profiles.csv   every point's profile along the nip (long format), for nip scenes
   sweep_<key>.png      each key with a standard error against the (first) varied value, with
-                       its physical bound (<key>_bound) and the measured points
+                       its physical bound (<key>_bound), the measured points and, per point,
+                       the key's own steady-state verdict, the run's and the run time
   sweep_slip.png, sweep_pressure.png, sweep_density.png   (Kawamoto Fig. 17-19, 22-27)
 Values carry units as in the case file (--vary populations.carrier.diameter=42um,50um,60um).
 Varying a population's diameter also scales its count by (d0/d)^3 and its diameter_std by

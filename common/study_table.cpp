@@ -56,18 +56,26 @@ std::vector<SummaryRow> read_summary_csv(const std::string &path)
   std::ifstream in(path);
   std::string line;
   bool header = true;
+  std::size_t drift = 0, drift_error = 0; // (0: no such column)
   while (std::getline(in, line))
   {
     if (line.empty() || line[0] == '#')
       continue;
+    const auto c = cells_of(line);
     if (header)
     {
       header = false;
+      for (std::size_t k = 1; k < c.size(); ++k)
+      {
+        drift = c[k] == "drift" ? k : drift;
+        drift_error = c[k] == "drift_standard_error" ? k : drift_error;
+      }
       continue;
     }
-    const auto c = cells_of(line);
-    if (c.size() >= 2)
-      rows.push_back({c[0], number_of(c[1]), c.size() >= 3 ? number_of(c[2]) : nan});
+    if (c.size() < 2)
+      continue;
+    auto cell = [&c](std::size_t k) { return k > 0 && k < c.size() ? number_of(c[k]) : nan; };
+    rows.push_back({c[0], number_of(c[1]), cell(2), cell(drift), cell(drift_error)});
   }
   return rows;
 }
@@ -76,9 +84,10 @@ std::string study_table_csv(const std::string &comment, const std::vector<std::s
                             const std::vector<std::string> &trailing_header, const std::vector<StudyPoint> &points,
                             const std::optional<MeasuredComparison> &comparison)
 {
-  // The columns: every key in the order first seen; a stderr column where any point has one.
+  // The columns: every key in the order first seen; a stderr column where any point has one,
+  // and the drift with its standard error where any point tested the key for steady state.
   std::vector<std::string> keys;
-  std::vector<char> has_error;
+  std::vector<char> has_error, has_drift;
   for (const auto &p : points)
     for (const auto &r : p.summary)
     {
@@ -87,9 +96,12 @@ std::string study_table_csv(const std::string &comment, const std::vector<std::s
       {
         keys.push_back(r.key);
         has_error.push_back(0);
+        has_drift.push_back(0);
         it = keys.end() - 1;
       }
-      has_error[static_cast<std::size_t>(it - keys.begin())] |= !std::isnan(r.standard_error);
+      const auto k = static_cast<std::size_t>(it - keys.begin());
+      has_error[k] |= !std::isnan(r.standard_error);
+      has_drift[k] |= !std::isnan(r.drift);
     }
   std::ostringstream o;
   if (!comment.empty())
@@ -98,7 +110,8 @@ std::string study_table_csv(const std::string &comment, const std::vector<std::s
   for (const auto &h : leading_header)
     o << "," << h;
   for (std::size_t k = 0; k < keys.size(); ++k)
-    o << "," << keys[k] << (has_error[k] ? "," + keys[k] + "_stderr" : "");
+    o << "," << keys[k] << (has_error[k] ? "," + keys[k] + "_stderr" : "")
+      << (has_drift[k] ? "," + keys[k] + "_drift," + keys[k] + "_drift_stderr" : "");
   const int percent = comparison ? static_cast<int>(std::lround(100.0 * comparison->tolerance)) : 0;
   if (comparison)
     o << ",measured_" << comparison->key << ",relative_error_" << comparison->key << ",within_" << percent
@@ -118,6 +131,8 @@ std::string study_table_csv(const std::string &comment, const std::vector<std::s
       o << "," << format(r ? r->value : nan);
       if (has_error[k])
         o << "," << format(r ? r->standard_error : nan);
+      if (has_drift[k])
+        o << "," << format(r ? r->drift : nan) << "," << format(r ? r->drift_standard_error : nan);
     }
     if (comparison)
     {

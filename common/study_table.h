@@ -8,6 +8,7 @@
 // appears in every study without touching the sweep.
 #pragma once
 
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -19,10 +20,14 @@ struct SummaryRow
   std::string key;
   double value;
   double standard_error; // NaN: none
+  // The steady-state test's numbers for this key, where the run tested it: the relative drift
+  // between the halves of the averaging window and the drift's own standard error.
+  double drift = std::numeric_limits<double>::quiet_NaN();
+  double drift_standard_error = std::numeric_limits<double>::quiet_NaN();
 };
 
-// The rows of a run's summary.csv (key,value,standard_error,...); an absent or unreadable
-// file gives no rows.
+// The rows of a run's summary.csv (key,value,standard_error,... with the columns drift and
+// drift_standard_error found by name); an absent or unreadable file gives no rows.
 std::vector<SummaryRow> read_summary_csv(const std::string &path);
 
 struct StudyPoint
@@ -41,7 +46,8 @@ struct MeasuredComparison
 };
 
 // The table as CSV: "point", the leading header, every summary key in the order first seen
-// (with "<key>_stderr" after it when any point has a standard error for it), then for a
+// (with "<key>_stderr" after it when any point has a standard error for it, then "<key>_drift"
+// and "<key>_drift_stderr" when any point tested it for steady state), then for a
 // comparison "measured_<key>", "relative_error_<key>", "within_<p>_percent_<key>", then the
 // trailing header. A point without a key gets "nan".
 std::string study_table_csv(const std::string &comment, const std::vector<std::string> &leading_header,

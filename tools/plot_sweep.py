@@ -7,7 +7,8 @@ Reads sweep_summary.csv there and writes (atomically) sweep_<key>.png for every 
 standard error, a physical bound (<key>_bound) or a measured comparison (or the keys named with
 --key): the mean with its standard-error bars against the first varied value (in SI), the bound
 as a dashed line, the measured points with their relative error and the within-tolerance flag,
-the steady-state verdict and the run time of each point. For nip scenes it also reads
+the steady-state verdict of the key itself (where the runs tested it: its drift between the
+halves of the window), of the whole run, and the run time of each point. For nip scenes it also reads
 sweep_profiles.csv and writes sweep_slip.png, sweep_pressure.png, sweep_density.png (Kawamoto
 Fig. 17-19 and 22-27: one curve per point).
 Exit status 3 when matplotlib is missing, 2 for unreadable inputs.
@@ -37,6 +38,27 @@ def number(text):
         return float("nan")
 
 
+def verdicts(col, r, key):
+    """The point's steady-state verdicts: this key's own (where the run tested it: its drift
+    between the halves of the window, under 2 % = steady, beyond two of its standard errors =
+    drifting, else undecided), the whole run's (every tested key), and the run time."""
+    steady = r[col["steady_state"]] if "steady_state" in col else "nan"
+    trend = r[col["significant_drift"]] if "significant_drift" in col else "nan"
+    run = r[col["run_time_s"]] if "run_time_s" in col else "?"
+    verdict = ("steady" if steady == "1" else "steady ?" if steady != "0" else
+               "undecided (noise)" if trend == "0" else "NOT steady")
+    if key + "_drift" not in col:
+        return f"{verdict}, {run} s"
+    drift = number(r[col[key + "_drift"]])
+    error = number(r[col[key + "_drift_stderr"]]) if key + "_drift_stderr" in col else float("nan")
+    if drift != drift:
+        return f"{key} not tested; run {verdict}, {run} s"
+    own = ("steady" if abs(drift) < 0.02 else "drifting" if error == error and abs(drift) > 2 * error
+           else "undecided (noise)")
+    spread = f" ± {100 * error:.1f}" if error == error else ""
+    return f"{key} {own} (drift {100 * drift:.1f}{spread} %); run {verdict}, {run} s"
+
+
 def plot_keys(plt, directory, header, rows, requested):
     """One plot per key: mean ± standard error against the first varied value (SI)."""
     col = {name: i for i, name in enumerate(header)}
@@ -56,6 +78,8 @@ def plot_keys(plt, directory, header, rows, requested):
             base = h[: -len("_bound")]
         elif h.startswith("measured_"):
             base = h[len("measured_"):]
+        if base and base.endswith("_drift") and base[: -len("_drift")] in col:
+            continue  # a key's steady-state drift: shown in that key's own plot
         if base and base in col and base not in keys:
             keys.append(base)
     for key in keys:
@@ -81,15 +105,8 @@ def plot_keys(plt, directory, header, rows, requested):
                     ok = flag and r[col[flag[0]]] == "1"
                     ax.annotate(f"{100 * e:+.1f} %" + (" ✓" if ok else " ✗"), (x, y), textcoords="offset points",
                                 xytext=(6, -12), fontsize=8, color="C2" if ok else "C3")
-        notes = []
-        for x, r in zip(xs, rows):
-            steady = r[col["steady_state"]] if "steady_state" in col else "nan"
-            trend = r[col["significant_drift"]] if "significant_drift" in col else "nan"
-            run = r[col["run_time_s"]] if "run_time_s" in col else "?"
-            verdict = ("steady" if steady == "1" else "steady ?" if steady != "0" else
-                       "undecided (noise)" if trend == "0" else "NOT steady")
-            notes.append(f"{x:g}: {verdict}, {run} s")
-        ax.set_title("; ".join(notes), fontsize=7)
+        notes = [f"{x:g}: {verdicts(col, r, key)}" for x, r in zip(xs, rows)]
+        ax.set_title("\n".join(notes) if key + "_drift" in col else "; ".join(notes), fontsize=7)
         ax.set_xlabel(x_name)
         ax.set_ylabel(key)
         ax.grid(alpha=0.3)

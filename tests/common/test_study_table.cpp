@@ -52,6 +52,20 @@ TEST(StudyTable, ColumnsAreTheUnionOfTheSummariesWithStandardErrorsWhereGiven)
   EXPECT_EQ(rows[2], (std::vector<std::string>{"p1", "-600V", "0.003", "nan", "nan", "-0.03", "0.001", "13", "failed"}));
 }
 
+// A key that a point tested for steady state gets its drift and the drift's standard error
+// (so that a plot can judge that key alone); points that did not test it read nan.
+TEST(StudyTable, DriftColumnsWhereAPointTestedTheKey)
+{
+  std::vector<StudyPoint> points = {{"p0", {}, {{"dma_kg_per_m2", 0.5, 0.01, 0.002, 0.01}}, {}},
+                                    {"p1", {}, {{"dma_kg_per_m2", 0.3, 0.01}}, {}}};
+  const auto rows = parse(study_table_csv("", {}, {}, points));
+  ASSERT_EQ(rows.size(), 3u);
+  EXPECT_EQ(rows[0], (std::vector<std::string>{"point", "dma_kg_per_m2", "dma_kg_per_m2_stderr", "dma_kg_per_m2_drift",
+                                                "dma_kg_per_m2_drift_stderr"}));
+  EXPECT_EQ(rows[1], (std::vector<std::string>{"p0", "0.5", "0.01", "0.002", "0.01"}));
+  EXPECT_EQ(rows[2], (std::vector<std::string>{"p1", "0.3", "0.01", "nan", "nan"}));
+}
+
 TEST(StudyTable, MeasuredComparisonGivesRelativeErrorAndTheTenPercentFlag)
 {
   std::vector<StudyPoint> points = {{"p0", {}, {{"dma_kg_per_m2", 0.50, 0.01}}, {}},
@@ -74,16 +88,19 @@ TEST(StudyTable, ReadsARunSummaryFile)
 {
   const auto dir = magbrush::testing::test_temp_dir("study_table");
   const auto path = dir / "summary.csv";
-  std::ofstream(path) << "# comment\nkey,value,standard_error,drift,unit,meaning,measurement\n"
-                         "normal_force_per_length_N_m,2.5,0.1,0.01,N/m,normal force,nip profile\n"
-                         "peak_normal_pressure_Pa,1400,nan,nan,Pa,peak,nip profile\n"
-                         "steady_state,1,nan,nan,1,all steady,run\n";
+  std::ofstream(path) << "# comment\nkey,value,standard_error,drift,unit,meaning,measurement,drift_standard_error\n"
+                         "normal_force_per_length_N_m,2.5,0.1,0.01,N/m,normal force,nip profile,0.004\n"
+                         "peak_normal_pressure_Pa,1400,nan,nan,Pa,peak,nip profile,nan\n"
+                         "steady_state,1,nan,nan,1,all steady,run,nan\n";
   const auto rows = read_summary_csv(path.string());
   ASSERT_EQ(rows.size(), 3u);
   EXPECT_EQ(rows[0].key, "normal_force_per_length_N_m");
   EXPECT_EQ(rows[0].value, 2.5);
   EXPECT_EQ(rows[0].standard_error, 0.1);
+  EXPECT_EQ(rows[0].drift, 0.01);
+  EXPECT_EQ(rows[0].drift_standard_error, 0.004);
   EXPECT_TRUE(std::isnan(rows[1].standard_error));
+  EXPECT_TRUE(std::isnan(rows[1].drift));
   EXPECT_EQ(rows[2].key, "steady_state");
   EXPECT_TRUE(read_summary_csv((dir / "absent.csv").string()).empty());
   std::filesystem::remove_all(dir);

@@ -70,7 +70,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// Held magnetic forces against a fresh full evaluation, sampled during the run.
 // Far-field passes of the reference solve (MAGBRUSH_BENCH_REFERENCE_FAR_PASSES, default 4).
 int reference_far_passes()
 {
@@ -78,6 +77,7 @@ int reference_far_passes()
   return v ? std::atoi(v) : 4;
 }
 
+// Held magnetic forces against a fresh full evaluation, sampled during the run.
 class HeldForceError : public dem::Measurement
 {
 public:
@@ -331,7 +331,8 @@ ModeResult run_mode(Case c, const std::string &mode, const std::string &restart,
   // "relative+R1+S0.6" = relative with local_region_limit 1 and the magnetic lists' skin 0.6
   // diameters; "+X0" = defer_exchange off (a full evaluation at every particle exchange);
   // "+A1" / "+A0" = admit_exchange on / off (admission without a rebuild at the next step);
-  // "+Q0" = no quiet steps, "+T0" = no held steps inside the engine's team; "+F0.1" = magnetic_staleness 0.1; "+H1" = hold the dipoles (the close pairs' forces live),
+  // "+Q0" = no quiet steps, "+T0" = no held steps inside the engine's team;
+  // "+F0.1" = magnetic_staleness 0.1; "+H1" = hold the dipoles (the close pairs' forces live),
   // with "+L3" live pairs within 3 mean radii (+ skin), "+N10" their changes every 10 steps.
   const std::vector<std::string> parts = split(mode, '+');
   c.dem.magnetic_staleness_mode = parts[0];

@@ -34,7 +34,7 @@ std::string run_summary_csv(const std::vector<std::unique_ptr<Measurement>> &mea
 {
   std::ostringstream o;
   o << "# magbrush run summary: every measurement's key numbers; standard errors by block averaging over "
-    << statistics.blocks << " blocks; drift = |mean of 2nd half - mean of 1st half| / |mean|, with its own "
+    << statistics.blocks << " blocks; drift = (mean of 2nd half - mean of 1st half) / |mean| (negative: falling), with its own "
     << "standard error from each half's blocks\n";
   o << "key,value,standard_error,drift,unit,meaning,measurement,drift_standard_error\n";
   SteadyStateVerdict verdict;
@@ -55,11 +55,11 @@ void SteadyStateVerdict::add(const SummaryValue &v, double tolerance)
   if (std::isnan(v.drift))
     return;
   ++tested;
-  steady += v.drift < tolerance;
+  steady += std::abs(v.drift) < tolerance;
   if (std::isnan(v.drift_standard_error))
     return;
   ++with_error;
-  trending += v.drift > 2.0 * v.drift_standard_error;
+  trending += std::abs(v.drift) > 2.0 * v.drift_standard_error;
   resolution = std::max(resolution, 2.0 * v.drift_standard_error);
 }
 

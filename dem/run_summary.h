@@ -10,7 +10,8 @@
 //   drift_resolution,0.012,,,1,two standard errors of the drift of the noisiest tested mean,run
 //
 // (and a last column, drift_standard_error, on every row.) steady_state is 1 when every value
-// tested for drift (a finite drift) is below statistics.steady_drift, 0 when one is not, NaN
+// tested for drift (a finite drift) is below statistics.steady_drift in size (the drift is
+// signed: negative while the quantity falls), 0 when one is not, NaN
 // when nothing was tested. The two rows after it say what a 0 means: significant_drift = 1 is
 // a trend (the run is not there yet: run longer); significant_drift = 0 with drift_resolution
 // above the tolerance is a window too noisy to decide (average more samples: a longer window

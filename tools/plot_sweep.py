@@ -56,7 +56,7 @@ def verdicts(col, r, key):
     own = ("steady" if abs(drift) < 0.02 else "drifting" if error == error and abs(drift) > 2 * error
            else "undecided (noise)")
     spread = f" ± {100 * error:.1f}" if error == error else ""
-    return f"{key} {own} (drift {100 * drift:.1f}{spread} %); run {verdict}, {run} s"
+    return f"{key} {own} (drift {100 * drift:+.1f}{spread} %); run {verdict}, {run} s"
 
 
 def plot_keys(plt, directory, header, rows, requested):

@@ -84,12 +84,13 @@ def steady_state_rows(run_summary, supplied=True):
         except ValueError:
             continue
         if math.isfinite(drift):
-            tested.append((drift, r["key"]))
+            tested.append((abs(drift), drift, r["key"]))
     if verdict is None or not tested:
         return []
     tested.sort(reverse=True)
     reached = verdict["value"] == "1"
-    worst = ", ".join(f"{k} {100 * d:.1f} %" for d, k in tested[:4])
+    # Signed: + still rising, − still falling (or draining).
+    worst = ", ".join(f"{k} {100 * d:+.1f} %" for _, d, k in tested[:4])
     trend = by_key.get("significant_drift", {}).get("value")
     try:
         resolution = float(by_key.get("drift_resolution", {}).get("value", "nan"))

@@ -66,7 +66,7 @@ double SampleSeries::drift() const
   const auto middle = values_.begin() + static_cast<std::ptrdiff_t>(values_.size() / 2);
   const double first = mean_of(values_.begin(), middle), second = mean_of(middle, values_.end());
   const double m = mean();
-  return m != 0.0 ? std::abs(second - first) / std::abs(m) : nan;
+  return m != 0.0 ? (second - first) / std::abs(m) : nan;
 }
 
 double SampleSeries::drift_standard_error(std::size_t blocks) const

@@ -8,7 +8,8 @@
 //    much longer than the correlation time; the block means are then nearly independent and
 //    their spread / √B estimates the standard error of the mean.
 //  * whether it is at a STEADY STATE: the relative drift between the means of the first and
-//    the second half of the averaging window, |m₂ − m₁| / |m|, below a tolerance (2 % by
+//    the second half of the averaging window, (m₂ − m₁) / |m| — signed, so that a report can
+//    say whether a quantity still rises or falls — below a tolerance in size (2 % by
 //    default, `statistics.steady_drift`). A series still rising or draining fails it; a
 //    stationary one passes once its halves' noise is below the tolerance.
 //  * whether a failed test says anything: the drift's own STANDARD ERROR, from each half's
@@ -39,7 +40,8 @@ public:
   // length (the oldest samples that do not fill a block are left out). NaN with fewer than
   // two samples per block.
   double standard_error(std::size_t blocks = default_blocks) const;
-  // |mean(second half) − mean(first half)| / |mean| (NaN with fewer than 4 samples or a zero mean).
+  // (mean(second half) − mean(first half)) / |mean|: positive while the quantity rises, negative
+  // while it falls (NaN with fewer than 4 samples or a zero mean).
   double drift() const;
   // Standard error of drift(): each half cut into blocks/2 blocks (the newest that fill them),
   // the half's standard error from its block means about its own mean, the two combined, over

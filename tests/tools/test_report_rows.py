@@ -64,6 +64,13 @@ class SteadyStateRow(unittest.TestCase):
         self.assertTrue(row[1].startswith("NOT reached"), row)
         self.assertNotIn("this window (a longer run", row[3])
 
+    def test_the_drift_says_which_way(self):
+        # A falling mean (negative drift) is as far from steady as a rising one, and the row
+        # says it falls.
+        row = report.steady_state_rows(summary(-0.10, 0.02, 0.04, True, False))[0]
+        self.assertTrue(row[1].startswith("NOT reached"), row)
+        self.assertIn("normal_force_per_length_N_m -10.0 %", row[3])
+
     def test_reached_needs_no_advice(self):
         row = report.steady_state_rows(summary(0.005, 0.004, 0.008, False, True))[0]
         self.assertEqual(row[1], "reached")

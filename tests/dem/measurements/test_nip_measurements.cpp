@@ -420,7 +420,7 @@ TEST(NipProfile, SummaryJudgesSteadyStateByTheDriftOfItsMeans)
   for (int k = 0; k < 100; ++k)
     draining.add_sample(k * 1e-6, {bead_pressing(draining, 2e-3 - 1e-3 * k / 100.0)});
   const SummaryValue d = value(draining.summary(), "normal_force_per_length_N_m");
-  EXPECT_NEAR(d.drift, (0.5e-3) / (1.505e-3), 1e-9);
+  EXPECT_NEAR(d.drift, -(0.5e-3) / (1.505e-3), 1e-9); // falling: a negative drift
   EXPECT_GT(d.standard_error, 0.0);
   m.clear();
   m.push_back(std::make_unique<NipProfile>(draining));

@@ -24,6 +24,12 @@ TEST(SampleSeries, DriftOfALinearRampIsExact)
   EXPECT_NEAR(s.mean(), m, 1e-14);
   EXPECT_NEAR(s.drift(), (a / 2.0) / m, 1e-13);
   EXPECT_GT(s.drift(), 0.02); // a 10 % ramp is not a steady state
+
+  // The same ramp downwards: the same size, the sign says it falls.
+  SampleSeries falling;
+  for (int k = 0; k < n; ++k)
+    falling.add(1.0 + a - a * k / n);
+  EXPECT_NEAR(falling.drift(), -(a / 2.0) / (1.0 + a - a * (n - 1) / (2.0 * n)), 1e-13);
 }
 
 TEST(SampleSeries, ConstantSeriesHasNoDriftAndNoError)
@@ -109,7 +115,7 @@ TEST(SampleSeries, DriftStandardErrorOfWhiteNoiseMatchesTheExactValue)
       s.add(sample(rng));
     const double se = s.drift_standard_error();
     mean_estimate += se / series;
-    beyond_two += s.drift() > 2.0 * se;
+    beyond_two += std::abs(s.drift()) > 2.0 * se;
   }
   EXPECT_NEAR(mean_estimate / exact, 1.0, 0.06);
   EXPECT_GT(beyond_two, series * 3 / 100);

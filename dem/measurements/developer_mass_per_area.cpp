@@ -55,7 +55,7 @@ bool DeveloperMassPerArea::applies(const Case &c)
 DeveloperMassPerArea::DeveloperMassPerArea(const Case &c)
   : settings_(c.dma), statistics_(c.statistics), R_(c.sleeve ? c.sleeve->radius : 0.0), Lz_(c.dem.periodic_length),
     sense_(c.sleeve && c.sleeve->omega() < 0.0 ? -1.0 : 1.0), speed_(c.sleeve ? c.sleeve->surface_speed() : 0.0),
-    centre_line_(0, 1, 1, 1, 1), release_before_(0, 1, 1, 1, 1), release_after_(0, 1, 1, 1, 1)
+    centre_line_(0, 1, 1, 1, 1)
 {
   const BladeOrGuide *blade = doctor_blade(c);
   if (!applies(c) || !blade)
@@ -78,11 +78,6 @@ DeveloperMassPerArea::DeveloperMassPerArea(const Case &c)
   const double within = R_ + settings_.height;
   centre_line_ = LineFlux(blade_angle_ + sense_ * settings_.after_blade, sense_, settings_.window, R_, Lz_);
   centre_line_.set_max_radius(within);
-  release_ = settings_.release_from != settings_.release_to;
-  release_before_ = LineFlux(settings_.release_from, sense_, settings_.window, R_, Lz_);
-  release_after_ = LineFlux(settings_.release_to, sense_, settings_.window, R_, Lz_);
-  release_before_.set_max_radius(within);
-  release_after_.set_max_radius(within);
 }
 
 double DeveloperMassPerArea::angle_from(double px, double py, double angle) const
@@ -111,9 +106,6 @@ void DeveloperMassPerArea::add_sample(double time, const ParticleState &s, const
   // The line counters see every sample (a crossing needs the previous position), the means
   // only those from average_from on.
   const LineFluxSample centre = centre_line_.sample(time, s);
-  LineFluxSample before, after;
-  if (release_)
-    before = release_before_.sample(time, s), after = release_after_.sample(time, s);
   const double dt = previous_time_ >= 0.0 ? time - previous_time_ : 0.0;
   previous_time_ = time;
 
@@ -144,8 +136,6 @@ void DeveloperMassPerArea::add_sample(double time, const ParticleState &s, const
   row.blade_radial = (force_on_blade.x * c + force_on_blade.y * sn) / Lz_;
   row.blade_along = sense_ * (-force_on_blade.x * sn + force_on_blade.y * c) / Lz_;
   row.held_in_front = front / Lz_;
-  row.release_before = before.crossed_mass;
-  row.release_after = after.crossed_mass;
   rows_.push_back(row);
 
   if (time < settings_.average_from)
@@ -158,8 +148,6 @@ void DeveloperMassPerArea::add_sample(double time, const ParticleState &s, const
   blade_radial_.add(row.blade_radial);
   blade_along_.add(row.blade_along);
   held_.add(row.held_in_front);
-  if (release_ && dt > 0.0)
-    released_before_.add(row.release_before), released_after_.add(row.release_after);
 }
 
 std::vector<SummaryValue> DeveloperMassPerArea::summary() const
@@ -185,16 +173,6 @@ std::vector<SummaryValue> DeveloperMassPerArea::summary() const
   if (concentration_.size() > 0)
     out.push_back(sampled("toner_concentration_after_blade", concentration_, false, "1",
                           "toner mass / carrier mass in the DMA window"));
-  if (release_)
-  {
-    // 1 − A/B from the mean crossed masses; its error from both (treated as independent).
-    const double a = released_after_.mean(), b = released_before_.mean();
-    const double sa = released_after_.standard_error(blocks), sb = released_before_.standard_error(blocks);
-    SummaryValue f{"released_fraction", b > 0.0 ? 1.0 - a / b : nan,
-                   b > 0.0 ? std::hypot(sa / b, a * sb / (b * b)) : nan, nan, "1",
-                   "1 - (flux near the sleeve after the release) / (flux before it)"};
-    out.push_back(f);
-  }
   return out;
 }
 
@@ -209,12 +187,11 @@ std::string DeveloperMassPerArea::csv() const
                 settings_.after_blade * 180.0 / M_PI, settings_.height * 1e3, dma_bound());
   o << line;
   o << "time_s,dma_kg_per_m2,dma_flux_kg_per_m2,toner_concentration,blade_force_N_per_m,blade_drag_N_per_m,"
-       "held_in_front_kg_per_m,release_before_kg,release_after_kg\n";
+       "held_in_front_kg_per_m\n";
   for (const Row &r : rows_)
   {
-    std::snprintf(line, sizeof line, "%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n", r.time, r.dma, r.dma_flux,
-                  r.toner_concentration, r.blade_radial, r.blade_along, r.held_in_front, r.release_before,
-                  r.release_after);
+    std::snprintf(line, sizeof line, "%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n", r.time, r.dma, r.dma_flux,
+                  r.toner_concentration, r.blade_radial, r.blade_along, r.held_in_front);
     o << line;
   }
   return o.str();

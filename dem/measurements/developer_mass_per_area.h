@@ -17,8 +17,7 @@
 //  * the developer held in front of the blade: the mass in the sector dma.front_window just
 //    before the tip, at any distance from the sleeve, per slab length (Kweon Fig. 5: the
 //    accumulation that the auxiliary guide wall removes);
-//  * with a release sector (dma.release_from ≠ dma.release_to): the masses crossing the two
-//    lines within dma.height of the sleeve; the RELEASED FRACTION is 1 − (after)/(before).
+// (The fraction released after the nip, dma.release_*, is developer_release.h's.)
 //
 // The summary (dem/summary.csv, gathered by `magbrush sweep`) gives the means over the samples
 // from dma.average_from with block-averaged standard errors and the steady-state drift, and
@@ -66,7 +65,6 @@ private:
     double time = 0, dma = 0, dma_flux = 0, toner_concentration = 0;
     double blade_radial = 0, blade_along = 0; // [N/m]
     double held_in_front = 0;                 // [kg/m]
-    double release_before = 0, release_after = 0; // crossed masses since the previous sample [kg]
   };
 
   DmaSettings settings_;
@@ -75,12 +73,10 @@ private:
   double blade_angle_ = 0, gap_ = 0, bulk_density_ = 0;
   std::string blade_name_;
   std::vector<char> is_toner_; // per population index
-  LineFlux centre_line_, release_before_, release_after_;
-  bool release_ = false;
+  LineFlux centre_line_;
   double previous_time_ = -1.0;
   std::vector<Row> rows_;
   SampleSeries dma_, dma_flux_, concentration_, blade_radial_, blade_along_, held_;
-  SampleSeries released_before_, released_after_;
 
   // Angle of p from `angle` in the sense the sleeve turns, in (−π, π].
   double angle_from(double px, double py, double angle) const;

@@ -1,9 +1,9 @@
 // The DMA measurement against values computed here from hand-made scenes: a ring of beads
 // riding on the sleeve (areal DMA from the count in the window; the flux form equals it over
 // whole spacings of the ring), the height filter, the developer held in front of the blade,
-// the blade's load resolved at its tip, the bound from the generated blade's gap, and a
-// release that drops every other bead (released fraction 1/2).
+// the blade's load resolved at its tip and the bound from the generated blade's gap.
 #include "dem/measurements/developer_mass_per_area.h"
+#include "sleeve_ring.h"
 
 #include "coupling/case_parser.h"
 
@@ -46,17 +46,9 @@ dem: {periodic_length: 0.2 mm, duration: 1 ms}
   return parse_case_text(text, "dma_test.yaml");
 }
 
-// N beads of mass m evenly spaced around the sleeve at height h, the whole ring turned by φ.
 ParticleState ring(int n, double h, double phi, double m_each)
 {
-  ParticleState s;
-  const double r = 25e-6, density = m_each / (4.0 / 3.0 * M_PI * r * r * r);
-  for (int k = 0; k < n; ++k)
-  {
-    const double a = phi + 2.0 * M_PI * (k + 0.5) / n;
-    s.add({(R + h) * std::cos(a), (R + h) * std::sin(a), 0.1e-3}, r, density, 0, 0.0);
-  }
-  return s;
+  return test_scenes::sleeve_ring(R, n, h, phi, m_each);
 }
 
 } // namespace
@@ -117,38 +109,14 @@ TEST(DeveloperMassPerArea, BladeLoadAlongItsRadiusAndAlongTheSleevesMotion)
   for (const auto &v : s)
   {
     if (v.key == "blade_force_N_per_m")
-      EXPECT_NEAR(v.value, 3e-3 / Lz, 1e-9);
-    if (v.key == "blade_drag_N_per_m")
-      EXPECT_NEAR(v.value, 2e-3 / Lz, 1e-9);
-  }
-}
-
-TEST(DeveloperMassPerArea, ReleasedFractionWhenEveryOtherBeadLeavesTheSleeve)
-{
-  // Release lines at 150 and 200 deg; past 175 deg the odd beads are 5 mm off the sleeve.
-  const Case c = blade_case("dma: {release_from: 150 deg, release_to: 200 deg, height: 1 mm}\n");
-  DeveloperMassPerArea dma(c);
-  const int n = 360;
-  const double spacing = 2 * M_PI / n, omega = c.sleeve->omega(), dt = spacing / 4.0 / omega;
-  for (int k = 0; k <= 4 * 40; ++k)
-  {
-    ParticleState s = ring(n, 0.2e-3, omega * k * dt, 1e-10);
-    for (std::size_t i = 1; i < s.size(); i += 2)
     {
-      const double a = std::fmod(std::atan2(s.y[i], s.x[i]) + 2 * M_PI, 2 * M_PI);
-      if (a > 175 * deg && a < 300 * deg)
-      {
-        const double scale = (R + 5e-3) / std::hypot(s.x[i], s.y[i]);
-        s.x[i] *= scale, s.y[i] *= scale;
-      }
+      EXPECT_NEAR(v.value, 3e-3 / Lz, 1e-9);
     }
-    dma.add_sample(k * dt, s, Vector3{});
+    if (v.key == "blade_drag_N_per_m")
+    {
+      EXPECT_NEAR(v.value, 2e-3 / Lz, 1e-9);
+    }
   }
-  double fraction = std::nan("");
-  for (const auto &v : dma.summary())
-    if (v.key == "released_fraction")
-      fraction = v.value;
-  EXPECT_NEAR(fraction, 0.5, 1e-9);
 }
 
 TEST(DeveloperMassPerArea, RegisteredOnlyForASceneWithADoctorBlade)

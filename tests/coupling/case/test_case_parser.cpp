@@ -156,6 +156,30 @@ TEST(CaseFiles, KweonFullRollerIsAClosedDeveloperLoop)
   EXPECT_GT(c.roller->poles[1].strength, 0.0);
 }
 
+TEST(CaseFiles, KweonReleaseBracketsTheLikePolesAndRemovesWhatLeavesTheSleeve)
+{
+  // The release sector: fed before S2, the two measuring lines on either side of the like
+  // poles S2/S3, the carried-back outflow past the second line, and what left the sleeve
+  // removed before it can cross that line as "carried".
+  const Case c = load_case(source_dir + "/cases/kweon_release.yaml");
+  EXPECT_TRUE(c.blades.empty());
+  ASSERT_EQ(c.roller->poles.size(), 5u);
+  const double s2 = c.roller->poles[2].angle, s3 = c.roller->poles[3].angle;
+  EXPECT_LT(c.roller->poles[2].strength, 0.0); // both S: they repel
+  EXPECT_LT(c.roller->poles[3].strength, 0.0);
+  EXPECT_LT(c.flow.inflow_angle, c.dma.release_from);
+  EXPECT_LT(c.dma.release_from, s2 + 0.5 * (s3 - s2));
+  EXPECT_GT(c.dma.release_to, s3);
+  EXPECT_LT(c.dma.release_to, c.flow.outflow_angle);
+  // A bead leaving the sleeve along the tangent at 200 deg is at R / cos(release_to - 200 deg)
+  // from the axis when it reaches the second line: beyond the outflow's radius, so removed.
+  const double R = c.sleeve->radius, leave = 200.0 * M_PI / 180.0;
+  EXPECT_GT(R / std::cos(c.dma.release_to - leave), c.flow.outflow_radius);
+  // Only the layer counts at the lines, and its chains (up to ~1.5 mm) are part of it.
+  EXPECT_LT(R + c.dma.height, c.flow.outflow_radius);
+  EXPECT_GE(c.dma.height, 1.5e-3);
+}
+
 TEST(CaseFiles, KweonDevelopmentHasTheBiasRangeAndChargedToner)
 {
   const Case c = load_case(source_dir + "/cases/kweon_development.yaml");

@@ -38,7 +38,8 @@ inline cli::CommandSpec engine_command_line(const std::string &program)
       "dem.checkpoint_wall_interval of wall time and at the end, each with a checksum and the\n"
       "case's inputs; the one before is kept as checkpoint.previous.bin. A damaged checkpoint is\n"
       "refused before anything is read; a restart under a case that differs beyond run control\n"
-      "(duration, intervals, threads, output) is refused with the keys that differ.\n";
+      "(duration, intervals, threads, output, what is measured and over which window) is refused\n"
+      "with the keys that differ.\n";
   return spec;
 }
 

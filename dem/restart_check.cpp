@@ -10,13 +10,21 @@ bool is_run_control_key(const std::string &key)
 {
   static const char *const exact[] = {"dem.duration",           "dem.output_interval",
                                       "dem.checkpoint_interval", "dem.checkpoint_wall_interval",
-                                      "dem.threads",             "nip.sample_interval",
-                                      "nip.average_from",        "compression.sample_interval",
+                                      "dem.threads",             "compression.sample_interval",
                                       "compression.map_interval"};
   for (const char *k : exact)
     if (key == k)
       return true;
-  return key.rfind("output.", 0) == 0;
+  // Whole sections that only say what to measure and how to judge it: the measurements are not
+  // in a checkpoint (a restart starts them afresh) and sampling them does not change the
+  // particles' bits, so a continued run may average over a new window
+  // (--set dma.average_from=30ms) without --restart-anyway.
+  static const char *const measurement_sections[] = {"output.", "nip.", "dma.", "development.", "flow_report.",
+                                                     "statistics."};
+  for (const char *prefix : measurement_sections)
+    if (key.rfind(prefix, 0) == 0)
+      return true;
+  return false;
 }
 
 std::vector<CaseDifference> case_differences(const CheckpointIdentity &checkpoint, const CheckpointIdentity &now)

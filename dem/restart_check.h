@@ -28,7 +28,8 @@ struct CaseDifference
 };
 
 // Run-control keys: dem.duration, the output, sample and checkpoint intervals, threads,
-// the measurements' sampling and averaging, the output directory and formats.
+// the output directory and formats, and every key of the measurement-only sections (nip.*,
+// dma.*, development.*, flow_report.*, statistics.*: windows, sampling, averaging).
 bool is_run_control_key(const std::string &key);
 
 // The keys whose values differ between the checkpoint's case and this one, in the order of

@@ -230,6 +230,12 @@ TEST(RestartCheck, RunControlMayDifferTheSceneMayNot)
   EXPECT_TRUE(contains(describe(d), "  populations.carrier.count: 2000 (checkpoint) -> 3000 (this case)\n"));
   EXPECT_TRUE(case_differences(written, written).empty());
   EXPECT_FALSE(d[4].added_at_default); // a default case has no toner material
+  // What is measured, and over which window, is not the state: a continued run may average anew.
+  for (const char *key : {"dma.average_from", "nip.half_width", "development.measure_to", "flow_report.flux_angle",
+                          "statistics.blocks"})
+    EXPECT_TRUE(is_run_control_key(key)) << key;
+  for (const char *key : {"drum.gap", "inflow.areal_mass", "electric.bias", "dem.magnetic_staleness"})
+    EXPECT_FALSE(is_run_control_key(key)) << key;
 
   // A key the schema gained after the checkpoint was written: at its default it is flagged
   // (the restart goes on), at another value it is a difference of the scene.

@@ -192,22 +192,25 @@ Vary parse_vary(const std::string &v)
   return {v.substr(0, eq), split(v.substr(eq + 1), ',')};
 }
 
-// The case key's declaration for an override path: "populations.carrier.diameter" is declared
-// as "populations[].diameter", "materials.toner.hamaker" as "materials.*.hamaker".
+// The case key's declaration for an override path: a list entry or a map entry is addressed
+// by its name, so "populations.carrier.diameter" is declared as "populations[].diameter",
+// "roller.poles.S2.angle" as "roller.poles[].angle", "materials.toner.hamaker" as
+// "materials.*.hamaker". Each inner segment is tried as such a name.
 const KeySpec *spec_of_path(const std::string &path)
 {
   if (const KeySpec *s = find_key_spec(path))
     return s;
-  const auto first = path.find('.'), second = path.find('.', first + 1);
-  if (first == std::string::npos || second == std::string::npos)
-    return nullptr;
-  for (const char *wild : {"[]", ".*"})
+  const std::vector<std::string> parts = split(path, '.');
+  for (std::size_t named = 1; named + 1 < parts.size(); ++named)
   {
-    const std::string head = path.substr(0, first);
-    const std::string pattern = std::string(wild) == "[]" ? head + "[]" + path.substr(second)
-                                                          : head + ".*" + path.substr(second);
-    if (const KeySpec *s = find_key_spec(pattern))
-      return s;
+    std::string head = parts[0], tail;
+    for (std::size_t k = 1; k < named; ++k)
+      head += "." + parts[k];
+    for (std::size_t k = named + 1; k < parts.size(); ++k)
+      tail += "." + parts[k];
+    for (const std::string &pattern : {head + "[]" + tail, head + ".*" + tail})
+      if (const KeySpec *s = find_key_spec(pattern))
+        return s;
   }
   return nullptr;
 }

@@ -105,9 +105,18 @@ def plot_keys(plt, directory, header, rows, requested):
                     ok = flag and r[col[flag[0]]] == "1"
                     ax.annotate(f"{100 * e:+.1f} %" + (" ✓" if ok else " ✗"), (x, y), textcoords="offset points",
                                 xytext=(6, -12), fontsize=8, color="C2" if ok else "C3")
-        notes = [f"{x:g}: {verdicts(col, r, key)}" for x, r in zip(xs, rows)]
+        # Each point as the user gave it ("144deg", "0.4mm"), on the axis and in the verdicts;
+        # the axis itself is in SI so that the points are spaced by their values.
+        given = x_name.rsplit(" [", 1)[0]
+        labels = [r[col[given]] for r in rows] if given in col else [f"{x:g}" for x in xs]
+        notes = [f"{label}: {verdicts(col, r, key)}" for label, r in zip(labels, rows)]
         ax.set_title("\n".join(notes) if key + "_drift" in col else "; ".join(notes), fontsize=7)
-        ax.set_xlabel(x_name)
+        if len(set(xs)) == len(xs) and len(xs) <= 12:
+            ax.set_xticks(xs)
+            ax.set_xticklabels(labels)
+            ax.set_xlabel(given)
+        else:
+            ax.set_xlabel(x_name)
         ax.set_ylabel(key)
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)

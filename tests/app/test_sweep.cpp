@@ -111,5 +111,16 @@ TEST(Sweep, PointsWithTheSameFieldInputsShareOneSolvedField)
                                            "output.directory=" + (dir / "out").string()});
   EXPECT_EQ(field_folders(dir / "out" / "sweep_pole" / "fields"), 2) << differ.output;
   EXPECT_EQ(differ.output.find("magnetic field up to date"), std::string::npos) << differ.output;
+  // A pole is addressed by its name inside a list inside a section (roller.poles[].strength):
+  // the table still knows the value's unit and gives it in SI, the axis of the study's plots.
+  const auto rows = magbrush::testing::read_csv_rows(dir / "out" / "sweep_pole" / "sweep_summary.csv");
+  ASSERT_EQ(rows.size(), 3u) << differ.output;
+  std::size_t si = rows[0].size();
+  for (std::size_t k = 0; k < rows[0].size(); ++k)
+    if (rows[0][k] == "roller.poles.N1.strength [A/m]")
+      si = k;
+  ASSERT_LT(si, rows[0].size()) << "no SI column for the pole's strength";
+  EXPECT_DOUBLE_EQ(std::stod(rows[1][si]), 150e3);
+  EXPECT_DOUBLE_EQ(std::stod(rows[2][si]), 160e3);
   fs::remove_all(dir);
 }

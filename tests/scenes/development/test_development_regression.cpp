@@ -15,7 +15,7 @@
 //
 // Cost: about 2 × 1 min on 2 cores in Release.
 #include "tests/csv_columns.h"
-#include "tests/test_temp_dir.h"
+#include "tests/scenes/sweep_study.h"
 
 #include <gtest/gtest.h>
 
@@ -28,14 +28,10 @@ namespace fs = std::filesystem;
 
 TEST(DevelopmentRegression, TmaRisesWithBiasBelowTheNeutralisationBoundWithLittleFog)
 {
-  const fs::path dir = magbrush::testing::test_temp_dir("development_regression");
-  const std::string cmd = "cd '" + dir.string() + "' && OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 '" +
-                          std::string(MAGBRUSH_BINARY_DIR) + "/bin/magbrush' sweep '" + MAGBRUSH_SOURCE_DIR +
-                          "/tests/scenes/development/development_cell.yaml' --vary electric.bias=-200V,-800V "
-                          "--name bias --set output.directory=results > sweep.log 2>&1";
-  const int raw = std::system(cmd.c_str());
-  ASSERT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 0) << "magbrush sweep failed: see " << (dir / "sweep.log");
-
+  const fs::path dir = magbrush::testing::run_sweep_study(
+      "development_regression", "'" MAGBRUSH_SOURCE_DIR "/tests/scenes/development/development_cell.yaml' "
+                                "--vary electric.bias=-200V,-800V --name bias");
+  ASSERT_FALSE(dir.empty());
   const fs::path sweep = dir / "results" / "sweep_bias";
   const auto table = magbrush::testing::read_csv_columns(sweep / "sweep_summary.csv");
   for (const char *column : {"tma_kg_per_m2", "tma_kg_per_m2_stderr", "tma_kg_per_m2_bound", "fog_kg_per_m2",

@@ -16,8 +16,7 @@
 //  * the table has what a user plots: standard errors, the bound, the run time, the plot.
 //
 // Cost: about 2 × 5 min on 2 idle cores in Release (2 × 14 min on a loaded machine).
-#include "tests/csv_columns.h"
-#include "tests/test_temp_dir.h"
+#include "tests/scenes/sweep_study.h"
 
 #include <gtest/gtest.h>
 
@@ -30,16 +29,11 @@ namespace fs = std::filesystem;
 
 TEST(RegulationRegression, DmaRisesWithTheBladeGapBelowTheBulkBoundAndMassIsConserved)
 {
-  const fs::path dir = magbrush::testing::test_temp_dir("regulation_regression");
-  const std::string cmd = "cd '" + dir.string() + "' && OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 '" +
-                          std::string(MAGBRUSH_BINARY_DIR) + "/bin/magbrush' sweep '" + MAGBRUSH_SOURCE_DIR +
-                          "/cases/kweon_regulation.yaml' --vary blades.doctor.gap=0.3mm,0.6mm --name gap "
-                          "--set dem.duration=11ms --set dma.after_blade=9deg --set dma.average_from=8.5ms "
-                          "--set output.directory=results "
-                          "> sweep.log 2>&1";
-  const int raw = std::system(cmd.c_str());
-  ASSERT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 0) << "magbrush sweep failed: see " << (dir / "sweep.log");
-
+  const fs::path dir = magbrush::testing::run_sweep_study(
+      "regulation_regression", "'" MAGBRUSH_SOURCE_DIR "/cases/kweon_regulation.yaml' --vary "
+                               "blades.doctor.gap=0.3mm,0.6mm --name gap --set dem.duration=11ms "
+                               "--set dma.after_blade=9deg --set dma.average_from=8.5ms");
+  ASSERT_FALSE(dir.empty());
   const fs::path sweep = dir / "results" / "sweep_gap";
   const auto table = magbrush::testing::read_csv_columns(sweep / "sweep_summary.csv");
   for (const char *column : {"dma_kg_per_m2", "dma_kg_per_m2_stderr", "dma_kg_per_m2_bound", "dma_flux_kg_per_m2",
@@ -74,28 +68,5 @@ TEST(RegulationRegression, DmaRisesWithTheBladeGapBelowTheBulkBoundAndMassIsCons
   EXPECT_TRUE(fs::exists(sweep / "sweep_dma_kg_per_m2.png"));
 
   // Mass conserved to the particle in each point (its flow report: in, out, present).
-  int reports = 0;
-  for (const auto &entry : fs::recursive_directory_iterator(sweep))
-  {
-    if (entry.path().filename() != "flow_report.csv")
-      continue;
-    ++reports;
-    const auto flow = magbrush::testing::read_csv_columns(entry.path());
-    ASSERT_TRUE(flow.count("present") && flow.count("in") && flow.count("out")) << entry.path();
-    const std::size_t rows = flow.at("present").size();
-    ASSERT_GT(rows, 100u) << entry.path();
-    long removed = 0;
-    for (std::size_t r = 0; r < rows; ++r)
-    {
-      const long in = std::atol(flow.at("in")[r].c_str()), out = std::atol(flow.at("out")[r].c_str());
-      ASSERT_EQ(std::atol(flow.at("present")[r].c_str()), in - out) << entry.path() << " row " << r;
-      const double in_mass = std::atof(flow.at("in_mass_kg")[r].c_str());
-      const double out_mass = std::atof(flow.at("out_mass_kg")[r].c_str());
-      ASSERT_NEAR(std::atof(flow.at("present_mass_kg")[r].c_str()), in_mass - out_mass, 1e-7 * in_mass)
-          << entry.path() << " row " << r;
-      removed = out;
-    }
-    EXPECT_GT(removed, 0) << entry.path() << ": nothing left the cell (no spill, no outflow)";
-  }
-  EXPECT_EQ(reports, 2);
+  EXPECT_EQ(magbrush::testing::expect_flow_budgets_close(sweep), 2);
 }

@@ -19,8 +19,7 @@
 // One run before it was a test (benchmark output): released 0.18 ± 0.03 at 144°, 0.990 ± 0.008 at
 // 165°; arriving 0.421 and 0.406 kg/m². Cost: 489 s of DEM at 144° on one core with two other
 // runs on the 2-core machine, about as much at 165°.
-#include "tests/csv_columns.h"
-#include "tests/test_temp_dir.h"
+#include "tests/scenes/sweep_study.h"
 
 #include <gtest/gtest.h>
 
@@ -33,16 +32,12 @@ namespace fs = std::filesystem;
 
 TEST(ReleaseRegression, MovingS2TowardsS3ReleasesTheDeveloperAndMassIsConserved)
 {
-  const fs::path dir = magbrush::testing::test_temp_dir("release_regression");
-  const std::string cmd = "cd '" + dir.string() + "' && OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 '" +
-                          std::string(MAGBRUSH_BINARY_DIR) + "/bin/magbrush' sweep '" + MAGBRUSH_SOURCE_DIR +
-                          "/cases/kweon_release.yaml' --vary roller.poles.S2.angle=144deg,165deg --name layout "
-                          "--set inflow.angle=168deg --set inflow.prefill_arc=50deg --set outflow.angle=218deg "
-                          "--set dma.release_from=174deg --set dma.release_to=214deg --set dem.duration=20ms "
-                          "--set dma.average_from=12ms --set output.directory=results > sweep.log 2>&1";
-  const int raw = std::system(cmd.c_str());
-  ASSERT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 0) << "magbrush sweep failed: see " << (dir / "sweep.log");
-
+  const fs::path dir = magbrush::testing::run_sweep_study(
+      "release_regression", "'" MAGBRUSH_SOURCE_DIR "/cases/kweon_release.yaml' --vary roller.poles.S2.angle=144deg,165deg "
+                            "--name layout --set inflow.angle=168deg --set inflow.prefill_arc=50deg "
+                            "--set outflow.angle=218deg --set dma.release_from=174deg --set dma.release_to=214deg "
+                            "--set dem.duration=20ms --set dma.average_from=12ms");
+  ASSERT_FALSE(dir.empty());
   const fs::path sweep = dir / "results" / "sweep_layout";
   const auto table = magbrush::testing::read_csv_columns(sweep / "sweep_summary.csv");
   for (const char *column : {"released_fraction", "released_fraction_stderr", "developer_arriving_at_release_kg_per_m2",
@@ -74,22 +69,5 @@ TEST(ReleaseRegression, MovingS2TowardsS3ReleasesTheDeveloperAndMassIsConserved)
   EXPECT_TRUE(fs::exists(sweep / "sweep_released_fraction.png"));
 
   // Mass conserved to the particle (each point's flow report: the prefilled layer, then in and out).
-  int reports = 0;
-  for (const auto &entry : fs::recursive_directory_iterator(sweep))
-  {
-    if (entry.path().filename() != "flow_report.csv")
-      continue;
-    ++reports;
-    const auto flow = magbrush::testing::read_csv_columns(entry.path());
-    ASSERT_TRUE(flow.count("present") && flow.count("in") && flow.count("out")) << entry.path();
-    const std::size_t rows = flow.at("present").size();
-    ASSERT_GT(rows, 100u) << entry.path();
-    auto count = [&](const char *column, std::size_t r) { return std::atol(flow.at(column)[r].c_str()); };
-    const long initial = count("present", 0) - count("in", 0) + count("out", 0);
-    EXPECT_GT(initial, 0) << "the prefilled layer";
-    for (std::size_t r = 0; r < rows; ++r)
-      ASSERT_EQ(count("present", r), initial + count("in", r) - count("out", r)) << entry.path() << " row " << r;
-    EXPECT_GT(count("out", rows - 1), 0) << entry.path();
-  }
-  EXPECT_EQ(reports, 2);
+  EXPECT_EQ(magbrush::testing::expect_flow_budgets_close(sweep), 2);
 }

@@ -15,13 +15,13 @@ bool is_run_control_key(const std::string &key)
   for (const char *k : exact)
     if (key == k)
       return true;
-  // Whole sections that only say what to measure and how to judge it: the measurements are not
-  // in a checkpoint (a restart starts them afresh) and sampling them does not change the
-  // particles' bits, so a continued run may average over a new window
+  // Where to write, and whole sections that only say what to measure and how to judge it: the
+  // measurements are not in a checkpoint (a restart starts them afresh) and sampling them does
+  // not change the particles' bits, so a continued run may average over a new window
   // (--set dma.average_from=30ms) without --restart-anyway.
-  static const char *const measurement_sections[] = {"output.", "nip.", "dma.", "development.", "flow_report.",
-                                                     "statistics."};
-  for (const char *prefix : measurement_sections)
+  static const char *const run_control_sections[] = {"output.",      "nip.",        "dma.",
+                                                     "development.", "flow_report.", "statistics."};
+  for (const char *prefix : run_control_sections)
     if (key.rfind(prefix, 0) == 0)
       return true;
   return false;

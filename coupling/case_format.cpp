@@ -304,6 +304,7 @@ std::vector<ResolvedEntry> resolved_entries(const Case &c)
   e.q("flow_report.sample_interval", "flow_report.sample_interval", flow.sample_interval);
   e.q("flow_report.flux_angle", "flow_report.flux_angle", flow.flux_angle);
   e.q("flow_report.density_window", "flow_report.density_window", flow.density_window);
+  e.q("flow_report.average_from", "flow_report.average_from", flow.average_from);
   e.q("development.measure_from", "development.measure_from", c.development.measure_from);
   e.q("development.measure_to", "development.measure_to", c.development.measure_to);
   e.q("development.sample_interval", "development.sample_interval", c.development.sample_interval);

@@ -63,6 +63,10 @@ std::vector<KeySpec> flow_keys()
       quantity("flow_report.density_window", D::angle, "Angular window centred on the flux line over which the areal "
                                                         "mass is measured.")
           .def("10 deg").positive().max(pi),
+      quantity("flow_report.average_from", D::time,
+               "The summary's means (summary.csv: the supplied flux and areal mass at the flux line, the "
+               "fraction of a sump's offer declined) over the samples at t >= this (the steady state).")
+          .def("0 s").non_negative(),
   };
 }
 

@@ -341,6 +341,7 @@ struct FlowSettings
   double sample_interval = 2e-6;     // flow report: time between samples [s]
   double flux_angle = 0.0;           // flow report: the radial line the flux is counted through [rad]
   double density_window = 10.0 * 3.14159265358979323846 / 180.0; // flow report: angular window of the areal mass [rad]
+  double average_from = 0.0;         // flow report: its summary's means over t >= this [s]
   bool inflow() const { return inflow_areal_mass > 0.0; }
   bool outflow() const { return outflow_width > 0.0 || outflow_radius > 0.0; }
 };

@@ -1033,6 +1033,7 @@ private:
     f.sample_interval = q(report, "sample_interval");
     f.flux_angle = q(report, "flux_angle");
     f.density_window = q(report, "density_window");
+    f.average_from = q(report, "average_from");
   }
 
   void build_field(FieldSettings &f, const Scope &s)

@@ -11,10 +11,18 @@
 //    areal mass around the line (line_flux.h), counted from positions alone.
 //
 // The engine's own counts of particles that entered and left are in the log.
+//
+// Its summary (summary.csv, what a study tabulates), over the samples at t >= flow_report.average_from:
+//  * supplied_flux_kg_per_m2: the mass flux through the line over (sleeve speed x slab), the
+//    developer mass per sleeve area the flow carries past it (the DMA in its flux form);
+//  * supplied_areal_mass_kg_per_m2: the areal mass around the line (the DMA in its areal form);
+//  * inflow_declined_fraction: the part of a sump's offer that found no room in the entry arc
+//    (a pile backed up to the inflow: then the supplied mass is measured, not set).
 #pragma once
 
 #include "dem/measurement.h"
 #include "dem/measurements/line_flux.h"
+#include "dem/measurements/sample_series.h"
 
 #include "coupling/case_model.h"
 
@@ -45,15 +53,21 @@ public:
   double interval() const override { return settings_.sample_interval; }
   void sample(const DemSystem &system) override;
   void write(const std::string &directory) const override;
+  std::vector<SummaryValue> summary() const override;
 
   const std::vector<FlowReportRow> &rows() const { return rows_; }
   std::string csv() const;
 
 private:
   FlowSettings settings_;
+  StatisticsSettings statistics_;
   double sleeve_speed_ = 0.0, slab_ = 0.0;
   LineFlux flux_;
   std::vector<FlowReportRow> rows_;
+  // The summary's samples (t >= average_from) and the first row in that window.
+  SampleSeries supplied_flux_, supplied_areal_;
+  long window_first_row_ = -1;
+  bool sump_ = false;
 };
 
 } // namespace magbrush::dem

@@ -26,6 +26,8 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <map>
+#include <string>
 
 using namespace magbrush;
 using namespace magbrush::dem;
@@ -135,7 +137,8 @@ TEST(DemParticleFlow, ConveyorReachesSteadyStateWithFluxEqualToDensityTimesSpeed
   // Blocks of 4 ms: longer than a bead needs to cross the density window (16 deg, 2.8 ms), so
   // that the blocks are close to independent and their standard error means what it says.
   const double slab = 3e-3, end = 40e-3, steady_from = 12e-3, block = 4e-3;
-  const Case c = conveyor_case(slab);
+  Case c = conveyor_case(slab);
+  c.flow.average_from = steady_from;
   auto sys = make_conveyor(c);
   FlowReport report(c);
   run_sampled(*sys, report, end);
@@ -200,6 +203,23 @@ TEST(DemParticleFlow, ConveyorReachesSteadyStateWithFluxEqualToDensityTimesSpeed
   EXPECT_LT(std::abs(d.mean), 3.0 * d.error) << "flux != density x speed";
   EXPECT_LT(std::abs(F.mean - nominal), 3.0 * F.error) << "flux != the source's areal mass x speed";
   EXPECT_LT(F.error, 0.05 * nominal) << "the check is too weak to mean anything";
+
+  // The report's summary (what a study tabulates): the supplied developer per sleeve area in its
+  // flux and its areal form, both the source's Γ within 3 of their own standard errors; a fixed
+  // supply declines nothing, so that key is absent.
+  std::map<std::string, SummaryValue> summary;
+  for (const SummaryValue &k : report.summary())
+    summary[k.key] = k;
+  ASSERT_EQ(summary.count("supplied_flux_kg_per_m2"), 1u);
+  ASSERT_EQ(summary.count("supplied_areal_mass_kg_per_m2"), 1u);
+  EXPECT_EQ(summary.count("inflow_declined_fraction"), 0u);
+  for (const char *key : {"supplied_flux_kg_per_m2", "supplied_areal_mass_kg_per_m2"})
+  {
+    const SummaryValue &k = summary[key];
+    std::printf("summary %s = %.5g +- %.2g kg/m^2 (source %.5g)\n", key, k.value, k.standard_error, areal_mass);
+    EXPECT_LT(std::abs(k.value - areal_mass), 3.0 * k.standard_error) << key;
+    EXPECT_LT(k.standard_error, 0.05 * areal_mass) << key << ": too weak to mean anything";
+  }
 }
 
 TEST(DemParticleFlow, MassBudgetCloses)
@@ -333,7 +353,8 @@ TEST(DemParticleFlow, ASumpLeavesWhatFindsNoRoomAndAFixedSupplyStops)
   };
   const double end = 0.012; // the sleeve offers ~300 beads; the pocket's entry arc is full with ~100
   {
-    const Case c = blocked("sump");
+    Case c = blocked("sump");
+    c.flow.average_from = 8e-3; // the pocket is full: (nearly) all that is offered is declined
     auto sys = make_conveyor(c);
     FlowReport report(c);
     run_sampled(*sys, report, end);
@@ -349,6 +370,13 @@ TEST(DemParticleFlow, ASumpLeavesWhatFindsNoRoomAndAFixedSupplyStops)
     EXPECT_GT(in.declined_mass(), 0.25 * in.mass_due(end)) << "the full pocket should turn much of the offer away";
     EXPECT_NEAR(created + in.declined_mass(), in.mass_due(end), one_bead);
     EXPECT_EQ(report.rows().back().declined_mass, in.declined_mass());
+    double declined_fraction = std::nan("");
+    for (const SummaryValue &k : report.summary())
+      if (k.key == "inflow_declined_fraction")
+        declined_fraction = k.value;
+    std::printf("declined over 8-12 ms: %.4f of the offer\n", declined_fraction);
+    EXPECT_GT(declined_fraction, 0.8);
+    EXPECT_LE(declined_fraction, 1.0 + 1e-12);
   }
   {
     const Case c = blocked("fixed");

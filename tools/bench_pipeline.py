@@ -88,7 +88,7 @@ FIELD_KNOBS = [
          quick=["x2"]),
 ]
 
-# The default scene reduced to a quarter of the quick default's slab (0.25 mm, 1,075 beads
+# The placed quick scene of kawamoto_nip.yaml reduced to a quarter of its slab (0.25 mm, 1,075 beads
 # at the same solid fraction in the same box), 0.1 ms of settling and 0.4 ms of turning,
 # averaged over the last 0.3 ms.
 NIP_SCENE = {

@@ -50,7 +50,7 @@ void ChainInclination::sample(const DemSystem &system)
   t_last_ = system.time();
   // The touching pairs are the engine's: its contact list marks each pair with
   // |x_j − x_i| < r_i + r_j at the positions of this step's contacts, so no search of our own
-  // (a cell list of its own cost ~9 ms a sample on the quick default's 4,300 beads).
+  // (a cell list of its own cost ~9 ms a sample on the placed quick scene's 4,300 beads).
   ++samples_;
   const ParticleState &p = system.particles();
   const NeighbourList &list = system.neighbour_list();

@@ -22,7 +22,7 @@
 //                coming down at 0.1 m/s: run once to `descent_at`, then every mode runs the
 //                same `descent` window from that checkpoint (error on the plate force).
 //
-//   nip_quick:   the same on tools/run's quick default (cases/kawamoto_nip.yaml, 4,300 beads,
+//   nip_quick:   the same on the placed quick scene (cases/kawamoto_nip.yaml, 4,300 beads,
 //                1 mm slab, 40 ns steps).
 //
 //   regulation:  cases/kweon_regulation.yaml (the sump inflow, the doctor blade, the outflow):
@@ -467,7 +467,7 @@ void print(const char *title, const char *wall_name, const std::vector<ModeResul
 
 double refresh_override_us = 0.0; // > 0: dem.magnetic_refresh for every run
 
-// quick = tools/run's quick default (cases/kawamoto_nip.yaml, 4,300 beads in a 1 mm slab),
+// quick = the placed quick scene (cases/kawamoto_nip.yaml, 4,300 beads in a 1 mm slab),
 // otherwise the reduced regression scene.
 void nip(const fs::path &dir, double flow_us, double sample_us, const std::vector<std::string> &modes,
          bool quick)
@@ -511,7 +511,7 @@ void nip(const fs::path &dir, double flow_us, double sample_us, const std::vecto
   std::snprintf(title, sizeof title,
                 "Flowing nip (%s, far field cell_multipole, %zu beads): "
                 "%.3g ms of turning after %.3g ms of settling, step %.3g ns, refresh %.3g us, staleness %.3g",
-                quick ? "cases/kawamoto_nip.yaml, tools/run quick default" : "tests/scenes/nip/kawamoto_nip_reduced.yaml",
+                quick ? "cases/kawamoto_nip.yaml, the placed quick scene" : "tests/scenes/nip/kawamoto_nip_reduced.yaml",
                 static_cast<std::size_t>(c.populations[0].count), flow_us * 1e-3, settle * 1e3, c.dem.time_step * 1e9,
                 c.dem.magnetic_refresh * 1e6, c.dem.magnetic_staleness);
   print(title, "drum", results);

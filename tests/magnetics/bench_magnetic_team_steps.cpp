@@ -5,7 +5,7 @@
 // clocks: the machine's load drifting over a minute (±30 % between identical runs on the
 // shared 2-core machine) then falls on both alike, which two separate runs cannot promise.
 //
-// Scene: tools/run's quick default (cases/kawamoto_nip.yaml, 4,300 beads, 40 ns steps, the
+// Scene: the placed quick scene (cases/kawamoto_nip.yaml, 4,300 beads, 40 ns steps, the
 // magnetics holding dipoles at staleness 0.6 and 40 µs, skin 1 diameter, close pairs every 40
 // steps), settled and turned for `turning_us`
 // first, so that the brush flows; its roller field is computed by `magbrush field` here.

@@ -180,6 +180,59 @@ TEST(CaseFiles, KweonReleaseBracketsTheLikePolesAndRemovesWhatLeavesTheSleeve)
   EXPECT_GE(c.dma.height, 1.5e-3);
 }
 
+// The default case is Kawamoto's nip supplied by the sleeve: the same roller, drum and beads as
+// the paper's placed scene, none placed, a sump inflow before the nip window and the outflow
+// after it (so that the window's bead budget counts the flux), and room for the layer where it
+// is placed: random placement refuses above 30 % solid, at the entry (the layer height or the
+// local gap, the smaller) and, for the prefill, in the gap itself.
+TEST(CaseFiles, KawamotoFedIsThePapersNipSuppliedWithRoomForItsLayer)
+{
+  const Case fed = load_case(source_dir + "/cases/kawamoto_nip_fed.yaml");
+  const Case paper = load_case(source_dir + "/cases/kawamoto_nip.yaml");
+  ASSERT_TRUE(fed.roller && paper.roller && fed.sleeve && paper.sleeve);
+  ASSERT_EQ(fed.roller->poles.size(), paper.roller->poles.size());
+  for (std::size_t i = 0; i < fed.roller->poles.size(); ++i)
+  {
+    EXPECT_EQ(fed.roller->poles[i].angle, paper.roller->poles[i].angle);
+    EXPECT_EQ(fed.roller->poles[i].strength, paper.roller->poles[i].strength);
+  }
+  EXPECT_EQ(fed.sleeve->radius, paper.sleeve->radius);
+  EXPECT_EQ(fed.sleeve->rpm, paper.sleeve->rpm);
+  EXPECT_EQ(fed.drum.radius, paper.drum.radius);
+  EXPECT_EQ(fed.drum.rpm, paper.drum.rpm);
+  EXPECT_EQ(fed.drum.gap, paper.drum.gap);
+  ASSERT_EQ(fed.populations.size(), 1u);
+  EXPECT_EQ(fed.populations[0].diameter_mean, paper.populations[0].diameter_mean);
+  EXPECT_EQ(fed.populations[0].count, 0);
+  EXPECT_EQ(fed.flow.inflow_supply, "sump");
+  EXPECT_LT(fed.flow.inflow_angle, -fed.nip.chain_half_angle);
+  EXPECT_GT(fed.flow.outflow_angle, fed.nip.chain_half_angle);
+  EXPECT_EQ(fed.flow.average_from, fed.nip.average_from);
+  EXPECT_LT(fed.nip.average_from, fed.dem.duration);
+
+  // Radial distance from the sleeve surface to the drum along the ray at sleeve angle a.
+  const double R = fed.sleeve->radius, Rd = fed.drum.radius, D = R + fed.drum.gap + Rd;
+  auto gap_at = [&](double a) {
+    const double c = std::cos(a - fed.drum.angle);
+    return D * c - std::sqrt(D * D * c * c - D * D + Rd * Rd) - R;
+  };
+  EXPECT_NEAR(gap_at(fed.drum.angle), fed.drum.gap, 1e-12);
+  double rho = 0.0;
+  for (const Material &m : fed.materials)
+    if (m.name == fed.populations[0].material)
+      rho = m.density;
+  ASSERT_GT(rho, 0.0);
+  const double entry = std::min(fed.flow.inflow_layer_height, gap_at(fed.flow.inflow_angle));
+  const double solid_at_entry = fed.flow.inflow_areal_mass / (rho * entry);
+  const double solid_in_gap = fed.flow.inflow_areal_mass / (rho * fed.drum.gap);
+  std::printf("fed nip: gap at the entry %.3f mm, solid fraction at the entry %.3f, in the gap %.3f\n",
+              gap_at(fed.flow.inflow_angle) * 1e3, solid_at_entry, solid_in_gap);
+  EXPECT_LT(solid_at_entry, 0.30);
+  // The prefill reaches through the gap centre to the outflow.
+  EXPECT_GE(fed.flow.inflow_angle + fed.flow.inflow_prefill_arc, fed.flow.outflow_angle - 1e-9);
+  EXPECT_LT(solid_in_gap, 0.30);
+}
+
 TEST(CaseFiles, KweonDevelopmentHasTheBiasRangeAndChargedToner)
 {
   const Case c = load_case(source_dir + "/cases/kweon_development.yaml");

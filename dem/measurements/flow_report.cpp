@@ -26,7 +26,8 @@ T sum(const std::vector<T> &v)
 } // namespace
 
 FlowReport::FlowReport(const Case &c)
-  : settings_(c.flow), statistics_(c.statistics), sleeve_speed_(c.sleeve ? c.sleeve->surface_speed() : 0.0), slab_(c.dem.periodic_length),
+  : settings_(c.flow), statistics_(c.statistics), sleeve_speed_(c.sleeve ? c.sleeve->surface_speed() : 0.0),
+    slab_(c.dem.periodic_length),
     flux_(c.flow.flux_angle, c.sleeve && c.sleeve->omega() < 0.0 ? -1.0 : 1.0, c.flow.density_window,
           c.sleeve ? c.sleeve->radius : 1.0, c.dem.periodic_length > 0.0 ? c.dem.periodic_length : 1.0),
     sump_(c.flow.inflow() && c.flow.inflow_supply == "sump")

@@ -252,7 +252,10 @@ def nip_plots(plt, profile, out, relative_speed):
         plt.close(fig)
         written.append(name)
 
-    one("nip_slip.png", "slip speed [m/s]", [("beads touching the drum (time average)", profile["slip_speed_m_s"], "o-")],
+    slip_series = [("contact points of the beads touching the drum (time average)", profile["slip_speed_m_s"], "o-")]
+    if "chain_speed_m_s" in profile:  # profiles written before the chain speed lack it
+        slip_series.append(("centres of those beads (the chain's end, rolling included)", profile["chain_speed_m_s"], "s-"))
+    one("nip_slip.png", "slip speed [m/s]", slip_series,
         "Slip speed of the beads touching the drum (cf. Kawamoto Fig. 17)", relative_speed,
         f"relative surface speed {relative_speed:.4g} m/s" if relative_speed is not None else None)
     one("nip_pressure.png", "pressure on the drum [kPa]",
@@ -423,6 +426,11 @@ def key_numbers(summary, nip_series, series, flux, run_summary=None, flow=None):
         rows.append(("slip speed at the gap centre", f"{fmt(slip)} m/s (bead spread {fmt(val('slip_std_at_gap_centre'), 2)})",
                      f"relative surface speed {fmt(rel)} m/s (Kawamoto: equal)",
                      f"{fmt(slip / rel if rel else float('nan'), 3)} of it"))
+        chain = val("chain_speed_at_gap_centre")
+        if math.isfinite(chain):
+            rows.append(("chain speed over the drum at the gap centre", f"{fmt(chain)} m/s (bead centres, rolling included)",
+                         f"relative surface speed {fmt(rel)} m/s (Kawamoto: equal)",
+                         f"{fmt(chain / rel if rel else float('nan'), 3)} of it"))
         b = val("gap_centre_field")
         if not math.isfinite(b) and flux:
             # The field at the sleeve surface facing the drum, from the sleeve profile.

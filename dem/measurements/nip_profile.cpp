@@ -74,6 +74,7 @@ DrumContactInFrame resolve_drum_contact(const NipFrame &f, const DrumContact &c)
   DrumContactInFrame out;
   out.x = f.x_along(q.x, q.y);
   out.slip = dot(v_bead - v_drum, t_local);
+  out.chain_speed = dot(c.velocity - v_drum, t_local);
   const Vector3 relative = v_bead - v_drum;
   const Vector3 relative_t = relative - dot(relative, n_out) * n_out;
   out.slip_speed = std::sqrt(dot(relative_t, relative_t));
@@ -94,6 +95,7 @@ NipProfile::NipProfile(const Case &c) : settings_(c.nip), statistics_(c.statisti
   ft_.assign(n, 0.0);
   slip_.assign(n, 0.0);
   slip2_.assign(n, 0.0);
+  chain_.assign(n, 0.0);
   count_.assign(n, 0);
   gap_field_ = field_at_gap_centre(c, frame_);
 }
@@ -140,7 +142,7 @@ void NipProfile::add_sample(double time, const std::vector<DrumContact> &contact
     t_first_ = time;
   t_last_ = time;
   ++samples_;
-  double fn = 0.0, ft = 0.0, centre_slip = 0.0;
+  double fn = 0.0, ft = 0.0, centre_slip = 0.0, centre_chain = 0.0;
   long touching = 0, centre = 0;
   for (const auto &c : contacts)
   {
@@ -153,6 +155,7 @@ void NipProfile::add_sample(double time, const std::vector<DrumContact> &contact
     ft_[k] += r.tangential;
     slip_[k] += r.slip;
     slip2_[k] += r.slip * r.slip;
+    chain_[k] += r.chain_speed;
     ++count_[k];
     if (r.slip_speed > sliding_speed())
     {
@@ -163,13 +166,16 @@ void NipProfile::add_sample(double time, const std::vector<DrumContact> &contact
     ft += r.tangential;
     ++touching;
     if (b == bins_half_)
-      centre_slip += r.slip, ++centre;
+      centre_slip += r.slip, centre_chain += r.chain_speed, ++centre;
   }
   normal_force_.add(fn / frame_.slab_depth);
   tangential_force_.add(ft / frame_.slab_depth);
   touching_.add(static_cast<double>(touching));
   if (centre > 0) // a sample without a bead in the centre bin says nothing about its slip
+  {
     centre_slip_.add(centre_slip / static_cast<double>(centre));
+    centre_chain_.add(centre_chain / static_cast<double>(centre));
+  }
 }
 
 std::vector<NipBin> NipProfile::bins() const
@@ -195,10 +201,11 @@ std::vector<NipBin> NipProfile::bins() const
       const double m = slip_[i] / static_cast<double>(count_[i]);
       b.slip = m;
       b.slip_std = std::sqrt(std::max(0.0, slip2_[i] / static_cast<double>(count_[i]) - m * m));
+      b.chain_speed = chain_[i] / static_cast<double>(count_[i]);
       b.normal_force_per_bead = fn_[i] / static_cast<double>(count_[i]);
     }
     else
-      b.slip = b.slip_std = b.normal_force_per_bead = nan;
+      b.slip = b.slip_std = b.chain_speed = b.normal_force_per_bead = nan;
     out.push_back(b);
   }
   return out;
@@ -208,6 +215,12 @@ double NipProfile::slip_at_gap_centre() const
 {
   const auto c = static_cast<std::size_t>(bins_half_);
   return count_[c] > 0 ? slip_[c] / static_cast<double>(count_[c]) : nan;
+}
+
+double NipProfile::chain_speed_at_gap_centre() const
+{
+  const auto c = static_cast<std::size_t>(bins_half_);
+  return count_[c] > 0 ? chain_[c] / static_cast<double>(count_[c]) : nan;
 }
 
 double NipProfile::tangential_over_normal() const
@@ -268,20 +281,22 @@ std::string NipProfile::csv() const
        "speed of the walls " +
            std::to_string(frame_.relative_surface_speed()) +
            " m/s).\n"
+           "# chain_speed: the same with the bead centre instead of its contact point (the chain's end moving over "
+           "the drum, rolling included: Kawamoto's slip speed of the chains).\n"
            "# pressures: forces of the touching beads on the drum per drum surface of the bin (arc x slab depth "
            "= " +
            std::to_string(frame_.slab_depth * 1e3) + " mm); normal presses into the drum, tangential drags it downstream.\n";
   o << "x_mm,x_lo_mm,x_hi_mm,drum_arc_mm,drum_angle_deg,sleeve_angle_deg,touching_beads,density_per_mm2,"
        "normal_pressure_Pa,tangential_pressure_Pa,tangential_over_normal,slip_speed_m_s,slip_std_m_s,"
-       "normal_force_per_bead_N,contact_samples\n";
+       "chain_speed_m_s,normal_force_per_bead_N,contact_samples\n";
   for (const auto &b : bins())
   {
     const double ratio = b.normal_pressure > 0.0 ? b.tangential_pressure / b.normal_pressure : nan;
-    std::snprintf(line, sizeof line, "%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%ld\n",
+    std::snprintf(line, sizeof line, "%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%ld\n",
                   b.x * 1e3, b.x_lo * 1e3, b.x_hi * 1e3, frame_.drum_arc_of_x(b.x) * 1e3,
                   frame_.drum_angle_of_x(b.x) * 180.0 / M_PI, frame_.sleeve_angle_of_x(b.x) * 180.0 / M_PI,
                   b.touching, b.density * 1e-6, b.normal_pressure, b.tangential_pressure, ratio, b.slip, b.slip_std,
-                  b.normal_force_per_bead, b.contacts);
+                  b.chain_speed, b.normal_force_per_bead, b.contacts);
     o << line;
   }
   return o.str();
@@ -312,6 +327,8 @@ std::string NipProfile::summary_csv() const
   row("relative_surface_speed", frame_.relative_surface_speed(), "m/s", "sleeve minus drum surface speed at the nip");
   row("slip_at_gap_centre", centre.slip, "m/s", "mean slip of the beads touching the drum in the centre bin");
   row("slip_std_at_gap_centre", centre.slip_std, "m/s", "spread of that slip over beads and samples");
+  row("chain_speed_at_gap_centre", centre.chain_speed, "m/s",
+      "mean speed of the touching beads' centres over the drum in the centre bin (rolling included)");
   row("beads_in_centre_bin", centre.touching, "1", "mean touching beads in the centre bin per sample");
   row("peak_normal_pressure", peak_normal_pressure(), "Pa", "largest bin normal pressure");
   row("normal_pressure_at_gap_centre", centre.normal_pressure, "Pa", "normal pressure of the centre bin");
@@ -350,8 +367,13 @@ std::vector<SummaryValue> NipProfile::summary() const
                               "slip of the beads touching the drum in the centre bin");
   slip.value = slip_at_gap_centre();
   slip.drift = slip.drift_standard_error = std::numeric_limits<double>::quiet_NaN();
+  SummaryValue chain = sampled("chain_speed_at_gap_centre_m_s", centre_chain_, "m/s",
+                               "speed of the touching beads' centres over the drum in the centre bin");
+  chain.value = chain_speed_at_gap_centre();
+  chain.drift = chain.drift_standard_error = std::numeric_limits<double>::quiet_NaN();
   return {
       slip,
+      chain,
       plain("relative_surface_speed_m_s", frame_.relative_surface_speed(), "m/s", "sleeve minus drum surface speed"),
       plain("peak_normal_pressure_Pa", peak_normal_pressure(), "Pa", "largest bin normal pressure"),
       plain("normal_pressure_at_gap_centre_Pa", centre.normal_pressure, "Pa", "normal pressure of the centre bin"),

@@ -4,6 +4,10 @@
 //  * slip speed: velocity of the bead's material at its contact point on the drum minus the
 //    velocity of the drum surface there, tangential component along the downstream tangent
 //    of the drum (the paper: equal to the relative surface speed 0.135 m/s at the gap centre);
+//  * chain speed: the same with the bead's centre instead of its contact point, i.e. how fast
+//    the chain's end moves over the drum whether it slides or rolls. Kawamoto's Fig. 17 is
+//    "the slip speed of the chains": a bead that rolls over the drum moves its chain along
+//    while its contact point stands still on the drum, so the two differ by the spin ω × r;
 //  * normal and tangential pressure on the drum: Σ (force of the touching beads on the drum,
 //    normal component pushing into the drum / tangential component downstream) per bin, over
 //    the drum surface of the bin (arc length of the bin on the drum × slab depth);
@@ -57,6 +61,7 @@ struct DrumContactInFrame
   double normal = 0.0;     // force pressing into the drum [N]
   double tangential = 0.0; // force on the drum along the downstream tangent [N]
   double slip_speed = 0.0; // |tangential velocity of the bead's contact point relative to the drum|, 3D [m/s]
+  double chain_speed = 0.0; // bead centre velocity relative to the drum surface at q, downstream > 0 [m/s]
 };
 DrumContactInFrame resolve_drum_contact(const NipFrame &frame, const DrumContact &c);
 
@@ -70,6 +75,7 @@ struct NipBin
   double normal_pressure = 0.0;              // [Pa]
   double tangential_pressure = 0.0;          // [Pa]
   double slip = 0.0, slip_std = 0.0;         // mean over touching beads and its spread [m/s] (NaN: none)
+  double chain_speed = 0.0;                  // mean bead-centre speed over the drum [m/s] (NaN: none)
   double normal_force_per_bead = 0.0;        // [N] (NaN: none)
   long contacts = 0;                         // contact samples accumulated
 };
@@ -92,6 +98,7 @@ public:
   std::vector<NipBin> bins() const;
   // Key numbers over the averaging window.
   double slip_at_gap_centre() const;          // mean slip of the centre bin [m/s]
+  double chain_speed_at_gap_centre() const;   // mean bead-centre speed over the drum, centre bin [m/s]
   double tangential_over_normal() const;      // Σ F_t / Σ F_n over every bin
   double peak_normal_pressure() const;        // [Pa]
   // Contacts slipping faster than this over the drum are sliding [m/s]: a tenth of the
@@ -118,13 +125,13 @@ private:
   NipFrame frame_;
   std::size_t drum_wall_ = 0;
   int bins_half_ = 0;                 // bins k = −bins_half_ … +bins_half_
-  std::vector<double> fn_, ft_, slip_, slip2_;
+  std::vector<double> fn_, ft_, slip_, slip2_, chain_;
   std::vector<long> count_;
   double fn_sliding_ = 0.0, fn_sliding_downstream_ = 0.0; // Σ F_n, Σ F_n cos over sliding contacts
   long samples_ = 0;
   double t_first_ = -1.0, t_last_ = -1.0;
   // Per-sample totals over the profile (for standard errors and the steady-state test).
-  SampleSeries normal_force_, tangential_force_, touching_, centre_slip_;
+  SampleSeries normal_force_, tangential_force_, touching_, centre_slip_, centre_chain_;
   double gap_field_;
   std::vector<WallContactRecord> records_; // reused between samples
   std::vector<DrumContact> contacts_;

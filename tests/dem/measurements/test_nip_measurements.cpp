@@ -159,6 +159,10 @@ TEST(NipProfile, HandPlacedBeadsGiveExactBinValues)
   EXPECT_NEAR(b0.slip_std, 0.0, 1e-7);
   EXPECT_NEAR(b4.slip, -v_drum, 1e-12);
   EXPECT_NEAR(profile.slip_at_gap_centre(), 0.2 + w * a - v_drum, 1e-12);
+  // The chain speed leaves the spin out: A's centre moves 0.2 m/s, the drum v_drum under it.
+  EXPECT_NEAR(b0.chain_speed, 0.2 - v_drum, 1e-12);
+  EXPECT_NEAR(b4.chain_speed, -v_drum, 1e-12);
+  EXPECT_NEAR(profile.chain_speed_at_gap_centre(), 0.2 - v_drum, 1e-12);
   // Σ F_t / Σ F_n over both samples: (2 × 0.7) / (2 × 2 + 1) mN.
   EXPECT_NEAR(profile.tangential_over_normal(), 1.4 / 5.0, 1e-12);
   EXPECT_NEAR(profile.peak_normal_pressure(), 2e-3 / area0, 1e-9 * 2e-3 / area0);
@@ -170,6 +174,8 @@ TEST(NipProfile, HandPlacedBeadsGiveExactBinValues)
   EXPECT_NE(csv.find("x_mm,"), std::string::npos);
   EXPECT_NE(csv.find("normal_pressure_Pa"), std::string::npos);
   EXPECT_NE(profile.summary_csv().find("slip_at_gap_centre"), std::string::npos);
+  EXPECT_NE(csv.find("chain_speed_m_s"), std::string::npos);
+  EXPECT_NE(profile.summary_csv().find("chain_speed_at_gap_centre"), std::string::npos);
 }
 
 // Which contacts slide, from the slip of each contact point alone: beads at the gap centre

@@ -173,16 +173,18 @@ void MagneticForceTerm::full_refresh(const BeadArrays &beads, double t, double r
 std::string MagneticForceTerm::cost_note() const
 {
   const RefreshCounts &c = counts_;
-  char line[640];
+  char line[768];
   std::snprintf(line, sizeof line,
                 "%ld full evaluations: %ld interval, %ld moved (lists expired %ld, region too large %ld), "
                 "%ld first or new set; %ld list rebuilds; %ld local refreshes; %ld admissions. "
                 "Time: full %.3g s (lists %.2g, tensors %.2g, far field %.2g, sweeps %.2g, forces %.2g), "
                 "local %.3g s, admissions %.3g s, live pairs %.3g s, checks %.3g s; "
-                "%ld of %ld steps held inside the engine's team (%ld of them quiet: no check needed)",
+                "%ld of %ld steps held inside the engine's team (%ld of them quiet: no check needed; "
+                "%ld with newcomers waiting)",
                 c.first + c.interval + c.moved, c.interval, c.moved, c.moved_lists, c.moved_region, c.first,
                 c.rebuilds, local_refreshes_, c.admitted, c.full_s, c.lists_s, c.tensors_s, c.far_s, c.sweeps_s,
-                c.forces_s, c.local_s, c.admit_s, c.live_s, c.check_s, steps_in_team_, steps_, quiet_steps_);
+                c.forces_s, c.local_s, c.admit_s, c.live_s, c.check_s, steps_in_team_, steps_, quiet_steps_,
+                steps_in_team_waiting_);
   return line;
 }
 
@@ -328,8 +330,14 @@ bool MagneticForceTerm::add_forces_in_team_if_held(const dem::ParticleState &sta
                                                    double t, double step_move)
 {
   // (All of this is written outside the team only: every thread decides alike.)
-  if (!held_steps_in_team_ || !enabled_ || carrier_.empty() || must_refresh_ || changed_ || pending_ ||
-      !newcomers_.empty() || state.size() != state_size_ || held_ramp_ == 0.0 || field_.ramp(t) != held_ramp_)
+  if (!held_steps_in_team_ || !enabled_ || carrier_.empty() || must_refresh_ || changed_ ||
+      (!pending_ && !newcomers_.empty()) || state.size() != state_size_ || held_ramp_ == 0.0 ||
+      field_.ramp(t) != held_ramp_)
+    return false;
+  // Newcomers that wait for a full evaluation (they entered empty space: admit_pending() would
+  // keep them waiting) stay in the team; add_held_step() adds their forces as add_forces()
+  // does. A step that could admit something or must apply the exchange goes out.
+  if (pending_ && !waiting_stays_in_team(state))
     return false;
   // A quiet step: the last check (in the team) found nothing stale, and the engine's largest
   // drift per step, summed since, bounds every bead's move below the distance that check
@@ -344,7 +352,9 @@ bool MagneticForceTerm::add_forces_in_team_if_held(const dem::ParticleState &sta
     if (moved < dipoles_.quiet_distance() && !dipoles_.interval_due(t))
     {
       quiet_moved_[me].moved = moved;
-      add_held_step(state, forces, false);
+      if (pending_)
+        gather_positions(state); // (the waiting forces read the held beads where they are)
+      add_held_step(state, forces, t, false, pending_);
       return true;
     }
   }
@@ -372,17 +382,42 @@ bool MagneticForceTerm::add_forces_in_team_if_held(const dem::ParticleState &sta
 #pragma omp master
     quiet_valid_ = true;
   }
-  add_held_step(state, forces, true);
+  add_held_step(state, forces, t, true, true);
   return true;
 }
 
-void MagneticForceTerm::add_held_step(const dem::ParticleState &state, dem::ForceBuffers &forces, bool checked)
+bool MagneticForceTerm::waiting_stays_in_team(const dem::ParticleState &state) const
+{
+  // What add_forces() would do on this step besides the held forces: admit_pending() (only
+  // with admit_exchange and the cell multipoles), apply_pending() (no held carrier to wait
+  // with, or too many waiting), admitting the leavers as holes (left_ > holes_), a newcomer
+  // in an occupied fine cell, dropping a waiting non-carrier, sorting the waiting list.
+  // When none of that would happen, that step only adds the waiting and the held forces.
+  const MagneticSettings &settings = dipoles_.settings();
+  if (!settings.admit_exchange || settings.far_field != FarField::cell_multipole || left_ > holes_ ||
+      carrier_.size() == left_ || newcomers_.empty() || newcomers_.size() > kMaxWaiting ||
+      !std::is_sorted(newcomers_.begin(), newcomers_.end()))
+    return false;
+  for (const std::uint32_t i : newcomers_)
+  {
+    const std::size_t species = static_cast<std::size_t>(state.species[i]);
+    if (species >= species_.size() || !species_[species].carrier)
+      return false;
+    const double x[3] = {state.x[i], state.y[i], state.z[i]};
+    if (dipoles_.admissible_position(x))
+      return false;
+  }
+  return true;
+}
+
+void MagneticForceTerm::add_held_step(const dem::ParticleState &state, dem::ForceBuffers &forces, double t,
+                                      bool checked, bool gathered)
 {
   // Called by every thread of the team, after a check (the positions gathered) or on a quiet
   // step (nothing looked at). The close pairs' changes read the positions only when they are
   // due: a quiet step gathers them then.
   const bool hold = dipoles_.settings().hold_dipoles;
-  if (hold && !checked && dipoles_.live_pair_changes_due())
+  if (hold && !gathered && dipoles_.live_pair_changes_due())
     gather_positions(state);
   const BeadArrays beads = bead_arrays();
   const double t1 = omp_get_wtime();
@@ -396,6 +431,14 @@ void MagneticForceTerm::add_held_step(const dem::ParticleState &state, dem::Forc
     ++steps_in_team_;
     ++steps_;
     quiet_steps_ += checked ? 0 : 1;
+    steps_in_team_waiting_ += pending_ ? 1 : 0;
+  }
+  // The waiting newcomers' forces come first, as in add_forces() (the same sums in the same
+  // order); one thread: they add reactions to the held beads near each newcomer.
+  if (pending_)
+  {
+#pragma omp single
+    add_waiting_forces(state, forces, t);
   }
   add_held_forces(forces, 1.0, live);
 }
@@ -533,6 +576,27 @@ void MagneticForceTerm::add_waiting_forces(const dem::ParticleState &state, dem:
   const bool have_held = held.size() == 3 * n;
   // The held dipoles follow a ramping field (p ∝ B for linear beads).
   const double s = (held_ramp_ > 0.0 && dipoles_.linear()) ? field_.ramp(t) / held_ramp_ : 1.0;
+  // The held beads that can be within reach of some newcomer: those inside the box around
+  // all of them, grown by the largest reach (along the open axes; a periodic axis is not
+  // cut). One pass over the held beads instead of one per newcomer; the candidates keep
+  // ascending k, so every newcomer sums its neighbours in the same order as a full scan.
+  candidates_.clear();
+  if (have_held)
+  {
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    for (const std::uint32_t i : newcomers_)
+    {
+      const double x[3] = {state.x[i], state.y[i], state.z[i]}, reach = 8.0 * state.radius[i];
+      for (int d = 0; d < 3; ++d)
+        lo[d] = std::min(lo[d], x[d] - reach), hi[d] = std::max(hi[d], x[d] + reach);
+    }
+    for (int d = 0; d < 3; ++d)
+      if (box_[d] > 0.0)
+        lo[d] = -HUGE_VAL, hi[d] = HUGE_VAL;
+    for (std::size_t k = 0; k < n; ++k)
+      if (x_[k] >= lo[0] && x_[k] <= hi[0] && y_[k] >= lo[1] && y_[k] <= hi[1] && z_[k] >= lo[2] && z_[k] <= hi[2])
+        candidates_.push_back(static_cast<std::uint32_t>(k));
+  }
   for (const std::uint32_t i : newcomers_)
   {
     const std::size_t species = static_cast<std::size_t>(state.species[i]);
@@ -543,7 +607,7 @@ void MagneticForceTerm::add_waiting_forces(const dem::ParticleState &state, dem:
     double B[3], g[3][3], p[3];
     field(x, B, g);
     neighbours_.clear();
-    for (std::size_t k = 0; have_held && k < n; ++k)
+    for (const std::uint32_t k : candidates_)
     {
       double r[3] = {x[0] - x_[k], x[1] - y_[k], x[2] - z_[k]};
       for (int d = 0; d < 3; ++d)

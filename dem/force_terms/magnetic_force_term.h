@@ -54,7 +54,8 @@ public:
   // the close pairs' live forces, the staleness checks).
   std::string cost_note() const override;
   void add_forces(const dem::ParticleState &state, dem::ForceBuffers &forces, double t) override;
-  // The steps that hold (no evaluation, exchange or ramp due) run inside the engine's team.
+  // The steps that hold (no evaluation, exchange or ramp due) run inside the engine's team,
+  // also while newcomers wait for admission in empty space (a fed brush: nearly always).
   // A step whose last look found nothing stale, and whose beads cannot have moved enough
   // since to change that (`step_move` summed), does not look again (a quiet step).
   bool add_forces_in_team_if_held(const dem::ParticleState &state, dem::ForceBuffers &forces, double t,
@@ -86,6 +87,9 @@ public:
   // Steps whose forces were added inside the team so far (this process; not checkpointed),
   // and of those the quiet ones (no gather, no check: their moves were bounded).
   long steps_held_in_team() const { return steps_in_team_; }
+  // Of those, the steps with newcomers waiting for admission; and how many wait now.
+  long steps_held_in_team_waiting() const { return steps_in_team_waiting_; }
+  std::size_t waiting_newcomers() const { return pending_ ? newcomers_.size() : 0; }
   long quiet_steps() const { return quiet_steps_; }
   // With false, every step in the team gathers and checks (benchmarks and tests compare: the
   // same bits).
@@ -179,7 +183,7 @@ private:
   // Meanwhile each waiting carrier is induced by the applied field and its neighbours' held
   // dipoles and feels their pair forces (and they its), every step (add_waiting_forces);
   // the engine indices and forces added at the last step (for last_forces).
-  std::vector<std::uint32_t> waiting_, neighbours_;
+  std::vector<std::uint32_t> waiting_, neighbours_, candidates_; // add_waiting_forces()
   std::vector<double> waiting_f_;
   // `corrected`: the two-sphere correction of a waiting carrier's close pairs, through a
   // two-bead state (the neighbour, the newcomer) reused every time.
@@ -225,10 +229,15 @@ private:
   };
   std::vector<QuietMove> quiet_moved_;
   bool quiet_valid_ = false, quiet_steps_on_ = true;
-  long quiet_steps_ = 0;
+  long quiet_steps_ = 0, steps_in_team_waiting_ = 0;
   // The held forces of a step in the team; `checked`: its positions were gathered and checked
-  // (otherwise a quiet step).
-  void add_held_step(const dem::ParticleState &state, dem::ForceBuffers &forces, bool checked);
+  // (otherwise a quiet step); `gathered`: the positions were gathered at this step. Newcomers
+  // waiting for admission add their forces first.
+  void add_held_step(const dem::ParticleState &state, dem::ForceBuffers &forces, double t, bool checked,
+                     bool gathered);
+  // Whether a step with newcomers waiting (pending_) would do nothing in add_forces() but add
+  // their forces and the held ones: then it stays in the team (every thread decides alike).
+  bool waiting_stays_in_team(const dem::ParticleState &state) const;
   AppliedFieldFunction lookup_at(double t) const;
   void full_refresh(const BeadArrays &beads, double t, double ramp);
   void take_held_forces();

@@ -359,3 +359,53 @@ TEST(MagneticAdmission, LeaversAreAdmittedWhenTheNewcomersMustWait)
   std::printf("the carriers near the leavers: worst |F - F_fresh| / RMS |F_fresh| %.2e\n", worst);
   EXPECT_LT(worst, 2e-2);
 }
+
+// Carriers that enter empty space (above the bed: no occupied fine cell to join) wait for the
+// next full evaluation, feeling the field and their held neighbours (add_waiting_forces). In a
+// fed brush some nearly always wait; their steps stay inside the engine's thread team when
+// nothing could be admitted, and give the bits of the serial path and of one thread.
+TEST(MagneticAdmission, WaitingNewcomersStayInTheTeamWithTheSerialBits)
+{
+  const Case c = parse_case_text(scene, "magnetic_admission.yaml");
+  struct Run
+  {
+    std::vector<double> state;
+    std::size_t waiting = 0;
+    long in_team = 0, in_team_waiting = 0;
+  };
+  auto run = [&c](int threads, bool in_team) {
+    omp_set_num_threads(threads);
+    auto system = std::make_unique<dem::DemSystem>(c);
+    MagneticSettings settings = MagneticSettings::from_case(c.dem);
+    settings.admit_exchange = true;
+    auto owned = std::make_unique<MagneticForceTerm>(c, settings, field, system->box().length);
+    MagneticForceTerm &term = *owned;
+    term.set_held_steps_in_team(in_team);
+    system->add_force_term(std::move(owned));
+    system->insert_particles();
+    system->initialize();
+    system->advance(40);
+    // Six carriers just above the bed (empty fine cells, but within reach of its top beads: the
+    // waiting forces are not zero), none leaving (and the helper's two toner).
+    std::vector<Spot> above;
+    for (int k = 0; k < 6; ++k)
+      above.push_back({0.15e-3 + 0.14e-3 * k, 0.2e-3 + 0.1e-3 * k, 0.42e-3, 30e-6});
+    exchange(*system, inflow, 0, above);
+    system->step(); // the exchange: outside the team
+    Run r;
+    r.waiting = term.waiting_newcomers();
+    system->advance(300);
+    r.in_team = term.steps_held_in_team();
+    r.in_team_waiting = term.steps_held_in_team_waiting();
+    r.state = state_in_id_order(*system);
+    return r;
+  };
+  const Run team = run(2, true), serial = run(2, false), one = run(1, true);
+  std::printf("waiting after the exchange: %zu; steps in the team %ld of 341, %ld of them with newcomers waiting\n",
+              team.waiting, team.in_team, team.in_team_waiting);
+  EXPECT_EQ(team.waiting, 6u) << "the carriers above the bed should wait for a full evaluation";
+  EXPECT_GT(team.in_team_waiting, 200) << "their steps should stay in the team";
+  EXPECT_EQ(serial.in_team, 0);
+  EXPECT_EQ(team.state, serial.state) << "in the team against the serial path";
+  EXPECT_EQ(team.state, one.state) << "2 threads against 1";
+}

@@ -526,7 +526,7 @@ void DemSystem::wall_phase(StepFlags &mine)
     int m = 0;
     for (std::size_t w = 0; w < W; ++w)
     {
-      if (!walls_.contact(w, p, r, g[m], range))
+      if (!walls_.may_touch(w, p, r + range) || !walls_.contact(w, p, r, g[m], range))
         continue;
       which[m] = static_cast<int>(w);
       if (m == max_wall_contacts)

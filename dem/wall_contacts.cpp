@@ -43,6 +43,13 @@ DemWalls::DemWalls(const WallSet &walls)
     }
     prism_boxes_.push_back(b);
   }
+  cylinder_filters_.resize(walls_.size());
+  for (std::size_t w = 0; w < walls_.size(); ++w)
+    if (walls_[w].kind == Kind::cylinder)
+    {
+      const CylinderWall &c = cylinders_[walls_[w].index];
+      cylinder_filters_[w] = {true, c.particles_outside, c.center[0], c.center[1], c.radius, 1e-9 * c.radius};
+    }
 }
 
 std::vector<std::string> DemWalls::materials() const

@@ -12,6 +12,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <memory>
+#include <random>
+#include <cmath>
 
 using namespace magbrush;
 using namespace magbrush::dem;
@@ -50,6 +52,47 @@ TEST(DemWalls, CylinderOutsideAndInside)
   walls.prepare(0.0, true);
   ASSERT_TRUE(walls.contact(1, {20e-3 - 48e-6, 0, 0}, 50e-6, g));
   EXPECT_EQ(g.surface_velocity.y, 0.0);
+}
+
+// The wall phase's pre-filter (no square root) never turns away a contact the exact test
+// finds: points scattered within a few radii of each cylinder's surface, thousands of them
+// within a few ulps of the touching distance, both senses, with and without an adhesion
+// range; and it does turn away the particles far from the wall (what it is for).
+TEST(DemWalls, CylinderPreFilterNeverMissesAContact)
+{
+  WallSet ws;
+  CylinderWall c;
+  c.name = c.material = "sleeve";
+  c.center = {1e-3, -2e-3};
+  c.radius = 12.5e-3;
+  ws.cylinders.push_back(c);
+  c.name = c.material = "housing";
+  c.particles_outside = false;
+  c.radius = 20e-3;
+  ws.cylinders.push_back(c);
+  DemWalls walls(ws);
+  walls.prepare(0.0, false);
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> angle(0.0, 2.0 * M_PI), unit(-1.0, 1.0);
+  long touching = 0, turned_away = 0;
+  for (int k = 0; k < 200000; ++k)
+  {
+    const std::size_t w = static_cast<std::size_t>(k % 2);
+    const double R = w == 0 ? 12.5e-3 : 20e-3, r = 30e-6, range = (k % 3 == 0) ? 0.4e-6 : 0.0;
+    // Half the points at the touching distance to within a few ulps, half within 4 radii.
+    const double touch = w == 0 ? R + r + range : R - r - range;
+    const double d = (k % 4 < 2) ? touch * (1.0 + 4e-16 * unit(rng)) : touch + 4.0 * r * unit(rng);
+    const double a = angle(rng);
+    const Vector3 p{1e-3 + d * std::cos(a), -2e-3 + d * std::sin(a), 0.0};
+    WallContactGeometry g;
+    const bool exact = walls.contact(w, p, r, g, range);
+    const bool may = walls.may_touch(w, p, r + range);
+    touching += exact;
+    turned_away += !may;
+    ASSERT_TRUE(may || !exact) << "wall " << w << " point " << k;
+  }
+  EXPECT_GT(touching, 20000);
+  EXPECT_GT(turned_away, 20000);
 }
 
 TEST(DemWalls, PlaneFollowsItsPath)

@@ -282,7 +282,7 @@ std::string NipProfile::csv() const
            std::to_string(frame_.relative_surface_speed()) +
            " m/s).\n"
            "# chain_speed: the same with the bead centre instead of its contact point (the chain's end moving over "
-           "the drum, rolling included: Kawamoto's slip speed of the chains).\n"
+           "the drum, rolling included: one reading of Kawamoto's slip speed of the chains).\n"
            "# pressures: forces of the touching beads on the drum per drum surface of the bin (arc x slab depth "
            "= " +
            std::to_string(frame_.slab_depth * 1e3) + " mm); normal presses into the drum, tangential drags it downstream.\n";

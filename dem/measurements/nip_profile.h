@@ -6,8 +6,9 @@
 //    of the drum (the paper: equal to the relative surface speed 0.135 m/s at the gap centre);
 //  * chain speed: the same with the bead's centre instead of its contact point, i.e. how fast
 //    the chain's end moves over the drum whether it slides or rolls. Kawamoto's Fig. 17 is
-//    "the slip speed of the chains": a bead that rolls over the drum moves its chain along
-//    while its contact point stands still on the drum, so the two differ by the spin ω × r;
+//    "the slip speed of the chains", without saying which of the two; a bead that rolls over
+//    the drum moves its chain along while its contact point stands still on the drum, so the
+//    two differ by the spin ω × r;
 //  * normal and tangential pressure on the drum: Σ (force of the touching beads on the drum,
 //    normal component pushing into the drum / tangential component downstream) per bin, over
 //    the drum surface of the bin (arc length of the bin on the drum × slab depth);

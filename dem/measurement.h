@@ -32,6 +32,12 @@ struct SummaryValue
   // Standard error of `drift` (NaN where drift is): a drift beyond two of them is a trend, one
   // within them is noise (dem/measurements/sample_series.h).
   double drift_standard_error = std::numeric_limits<double>::quiet_NaN();
+  // A STATE value: an amount the scene holds (the beads in the nip window), not a force or a
+  // speed the particles exert. Its drift is what tells a transient (the scene still filling or
+  // draining) from a steady state; a run with state values is steady when every state value
+  // drifts < statistics.steady_drift and no other tested mean drifts by more than both that
+  // tolerance and two of its own standard errors (dem/run_summary.h).
+  bool state = false;
 };
 
 class Measurement

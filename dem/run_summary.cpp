@@ -36,14 +36,14 @@ std::string run_summary_csv(const std::vector<std::unique_ptr<Measurement>> &mea
   o << "# magbrush run summary: every measurement's key numbers; standard errors by block averaging over "
     << statistics.blocks << " blocks; drift = (mean of 2nd half - mean of 1st half) / |mean| (negative: falling), with its own "
     << "standard error from each half's blocks\n";
-  o << "key,value,standard_error,drift,unit,meaning,measurement,drift_standard_error\n";
+  o << "key,value,standard_error,drift,unit,meaning,measurement,drift_standard_error,state\n";
   SteadyStateVerdict verdict;
   for (const auto &m : measurements)
     for (const SummaryValue &v : m->summary())
     {
       o << cell(v.key) << "," << number(v.value) << "," << number(v.standard_error) << "," << number(v.drift) << ","
         << cell(v.unit) << "," << cell(v.meaning) << "," << cell(m->name()) << "," << number(v.drift_standard_error)
-        << "\n";
+        << "," << (v.state ? 1 : 0) << "\n";
       verdict.add(v, statistics.steady_drift);
     }
   o << verdict.rows(statistics.steady_drift);
@@ -55,29 +55,58 @@ void SteadyStateVerdict::add(const SummaryValue &v, double tolerance)
   if (std::isnan(v.drift))
     return;
   ++tested;
-  steady += std::abs(v.drift) < tolerance;
-  if (std::isnan(v.drift_standard_error))
+  const bool within = std::abs(v.drift) < tolerance;
+  steady += within;
+  const bool has_error = !std::isnan(v.drift_standard_error);
+  const bool beyond_noise = has_error && std::abs(v.drift) > 2.0 * v.drift_standard_error;
+  if (v.state)
+  {
+    // A state value's noise is small (hundreds of beads counted, not their forces): a drift
+    // below the tolerance is steady even when it is resolved; one above it and beyond its
+    // noise is a transient (a trend).
+    ++states;
+    steady_states += within;
+    trending += !within && beyond_noise;
+    return;
+  }
+  observables_beyond += !within && beyond_noise;
+  if (!has_error)
     return;
   ++with_error;
-  trending += std::abs(v.drift) > 2.0 * v.drift_standard_error;
+  trending += beyond_noise;
   resolution = std::max(resolution, 2.0 * v.drift_standard_error);
+}
+
+double SteadyStateVerdict::verdict() const
+{
+  if (tested == 0)
+    return std::numeric_limits<double>::quiet_NaN();
+  if (states == 0)
+    return steady == tested ? 1.0 : 0.0;
+  return steady_states == states && observables_beyond == 0 ? 1.0 : 0.0;
 }
 
 std::string SteadyStateVerdict::rows(double tolerance) const
 {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   auto row = [](const char *key, double value, const std::string &meaning) {
-    return std::string(key) + "," + number(value) + ",nan,nan,1," + cell(meaning) + ",run,nan\n";
+    return std::string(key) + "," + number(value) + ",nan,nan,1," + cell(meaning) + ",run,nan,0\n";
   };
-  char text[256];
-  std::snprintf(text, sizeof text, "%d of %d tested means drift < %.3g %% between the halves of their window", steady,
-                tested, 100.0 * tolerance);
-  std::string out = row("steady_state", tested == 0 ? nan : steady == tested ? 1.0 : 0.0, text);
+  char text[320];
+  if (states == 0)
+    std::snprintf(text, sizeof text, "%d of %d tested means drift < %.3g %% between the halves of their window",
+                  steady, tested, 100.0 * tolerance);
+  else
+    std::snprintf(text, sizeof text,
+                  "%d of %d state values (beads held) drift < %.3g %% between the halves of their window; %d of %d "
+                  "other tested means drift beyond both that and two standard errors",
+                  steady_states, states, 100.0 * tolerance, observables_beyond, tested - states);
+  std::string out = row("steady_state", verdict(), text);
   std::snprintf(text, sizeof text,
                 "%d of %d tested means drift by more than two of the drift's standard errors (a trend; the rest is "
                 "noise)",
-                trending, with_error);
-  out += row("significant_drift", with_error == 0 ? nan : trending > 0 ? 1.0 : 0.0, text);
+                trending, with_error + states);
+  out += row("significant_drift", with_error + states == 0 ? nan : trending > 0 ? 1.0 : 0.0, text);
   std::snprintf(text, sizeof text,
                 "two standard errors of the drift of the noisiest tested mean: the smallest drift this window tells "
                 "from noise (above %.3g the steady-state test needs more samples)",
@@ -85,6 +114,7 @@ std::string SteadyStateVerdict::rows(double tolerance) const
   out += row("drift_resolution", with_error == 0 ? nan : resolution, text);
   return out;
 }
+
 void write_run_summary(const std::string &directory, const std::vector<std::unique_ptr<Measurement>> &measurements,
                        const StatisticsSettings &statistics)
 {

@@ -77,20 +77,22 @@ def steady_state_rows(run_summary, supplied=True):
         return []
     by_key = {r["key"]: r for r in run_summary}
     verdict = by_key.get("steady_state")
-    tested = []
+    tested, states = [], []
     for r in run_summary:
         try:
             drift = float(r["drift"])
         except ValueError:
             continue
         if math.isfinite(drift):
-            tested.append((abs(drift), drift, r["key"]))
-    if verdict is None or not tested:
+            # A state value (the beads the scene holds) decides the verdict with the forces'
+            # trends (dem/run_summary.h): it is named first.
+            (states if r.get("state") == "1" else tested).append((abs(drift), drift, r["key"]))
+    if verdict is None or not (tested or states):
         return []
     tested.sort(reverse=True)
     reached = verdict["value"] == "1"
     # Signed: + still rising, − still falling (or draining).
-    worst = ", ".join(f"{k} {100 * d:+.1f} %" for _, d, k in tested[:4])
+    worst = ", ".join(f"{k} {100 * d:+.1f} %" for _, d, k in states + tested[:4])
     trend = by_key.get("significant_drift", {}).get("value")
     try:
         resolution = float(by_key.get("drift_resolution", {}).get("value", "nan"))
@@ -105,6 +107,9 @@ def steady_state_rows(run_summary, supplied=True):
     note = f"drift: {worst}"
     if math.isfinite(resolution):
         note += f"; this window resolves drifts down to {100 * resolution:.1f} % (2 standard errors)"
+        if reached and states and math.isfinite(drift_tolerance(verdict["meaning"])) and \
+                resolution > drift_tolerance(verdict["meaning"]):
+            note += " — so the forces show no trend beyond that, not a 2 % certainty"
         tolerance = drift_tolerance(verdict["meaning"])
         if not reached and trend == "0" and math.isfinite(tolerance) and resolution > tolerance:
             # Block standard errors fall as 1/sqrt(window): (resolution / tolerance)² windows.

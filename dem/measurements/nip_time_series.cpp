@@ -3,6 +3,7 @@
 
 #include "dem/measurements/measurement_registry.h"
 #include "dem/measurements/nip_profile.h" // resolve_drum_contact
+#include "dem/measurements/sample_series.h"
 #include "dem/snapshot_writer.h"
 
 #include <cmath>
@@ -17,7 +18,8 @@ namespace {
 constexpr std::int8_t unseen = 2;
 }
 
-NipTimeSeries::NipTimeSeries(const Case &c) : settings_(c.nip), frame_(NipFrame::from_case(c))
+NipTimeSeries::NipTimeSeries(const Case &c)
+    : settings_(c.nip), statistics_(c.statistics), frame_(NipFrame::from_case(c))
 {
   // The magnetic grid ends at field.grid_outer_radius (0 = sleeve + 3 mm): beyond it no field
   // holds a bead to the brush.
@@ -117,6 +119,19 @@ void NipTimeSeries::sample(const DemSystem &system)
   }
   if (at_centre > 0)
     row.centre_slip = slip / static_cast<double>(at_centre);
+}
+
+std::vector<SummaryValue> NipTimeSeries::summary() const
+{
+  // The same samples as the nip profile's means (t >= nip.average_from).
+  SampleSeries in_window;
+  for (const NipBudgetRow &r : rows_)
+    if (r.time >= settings_.average_from)
+      in_window.add(static_cast<double>(r.in_window));
+  SummaryValue v = summarise(in_window, static_cast<std::size_t>(statistics_.blocks), true, "beads_in_nip_window",
+                             "1", "beads in the nip window (|sleeve angle| <= nip.chain_half_angle): the nip's state");
+  v.state = true;
+  return {v};
 }
 
 std::string NipTimeSeries::csv() const

@@ -12,6 +12,12 @@
 //    left grow at the same rate (the flux through the nip);
 //  * drum: beads touching it, total normal and tangential force on it [N] (signs as in
 //    nip_profile.h), and the mean slip of the touching beads within one bin of the gap centre.
+//
+// Its summary is the STATE of the nip for the steady-state verdict (dem/run_summary.h): the
+// mean number of beads in the window over the averaging window (t >= nip.average_from), with
+// its block standard error and drift. While the sleeve still fills the nip (or a placed load
+// drains through it) this count moves by tens of per cent; in a steady state it holds, and it
+// is counted over thousands of beads, so its halves agree far better than the drum forces'.
 #pragma once
 
 #include "dem/dem_system.h"
@@ -44,6 +50,7 @@ public:
   double interval() const override { return settings_.sample_interval; }
   void sample(const DemSystem &system) override;
   void write(const std::string &directory) const override;
+  std::vector<SummaryValue> summary() const override;
 
   // The bead budget from plain arrays (tests): ids, positions, radii at one time.
   void add_beads(double time, const std::vector<std::int32_t> &ids, const std::vector<Vector3> &positions,
@@ -54,6 +61,7 @@ public:
 
 private:
   NipSettings settings_;
+  StatisticsSettings statistics_;
   NipFrame frame_;
   double lost_radius_ = 0.0;             // beyond this distance from the roller axis a bead is lost [m]
   std::vector<std::int8_t> region_;      // by id: −1 upstream, 0 in the window, +1 downstream, 2 unseen

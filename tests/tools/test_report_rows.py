@@ -77,6 +77,22 @@ class SteadyStateRow(unittest.TestCase):
         self.assertNotIn("× this window", row[3])
 
 
+    def test_a_state_value_is_named_first_and_the_resolution_qualifies_reached(self):
+        # The nip: the beads in its window hold (+0.4 %), the drum force fluctuates (-4.4 %
+        # within its noise); the run's verdict is "reached", and the row says what that means
+        # for the forces when the window resolves less than 2 %.
+        rows = summary(-0.044, 0.025, 0.05, False, True)
+        rows.insert(0, {"key": "beads_in_nip_window", "value": "3960", "drift": "0.004",
+                        "drift_standard_error": "0.001", "meaning": "beads", "state": "1"})
+        rows[-3]["meaning"] = ("1 of 1 state values (beads held) drift < 2 % between the halves of their window; "
+                               "0 of 1 other tested means drift beyond both that and two standard errors")
+        row = report.steady_state_rows(rows)[0]
+        self.assertEqual(row[1], "reached")
+        self.assertTrue(row[3].startswith("drift: beads_in_nip_window +0.4 %, normal_force_per_length_N_m -4.4 %"),
+                        row)
+        self.assertIn("no trend beyond that, not a 2 % certainty", row[3])
+
+
 class BudgetRow(unittest.TestCase):
     def test_budget_closes(self):
         f = flow([10, 11], [0, 3], [0, 2], [1e-6, 1.1e-6], [math.nan, math.nan])

@@ -325,6 +325,70 @@ TEST(NipTimeSeries, CountsBeadsCrossingTheWindowAndLostBeads)
   EXPECT_EQ(series.rows().back().lost, 1);
 }
 
+// The nip's STATE for the steady-state verdict: the beads in the window over the averaging
+// window. A window still filling drifts; a full one holds, and then a drum force that only
+// fluctuates (within its noise) does not fail the run, while one that trends does.
+TEST(NipTimeSeries, BeadsInTheWindowAreTheStateOfTheSteadyStateVerdict)
+{
+  Case c = nip_case(0.0);
+  c.nip.chain_half_angle = 10.0 * pi / 180.0;
+  c.nip.average_from = 10.0;
+  const double rm = 12.6e-3, r = 30e-6, deg = pi / 180.0;
+  auto at = [&](double theta_deg) { return Vector3{rm * std::cos(theta_deg * deg), rm * std::sin(theta_deg * deg), 0.5e-3}; };
+  // 200 beads; at sample k the first in(k) of them are in the window, the rest upstream.
+  auto run = [&](auto in) {
+    NipTimeSeries series(c);
+    std::vector<std::int32_t> ids(200);
+    std::vector<double> radii(200, r);
+    for (int i = 0; i < 200; ++i)
+      ids[static_cast<std::size_t>(i)] = i;
+    for (int k = 0; k < 120; ++k)
+    {
+      std::vector<Vector3> x(200);
+      for (int i = 0; i < 200; ++i)
+        x[static_cast<std::size_t>(i)] = at(i < in(k) ? 0.0 : -15.0);
+      series.add_beads(static_cast<double>(k), ids, x, radii);
+    }
+    return series;
+  };
+  // Filling: 100 → 199 beads over the whole run; averaged from t = 10 (samples 10 … 119).
+  const NipTimeSeries filling = run([](int k) { return 100 + (99 * k) / 119; });
+  const auto f = filling.summary();
+  ASSERT_EQ(f.size(), 1u);
+  EXPECT_EQ(f[0].key, "beads_in_nip_window");
+  EXPECT_TRUE(f[0].state);
+  EXPECT_GT(f[0].drift, 0.2); // the halves' means 131 and 177
+  // Full: 150 ± 1 beads.
+  const NipTimeSeries full = run([](int k) { return 150 + (k % 3) - 1; });
+  const auto s = full.summary();
+  EXPECT_NEAR(s[0].value, 150.0, 0.02);
+  EXPECT_LT(std::abs(s[0].drift), 0.01);
+
+  // The verdict with a drum force beside the state: one that fluctuates (a 4 % drift within
+  // two of its standard errors), one that trends (6 % at six standard errors).
+  auto force = [](double drift, double error) {
+    SummaryValue v;
+    v.key = "normal_force_per_length_N_m", v.value = 1.0, v.drift = drift, v.drift_standard_error = error;
+    return v;
+  };
+  auto verdict = [&](const SummaryValue &state, const SummaryValue &fn) {
+    SteadyStateVerdict v;
+    v.add(state, 0.02);
+    v.add(fn, 0.02);
+    return v;
+  };
+  EXPECT_EQ(verdict(s[0], force(-0.04, 0.025)).verdict(), 1.0);
+  EXPECT_EQ(verdict(s[0], force(-0.06, 0.01)).verdict(), 0.0);
+  EXPECT_EQ(verdict(f[0], force(-0.04, 0.025)).verdict(), 0.0); // still filling
+  const std::string rows = verdict(f[0], force(0.0, 0.01)).rows(0.02);
+  EXPECT_NE(rows.find("steady_state,0,"), std::string::npos) << rows;
+  EXPECT_NE(rows.find("significant_drift,1,"), std::string::npos) << rows; // the filling is a trend
+  // Without a state, the strict rule: the fluctuating force alone fails the 2 % test.
+  SteadyStateVerdict alone;
+  alone.add(force(-0.04, 0.025), 0.02);
+  EXPECT_EQ(alone.verdict(), 0.0);
+}
+
 TEST(NipProfile, OneEngineStepOnATurningDrum)
 {
   // Beads pressed on the drum by a prescribed overlap, the drum turning: the profile must

@@ -9,8 +9,8 @@
 //   significant_drift,0,,,1,0 of 3 tested means drift by more than two standard errors,run
 //   drift_resolution,0.012,,,1,two standard errors of the drift of the noisiest tested mean,run
 //
-// (and two last columns on every row: drift_standard_error, and state = 1 for a state value.) The verdict, steady_state, is 1, 0
-// or NaN (nothing tested), by one of two rules:
+// (and two last columns on every row: drift_standard_error, and state = 1 for a state value.)
+// The verdict, steady_state, is 1, 0 or NaN (nothing tested), by one of two rules:
 //
 //  * without STATE values (SummaryValue::state): every value tested for drift (a finite
 //    drift) is below statistics.steady_drift in size (the drift is signed: negative while the

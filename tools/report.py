@@ -107,10 +107,9 @@ def steady_state_rows(run_summary, supplied=True):
     note = f"drift: {worst}"
     if math.isfinite(resolution):
         note += f"; this window resolves drifts down to {100 * resolution:.1f} % (2 standard errors)"
-        if reached and states and math.isfinite(drift_tolerance(verdict["meaning"])) and \
-                resolution > drift_tolerance(verdict["meaning"]):
-            note += " — so the forces show no trend beyond that, not a 2 % certainty"
         tolerance = drift_tolerance(verdict["meaning"])
+        if reached and states and math.isfinite(tolerance) and resolution > tolerance:
+            note += f" — so the forces show no trend beyond that, not a {100 * tolerance:g} % certainty"
         if not reached and trend == "0" and math.isfinite(tolerance) and resolution > tolerance:
             # Block standard errors fall as 1/sqrt(window): (resolution / tolerance)² windows.
             how = ("a longer run, or a deeper slab" if supplied else

@@ -880,11 +880,47 @@ void MagneticForceTerm::admit_newcomers(const dem::ParticleState &state)
     append_bead(state, k, species_[species]);
     compact_origin_.push_back(-1);
   }
+  follow_engine_order();
   const std::size_t n = carrier_.size();
   for (auto *v : {&fx_, &fy_, &fz_, &tx_, &ty_, &tz_})
     v->assign(n, 0.0);
   dipoles_.particles_changed(compact_origin_);
   compact_origin_.clear();
+}
+
+// The compact order re-sorted by engine index, while the solver learns a new set anyway (its
+// lists are rebuilt for it). The engine keeps its particles in cell order (it re-sorts them at
+// every list build), so this puts neighbours in space next to each other in the magnetics' own
+// arrays too, and makes the per-step loops (positions gathered, held forces added: engine
+// index carrier_[k] for compact bead k) read and write the engine's arrays as a stream instead
+// of a scatter. Without it the order decays with every exchange (newcomers join at the end,
+// the engine moves everyone else), and in a fed scene after a few thousand exchanges those
+// loops wait on cache misses (docs/magnetics.md, "The compact order follows the engine's").
+// compact_origin_ (new compact bead → the solver's old index) is permuted alongside.
+void MagneticForceTerm::follow_engine_order()
+{
+  if (!follow_engine_order_on_ || std::is_sorted(carrier_.begin(), carrier_.end()))
+    return;
+  const std::size_t n = carrier_.size();
+  sort_order_.resize(n);
+  for (std::size_t k = 0; k < n; ++k)
+    sort_order_[k] = static_cast<std::uint32_t>(k);
+  std::sort(sort_order_.begin(), sort_order_.end(),
+            [this](std::uint32_t a, std::uint32_t b) { return carrier_[a] < carrier_[b]; });
+  for (auto *v : {&x_, &y_, &z_, &radius_, &mu_r_, &Ms_})
+  {
+    sort_scratch_.resize(n);
+    for (std::size_t k = 0; k < n; ++k)
+      sort_scratch_[k] = (*v)[sort_order_[k]];
+    v->swap(sort_scratch_);
+  }
+  sort_index_scratch_.resize(n);
+  for (std::size_t k = 0; k < n; ++k)
+    sort_index_scratch_[k] = compact_origin_[sort_order_[k]];
+  compact_origin_.swap(sort_index_scratch_);
+  for (std::size_t k = 0; k < n; ++k)
+    sort_order_[k] = carrier_[sort_order_[k]];
+  carrier_.swap(sort_order_);
 }
 
 // ---------------------------------------------------------------------------------------

@@ -94,6 +94,9 @@ public:
   // With false, every step in the team gathers and checks (benchmarks and tests compare: the
   // same bits).
   void set_quiet_steps(bool on) { quiet_steps_on_ = on; }
+  // For benchmarks: keep the compact order as the exchanges leave it instead of following the
+  // engine's (follow_engine_order()).
+  void set_follow_engine_order(bool on) { follow_engine_order_on_ = on; }
   // Full evaluations (compute) and local refreshes so far.
   long evaluations() const { return evaluations_; }
   long local_refreshes() const { return local_refreshes_; }
@@ -133,6 +136,9 @@ public:
   };
   const RefreshCounts &refresh_counts() const { return counts_; }
   const InducedDipoles &dipoles() const { return dipoles_; }
+  // The engine index of each bead in the magnetics' compact order (kLeft for a carrier that
+  // left and waits to be dropped).
+  const std::vector<std::uint32_t> &compact_carriers() const { return carrier_; }
   // The magnetic forces this term added at its last step, by engine index (0 for toner):
   // `fx` etc. are resized to the engine's particle count and overwritten [N].
   void last_forces(std::vector<double> &fx, std::vector<double> &fy, std::vector<double> &fz) const;
@@ -202,6 +208,11 @@ private:
 
   void select_carriers(const dem::ParticleState &state);
   void admit_newcomers(const dem::ParticleState &state);
+  void follow_engine_order();
+  bool follow_engine_order_on_ = true;
+  std::vector<std::uint32_t> sort_order_; // follow_engine_order()'s permutation and scratch
+  std::vector<double> sort_scratch_;
+  std::vector<std::int32_t> sort_index_scratch_;
   bool follow_exchange(const std::vector<std::int32_t> &origin);
   void defer_change(const std::vector<std::int32_t> &origin);
   bool admit_pending(const dem::ParticleState &state, double t);

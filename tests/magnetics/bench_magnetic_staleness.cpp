@@ -27,9 +27,11 @@
 //
 //   regulation:  cases/kweon_regulation.yaml (the sump inflow, the doctor blade, the outflow):
 //                run to `until` once, then every mode runs the same `flow` window (function
-//                regulation() below: a state of `magbrush run` can be reused).
+//                fed() below: a state of `magbrush run` can be reused).
+//   nip_fed:     cases/kawamoto_nip_fed.yaml (the default: the layer supplied through the
+//                gap), the same way; the force error on the drum.
 //
-//   bench_magnetic_staleness [nip|nip_quick|compression|both|regulation] [flow_us (nip, 300)] [until_us (compression, 500)]
+//   bench_magnetic_staleness [nip|nip_quick|compression|both|regulation|nip_fed] [flow_us (nip, 300)] [until_us (compression, 500)]
 //                            [sample_us (2)] [modes (absolute,local,relative)] [refresh_us (the case's: 5)]
 //                            [descent_at_us (2500)] [descent_us (300; 0 = skip)]
 // Environment (knobs without a case key): MAGBRUSH_LOCAL_REGION_LIMIT, MAGBRUSH_LOCAL_BATCH,
@@ -331,7 +333,8 @@ ModeResult run_mode(Case c, const std::string &mode, const std::string &restart,
   // "relative+R1+S0.6" = relative with local_region_limit 1 and the magnetic lists' skin 0.6
   // diameters; "+X0" = defer_exchange off (a full evaluation at every particle exchange);
   // "+A1" / "+A0" = admit_exchange on / off (admission without a rebuild at the next step);
-  // "+Q0" = no quiet steps, "+T0" = no held steps inside the engine's team;
+  // "+Q0" = no quiet steps, "+T0" = no held steps inside the engine's team, "+O0" = the compact
+  // order as the exchanges leave it (not following the engine's);
   // "+F0.1" = magnetic_staleness 0.1; "+H1" = hold the dipoles (the close pairs' forces live),
   // with "+L3" live pairs within 3 mean radii (+ skin), "+N10" their changes every 10 steps.
   const std::vector<std::string> parts = split(mode, '+');
@@ -379,7 +382,7 @@ ModeResult run_mode(Case c, const std::string &mode, const std::string &restart,
       settings.live_pair_radius = v;
     else if (parts[k][0] == 'N')
       settings.live_pair_steps = static_cast<int>(v);
-    else if (parts[k][0] == 'Q' || parts[k][0] == 'T')
+    else if (parts[k][0] == 'Q' || parts[k][0] == 'T' || parts[k][0] == 'O')
       continue; // (the term's switches, below)
     else
       throw std::runtime_error("unknown mode variant " + parts[k]);
@@ -392,6 +395,8 @@ ModeResult run_mode(Case c, const std::string &mode, const std::string &restart,
       owned->set_quiet_steps(std::atof(parts[k].c_str() + 1) != 0.0);
     else if (parts[k][0] == 'T')
       owned->set_held_steps_in_team(std::atof(parts[k].c_str() + 1) != 0.0);
+    else if (parts[k][0] == 'O')
+      owned->set_follow_engine_order(std::atof(parts[k].c_str() + 1) != 0.0);
   const MagneticForceTerm *term = owned.get();
   system.replace_force_term("magnetic dipoles", std::move(owned));
   auto probe = std::make_unique<HeldForceError>(c, term, settings, field, system.box().length, wall, sample);
@@ -561,19 +566,36 @@ void compression(const fs::path &dir, double until_us, double sample_us, const s
   print(title, "plate", results);
 }
 
-// The doctor-blade regulation cell (cases/kweon_regulation.yaml: developer fed by the sump
-// inflow every 2 us onto the turning sleeve, piled in front of the blade, sheared through its
-// gap, removed by the outflow): run (or take) the state at `until`, then every mode runs the
-// same `flow` window from it; the wall force is the sleeve's. Environment, to reuse a state
-// written by `magbrush run cases/kweon_regulation.yaml --set dem.duration=...`:
-// MAGBRUSH_BENCH_REGULATION_RESTART (its dem/checkpoint.bin; `until` must be its time) and
-// MAGBRUSH_BENCH_REGULATION_FIELDS (its field.output_dir).
-void regulation(const fs::path &dir, double until_us, double flow_us, double sample_us,
-                const std::vector<std::string> &modes)
+// A fed scene: the doctor-blade regulation cell (cases/kweon_regulation.yaml: developer fed by
+// the sump inflow every 2 us onto the turning sleeve, piled in front of the blade, sheared
+// through its gap, removed by the outflow; the wall force is the sleeve's) or the fed nip
+// (cases/kawamoto_nip_fed.yaml: the layer supplied by the sleeve through the development gap;
+// the wall force is the drum's). Run (or take) the state at `until`, then every mode runs the
+// same `flow` window from it. Environment, to reuse a state written by
+// `magbrush run <case> --set dem.duration=...` (or `magbrush-dem`):
+// MAGBRUSH_BENCH_<SCENE>_RESTART (its dem/checkpoint.bin; `until` must be its time) and
+// MAGBRUSH_BENCH_<SCENE>_FIELDS (its field.output_dir), <SCENE> = REGULATION or NIP_FED.
+struct FedScene
 {
-  const std::string file = std::string(MAGBRUSH_SOURCE_DIR) + "/cases/kweon_regulation.yaml";
-  const char *fields = std::getenv("MAGBRUSH_BENCH_REGULATION_FIELDS");
-  const char *restart = std::getenv("MAGBRUSH_BENCH_REGULATION_RESTART");
+  const char *case_file;  // under the source tree
+  const char *env_prefix; // MAGBRUSH_BENCH_<prefix>_RESTART / _FIELDS
+  const char *label;      // the table's title
+  std::size_t wall;       // whose force error is reported
+  const char *wall_name;
+};
+
+const FedScene regulation_scene{"cases/kweon_regulation.yaml", "REGULATION",
+                                "Regulation cell (cases/kweon_regulation.yaml)", 0, "sleeve"};
+const FedScene fed_nip_scene{"cases/kawamoto_nip_fed.yaml", "NIP_FED",
+                             "Fed nip (cases/kawamoto_nip_fed.yaml)", 1, "drum"};
+
+void fed(const FedScene &scene, const fs::path &dir, double until_us, double flow_us, double sample_us,
+         const std::vector<std::string> &modes)
+{
+  const std::string file = std::string(MAGBRUSH_SOURCE_DIR) + "/" + scene.case_file;
+  const std::string prefix = std::string("MAGBRUSH_BENCH_") + scene.env_prefix;
+  const char *fields = std::getenv((prefix + "_FIELDS").c_str());
+  const char *restart = std::getenv((prefix + "_RESTART").c_str());
   std::vector<std::string> overrides = {
     "field.output_dir=" + (fields ? std::string(fields) : (dir / "fields").string()),
     "output.directory=" + dir.string(), "dem.output_interval=0 s"};
@@ -585,7 +607,7 @@ void regulation(const fs::path &dir, double until_us, double flow_us, double sam
       cmd += " --set '" + o + "'";
     if (std::system((cmd + " > field.log 2>&1").c_str()) != 0)
     {
-      std::printf("regulation: `magbrush field` failed (see %s/field.log)\n", dir.c_str());
+      std::printf("%s: `magbrush field` failed (see %s/field.log)\n", scene.env_prefix, dir.c_str());
       return;
     }
   }
@@ -601,19 +623,18 @@ void regulation(const fs::path &dir, double until_us, double flow_us, double sam
     const double t_wall = omp_get_wtime();
     run_mode(first, "relative", "", dir / "first", 0, 1e9, 0.0);
     checkpoint = (dir / "first" / "run_relative" / "checkpoint.bin").string();
-    std::printf("regulation: ran to %.3g ms in %.0f s\n", start * 1e3, omp_get_wtime() - t_wall);
+    std::printf("%s: ran to %.3g ms in %.0f s\n", scene.env_prefix, start * 1e3, omp_get_wtime() - t_wall);
   }
   c.dem.duration = start + flow_us * 1e-6;
   std::vector<ModeResult> results;
   for (const auto &mode : modes)
-    results.push_back(run_mode(c, mode, checkpoint, dir, 0, sample_us * 1e-6, start));
+    results.push_back(run_mode(c, mode, checkpoint, dir, scene.wall, sample_us * 1e-6, start));
   char title[512];
   std::snprintf(title, sizeof title,
-                "Regulation cell (cases/kweon_regulation.yaml): %.3g ... %.3g ms, step %.3g ns, refresh %.3g us, "
-                "staleness %.3g, inflow every %.3g us",
-                start * 1e3, c.dem.duration * 1e3, c.dem.time_step * 1e9, c.dem.magnetic_refresh * 1e6,
+                "%s: %.3g ... %.3g ms, step %.3g ns, refresh %.3g us, staleness %.3g, inflow every %.3g us",
+                scene.label, start * 1e3, c.dem.duration * 1e3, c.dem.time_step * 1e9, c.dem.magnetic_refresh * 1e6,
                 c.dem.magnetic_staleness, c.flow.interval * 1e6);
-  print(title, "sleeve", results);
+  print(title, scene.wall_name, results);
 }
 
 } // namespace
@@ -640,7 +661,9 @@ int main(int argc, char **argv)
     if (scene == "compression" || scene == "both")
       compression(dir, until_us, sample_us, modes);
     if (scene == "regulation")
-      regulation(dir, until_us, flow_us, sample_us, modes);
+      fed(regulation_scene, dir, until_us, flow_us, sample_us, modes);
+    if (scene == "nip_fed")
+      fed(fed_nip_scene, dir, until_us, flow_us, sample_us, modes);
   }
   catch (const std::exception &e)
   {

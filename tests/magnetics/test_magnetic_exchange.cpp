@@ -128,6 +128,55 @@ TEST(MagneticForceTerm, CarriersLeavingAndEnteringKeepTheSolverConsistent)
   EXPECT_LT(after_removal, 1e-5);
 }
 
+// The compact order follows the engine's when the solver learns a new set: after exchanges
+// and the engine's re-sorts, the beads are in ascending engine index (cell order), so the
+// per-step loops stream over the engine's arrays; the forces still equal a fresh solve. With
+// the switch off, the order is the one the exchanges leave (survivors in their old order, the
+// newcomers at the end): the same forces, in another order.
+TEST(MagneticForceTerm, CompactOrderFollowsTheEnginesAfterExchanges)
+{
+  omp_set_num_threads(2);
+  const Case c = parse_case_text(scene, "magnetic_exchange.yaml");
+  for (const bool follow : {true, false})
+  {
+    dem::DemSystem system(c);
+    MagneticSettings settings = MagneticSettings::from_case(c.dem);
+    settings.defer_exchange = false; // the exchange is solved at once
+    auto owned = std::make_unique<MagneticForceTerm>(c, settings, AppliedMagneticField::uniform({0, 0, 1}, 0.13),
+                                                     system.box().length);
+    owned->set_follow_engine_order(follow);
+    const MagneticForceTerm *term = owned.get();
+    system.add_force_term(std::move(owned));
+    system.insert_particles();
+    system.initialize();
+    system.advance(20);
+    for (int round = 0; round < 3; ++round)
+    {
+      system.request_neighbour_rebuild(); // a re-sort: the engine indices move under the term
+      system.advance(5);
+      std::vector<std::int32_t> leave;
+      for (std::size_t i = 0; i < system.particles().size(); ++i)
+        if (system.particles().id[i] % 9 == round)
+          leave.push_back(static_cast<std::int32_t>(i));
+      dem::ParticleState enter;
+      for (int k = 0; k < 12; ++k)
+        enter.add({0.08e-3 * k + 0.05e-3, 0.2e-3 * round + 0.1e-3, 0.4e-3}, 30e-6, 2200.0, 0, 0.0);
+      system.exchange_particles(leave, enter);
+      system.request_neighbour_rebuild(); // the newcomers sorted in among the others
+      system.step();
+    }
+    const std::vector<std::uint32_t> &order = term->compact_carriers();
+    ASSERT_FALSE(order.empty());
+    EXPECT_EQ(std::is_sorted(order.begin(), order.end()), follow)
+      << (follow ? "the compact order should follow the engine's" : "the order the exchanges leave is not sorted");
+    int fresh_sweeps = 0;
+    const double difference = difference_to_fresh_solve(c, system, *term, fresh_sweeps);
+    std::printf("order %s the engine's after 3 exchanges: max |F - F_fresh| / max |F| = %.2e\n",
+                follow ? "following" : "not following", difference);
+    EXPECT_LT(difference, 1e-5);
+  }
+}
+
 // MagneticSettings::defer_exchange (the default): an exchange forces no evaluation. An empty
 // one changes nothing; after a real one the newcomers feel the applied field and their
 // neighbours' held dipoles (bounded error) until the next full evaluation, which admits them

@@ -895,7 +895,8 @@ void MagneticForceTerm::admit_newcomers(const dem::ParticleState &state)
 // index carrier_[k] for compact bead k) read and write the engine's arrays as a stream instead
 // of a scatter. Without it the order decays with every exchange (newcomers join at the end,
 // the engine moves everyone else), and in a fed scene after a few thousand exchanges those
-// loops wait on cache misses (docs/magnetics.md, "The compact order follows the engine's").
+// loops wait on cache misses (docs/magnetics.md, "The fed nip's error budget, and the compact
+// order following the engine's").
 // compact_origin_ (new compact bead → the solver's old index) is permuted alongside.
 void MagneticForceTerm::follow_engine_order()
 {

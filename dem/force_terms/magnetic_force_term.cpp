@@ -1,5 +1,6 @@
 #include "dem/force_terms/magnetic_force_term.h"
 
+#include "dem/particle_state.h"
 #include "dem/periodic_unwrap.h"
 #include "magnetics/dipole_physics.h"
 
@@ -9,6 +10,7 @@
 
 #include "coupling/field_files.h"
 
+#include <numeric>
 #include <omp.h>
 
 #include <algorithm>
@@ -902,26 +904,15 @@ void MagneticForceTerm::follow_engine_order()
 {
   if (!follow_engine_order_on_ || std::is_sorted(carrier_.begin(), carrier_.end()))
     return;
-  const std::size_t n = carrier_.size();
-  sort_order_.resize(n);
-  for (std::size_t k = 0; k < n; ++k)
-    sort_order_[k] = static_cast<std::uint32_t>(k);
+  sort_order_.resize(carrier_.size());
+  std::iota(sort_order_.begin(), sort_order_.end(), 0);
+  const auto engine_index = [this](std::int32_t k) { return carrier_[static_cast<std::size_t>(k)]; };
   std::sort(sort_order_.begin(), sort_order_.end(),
-            [this](std::uint32_t a, std::uint32_t b) { return carrier_[a] < carrier_[b]; });
+            [&](std::int32_t a, std::int32_t b) { return engine_index(a) < engine_index(b); });
   for (auto *v : {&x_, &y_, &z_, &radius_, &mu_r_, &Ms_})
-  {
-    sort_scratch_.resize(n);
-    for (std::size_t k = 0; k < n; ++k)
-      sort_scratch_[k] = (*v)[sort_order_[k]];
-    v->swap(sort_scratch_);
-  }
-  sort_index_scratch_.resize(n);
-  for (std::size_t k = 0; k < n; ++k)
-    sort_index_scratch_[k] = compact_origin_[sort_order_[k]];
-  compact_origin_.swap(sort_index_scratch_);
-  for (std::size_t k = 0; k < n; ++k)
-    sort_order_[k] = carrier_[sort_order_[k]];
-  carrier_.swap(sort_order_);
+    dem::permute_array(*v, sort_order_, sort_scratch_);
+  dem::permute_array(compact_origin_, sort_order_, sort_index_scratch_);
+  dem::permute_array(carrier_, sort_order_, sort_carrier_scratch_);
 }
 
 // ---------------------------------------------------------------------------------------

@@ -210,9 +210,10 @@ private:
   void admit_newcomers(const dem::ParticleState &state);
   void follow_engine_order();
   bool follow_engine_order_on_ = true;
-  std::vector<std::uint32_t> sort_order_; // follow_engine_order()'s permutation and scratch
+  std::vector<std::int32_t> sort_order_; // follow_engine_order()'s permutation and scratch
   std::vector<double> sort_scratch_;
   std::vector<std::int32_t> sort_index_scratch_;
+  std::vector<std::uint32_t> sort_carrier_scratch_;
   bool follow_exchange(const std::vector<std::int32_t> &origin);
   void defer_change(const std::vector<std::int32_t> &origin);
   bool admit_pending(const dem::ParticleState &state, double t);

@@ -87,7 +87,9 @@ Values carry units as in the case file (--vary populations.carrier.diameter=42um
 Varying a population's diameter also scales its count by (d0/d)^3 and its diameter_std by
 d/d0, so that the supplied carrier volume (the layer) stays the same, as in the paper's
 42/50/60 um comparison, and a fixed dem.time_step by d/d0 (the stable step is proportional to
-the bead size); --no-keep-layer switches that off.
+the bead size); a population supplied by the inflow or given by its mass (count 0) keeps its
+volume by itself, and its diameter_std and the step still scale; --no-keep-layer switches
+all of that off.
 The options of the stages (named in brackets) go to the stages that declare them, at every point.
 
 Beyond one process (the points are independent; the table is the same bit for bit but for
@@ -375,17 +377,22 @@ PointSetup set_up_point(const SweepPlan &plan, std::size_t n)
     point.label += "_" + label_of(key, val);
   }
   // Keep the supplied carrier volume when a diameter changes: count × (d0/d)³, std × d/d0.
+  // A population placed by mass or supplied by the inflow (count 0) keeps its volume by
+  // itself (the inflow offers an areal mass); its spread and the time step still scale.
   point.point_case = load_case(plan.case_path, point.overrides);
   for (std::size_t k = 0; k < plan.vary.size() && plan.keep_layer; ++k)
   {
     std::string selector;
     const Population *p0 = population_of(plan.base, plan.vary[k].key, selector);
-    if (!p0 || plan.vary[k].key.substr(plan.vary[k].key.find_last_of('.') + 1) != "diameter" || p0->count <= 0)
+    if (!p0 || plan.vary[k].key.substr(plan.vary[k].key.find_last_of('.') + 1) != "diameter")
       continue;
     const Population *p1 = population_of(point.point_case, plan.vary[k].key, selector);
     const double ratio = p0->diameter_mean / p1->diameter_mean;
-    const long count = std::lround(static_cast<double>(p0->count) * ratio * ratio * ratio);
-    point.overrides.push_back("populations." + selector + ".count=" + std::to_string(count));
+    if (p0->count > 0)
+    {
+      const long count = std::lround(static_cast<double>(p0->count) * ratio * ratio * ratio);
+      point.overrides.push_back("populations." + selector + ".count=" + std::to_string(count));
+    }
     char std_text[64];
     std::snprintf(std_text, sizeof std_text, "%.9g", p0->diameter_std / ratio);
     point.overrides.push_back("populations." + selector + ".diameter_std=" + std_text);

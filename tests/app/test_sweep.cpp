@@ -124,3 +124,36 @@ TEST(Sweep, PointsWithTheSameFieldInputsShareOneSolvedField)
   EXPECT_DOUBLE_EQ(std::stod(rows[2][si]), 160e3);
   fs::remove_all(dir);
 }
+
+// A population given by its mass (or supplied by the inflow: count 0) keeps its volume by
+// itself when its diameter changes; the sweep must still scale its spread and a fixed time
+// step with the diameter (a fed nip at 42 µm otherwise runs at the 60 µm step, above the
+// stable limit, and with the 60 µm spread).
+TEST(Sweep, ADiameterStudyOfAPopulationGivenByMassScalesItsSpreadAndTheStep)
+{
+  const fs::path dir = magbrush::testing::test_temp_dir("app_sweep_mass");
+  std::string box = magbrush::testing::sweep_box_case;
+  // 100 beads' mass at 100 µm (2200 kg/m³): 1.152e-7 kg.
+  box.replace(box.find("count: 100"), std::string("count: 100").size(), "mass: 1.152e-7 kg, diameter_std: 10 um");
+  box.replace(box.find("dem: {"), std::string("dem: {").size(), "dem: {time_step: 40 ns, ");
+  std::ofstream(dir / "box.yaml") << box;
+  const Result r = magbrush_run(dir, {"sweep", (dir / "box.yaml").string(), "--vary",
+                                      "populations.carrier.diameter=100um,50um", "--skip", "mesh,field,dem,report",
+                                      "--set", "output.directory=" + (dir / "out").string()});
+  ASSERT_EQ(r.status, 0) << r.output;
+  const std::size_t second = r.output.find("p1_diameter-50um");
+  ASSERT_NE(second, std::string::npos) << r.output;
+  const std::string point = r.output.substr(second);
+  auto resolved = [&](const std::string &key) {
+    const std::size_t at = point.find("\n" + key + " ");
+    if (at == std::string::npos)
+      return std::string("(missing)");
+    const std::size_t eq = point.find("= ", at);
+    return point.substr(eq + 2, point.find('\n', eq) - eq - 2);
+  };
+  EXPECT_EQ(resolved("populations.carrier.mass"), "115.2 ug") << point.substr(0, 4000);
+  EXPECT_EQ(resolved("populations.carrier.count"), "0");
+  EXPECT_EQ(resolved("populations.carrier.diameter_std"), "5 um");
+  EXPECT_EQ(resolved("dem.time_step"), "20 ns");
+  fs::remove_all(dir);
+}

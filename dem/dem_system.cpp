@@ -356,37 +356,19 @@ std::string DemSystem::describe_particle(std::size_t i, const Vector3 &at) const
 // Particle–particle contacts (the kernel and the order of the sums: pair_kernel.h).
 
 // Phase 1 (all threads, work-shared; ends with a barrier): pairs and rows, block by block.
-// Sets this thread's overlap alarm when one of its pairs overlaps beyond the guard.
+// Sets this thread's overlap alarm when one of its pairs overlaps beyond the guard. On one
+// thread the columns are summed here too (one_thread_pairs_rows_and_columns).
 void DemSystem::pair_and_row_phase(StepFlags &mine)
 {
-  int overlap_alarm = 0;
-  const ParticleState &s = particles_;
-  const NeighbourList &L = list_;
-  const long n = static_cast<long>(s.size());
-  // Image shifts and coefficients as plain arrays, one per component / field.
-  double shift[3][27];
-  for (int code = 0; code < 27; ++code)
+  const PairKernelData D = pair_kernel_data();
+  if (omp_get_num_threads() == 1)
   {
-    const Vector3 v = L.shifts()[code];
-    shift[0][code] = v.x;
-    shift[1][code] = v.y;
-    shift[2][code] = v.z;
+    mine.overlap_alarm |= one_thread_pairs_rows_and_columns(D, mine.row_torques);
+    return;
   }
-  const std::size_t types = table_.species() * table_.columns();
-  const double *coef = coefficient_fields_.data();
-  NeighbourList &W = list_; // the pair slots written here
-  const PairKernelData D{s.x.data(), s.y.data(), s.z.data(), s.vx.data(), s.vy.data(), s.vz.data(),
-                         s.wx.data(), s.wy.data(), s.wz.data(), s.radius.data(), s.mass.data(),
-                         s.inv_inertia.data(), s.species.data(), L.owner.data(), L.partner.data(),
-                         L.image.data(), shift[0], shift[1], shift[2], coef, coef + types, coef + 2 * types,
-                         coef + 3 * types, coef + 4 * types, coef + 5 * types,
-                         static_cast<std::int64_t>(table_.columns()), table_.species() == 1, dt_,
-                         case_.dem.max_overlap_fraction, W.hist_x.data(), W.hist_y.data(), W.hist_z.data(),
-                         W.force_x.data(), W.force_y.data(), W.force_z.data(), W.torque_j_x.data(),
-                         W.torque_j_y.data(), W.torque_j_z.data(), W.touching.data(),
-                         coef + 6 * types, coef + 7 * types, coef + 8 * types, table_.adhesion_cutoff(),
-                         table_.adhesion_range(), table_.particles_adhesive()};
-  const std::int32_t *row_start = L.row_start.data();
+  int overlap_alarm = 0;
+  const long n = static_cast<long>(particles_.size());
+  const std::int32_t *row_start = list_.row_start.data();
   ForceBuffers &f = forces_;
   const long blocks = (n + contact_block_rows - 1) / contact_block_rows;
   std::vector<double> &row_torques = mine.row_torques; // the torques on i of one block's pairs
@@ -426,10 +408,120 @@ void DemSystem::pair_and_row_phase(StepFlags &mine)
 #pragma omp barrier
 }
 
-// Phase 2 (after phase 1's barrier; static schedule, no barrier): each particle adds the
-// pairs in which it is the partner, in ascending pair order: −F on it, the pair's torque on j.
+// The kernel's view of the particles, the pairs and their slots.
+PairKernelData DemSystem::pair_kernel_data()
+{
+  const ParticleState &s = particles_;
+  NeighbourList &L = list_;
+  // Image shifts and coefficients as plain arrays, one per component / field.
+  const std::size_t types = table_.species() * table_.columns();
+  const double *coef = coefficient_fields_.data();
+  return PairKernelData{s.x.data(), s.y.data(), s.z.data(), s.vx.data(), s.vy.data(), s.vz.data(),
+                        s.wx.data(), s.wy.data(), s.wz.data(), s.radius.data(), s.mass.data(),
+                        s.inv_inertia.data(), s.species.data(), L.owner.data(), L.partner.data(),
+                        L.image.data(), L.shift_component(0), L.shift_component(1), L.shift_component(2), coef, coef + types,
+                        coef + 2 * types, coef + 3 * types, coef + 4 * types, coef + 5 * types,
+                        static_cast<std::int64_t>(table_.columns()), table_.species() == 1, dt_,
+                        case_.dem.max_overlap_fraction, L.hist_x.data(), L.hist_y.data(), L.hist_z.data(),
+                        L.force_x.data(), L.force_y.data(), L.force_z.data(), L.torque_j_x.data(),
+                        L.torque_j_y.data(), L.torque_j_z.data(), L.touching.data(),
+                        coef + 6 * types, coef + 7 * types, coef + 8 * types, table_.adhesion_cutoff(),
+                        table_.adhesion_range(), table_.particles_adhesive()};
+}
+
+namespace {
+// m pairs into their partners' column sums, in pair order: column[partner] += sign × v (sign
+// ±1: −F on the partner, +its torque; the sign only flips, so the sum is the column pass's
+// `−=`), and the touching flags into the contact counts (when given).
+void scatter_to_columns(const std::int32_t *__restrict partner, const std::int32_t *__restrict touching,
+                        const double *__restrict vx, const double *__restrict vy, const double *__restrict vz,
+                        double sign, double *__restrict cx, double *__restrict cy, double *__restrict cz,
+                        std::int32_t *__restrict count, std::size_t m)
+{
+  for (std::size_t k = 0; k < m; ++k)
+  {
+    const std::size_t j = static_cast<std::size_t>(partner[k]);
+    cx[j] += sign * vx[k];
+    cy[j] += sign * vy[k];
+    cz[j] += sign * vz[k];
+  }
+  if (count)
+    for (std::size_t k = 0; k < m; ++k)
+      count[static_cast<std::size_t>(partner[k])] += touching[k];
+}
+} // namespace
+
+// Phases 1 and 2 on one thread (pair_kernel.h): the same sums in the same order, so the same
+// bits, but each block's pair forces stay in `scratch` and go straight into the partners'
+// column sums, which wait in the force arrays until their own row is reached. At 55k
+// particles the per-pair slots (48 bytes a pair, written, then read back through the
+// transposed index) no longer stay in cache between the two passes.
+int DemSystem::one_thread_pairs_rows_and_columns(PairKernelData D, std::vector<double> &scratch)
+{
+  int overlap_alarm = 0;
+  const long n = static_cast<long>(particles_.size());
+  const std::int32_t *row_start = list_.row_start.data(), *partner = list_.partner.data();
+  ForceBuffers &f = forces_;
+  for (std::vector<double> *a : {&f.fx, &f.fy, &f.fz, &f.tx, &f.ty, &f.tz})
+    std::fill(a->begin(), a->end(), 0.0); // the column sums start from zero
+  std::fill(contact_count_.begin(), contact_count_.end(), 0);
+  const long blocks = (n + contact_block_rows - 1) / contact_block_rows;
+  for (long b = 0; b < blocks; ++b)
+  {
+    const long i0 = b * contact_block_rows, i1 = std::min(n, i0 + contact_block_rows);
+    const std::int64_t p0 = row_start[i0], p1 = row_start[i1];
+    const std::size_t m = static_cast<std::size_t>(p1 - p0);
+    scratch.resize(9 * m);
+    double *out = scratch.data();
+    D.fx = out, D.fy = out + m, D.fz = out + 2 * m;
+    D.tjx = out + 3 * m, D.tjy = out + 4 * m, D.tjz = out + 5 * m;
+    D.slot_base = p0;
+    const RowTorques T{out + 6 * m, out + 7 * m, out + 8 * m};
+    overlap_alarm |= particle_pair_kernel(D, T, p0, p1);
+    // The block's pairs into their partners' column sums, in ascending pair order (each
+    // partner j > its pair's i). Every pair of a column of this block's rows is then in:
+    // its pairs belong to earlier rows, of this block or of earlier ones. (Forces and
+    // torques in separate passes: fewer live pointers, no spills in the scalar loops.)
+    scatter_to_columns(partner + p0, D.touching + p0, D.fx, D.fy, D.fz, -1.0, f.fx.data(), f.fy.data(), f.fz.data(),
+                       contact_count_.data(), m);
+    scatter_to_columns(partner + p0, nullptr, D.tjx, D.tjy, D.tjz, 1.0, f.tx.data(), f.ty.data(), f.tz.data(), nullptr,
+                       m);
+    // Each row's own pairs, then column + row, as column_phase forms it.
+    for (long i = i0; i < i1; ++i)
+    {
+      double fx = 0, fy = 0, fz = 0, tx = 0, ty = 0, tz = 0;
+      std::int32_t count = 0;
+      for (std::int64_t p = row_start[i]; p < row_start[i + 1]; ++p)
+      {
+        const std::size_t k = static_cast<std::size_t>(p - p0);
+        count += D.touching[p];
+        fx += D.fx[k];
+        fy += D.fy[k];
+        fz += D.fz[k];
+        tx += T.x[k];
+        ty += T.y[k];
+        tz += T.z[k];
+      }
+      const std::size_t iu = static_cast<std::size_t>(i);
+      f.fx[iu] = fx + f.fx[iu];
+      f.fy[iu] = fy + f.fy[iu];
+      f.fz[iu] = fz + f.fz[iu];
+      f.tx[iu] = tx + f.tx[iu];
+      f.ty[iu] = ty + f.ty[iu];
+      f.tz[iu] = tz + f.tz[iu];
+      contact_count_[iu] += count;
+    }
+  }
+  return overlap_alarm;
+}
+
+// Phase 2 (after phase 1's barrier; static schedule, no barrier): each particle sums the
+// pairs in which it is the partner, in ascending pair order from zero (−F on it, the pair's
+// torque on j), and adds that to its row's sum. (On one thread phase 1 has done this.)
 void DemSystem::column_phase()
 {
+  if (omp_get_num_threads() == 1)
+    return;
   const NeighbourList &L = list_;
   const long n = static_cast<long>(particles_.size());
   ForceBuffers &f = forces_;
@@ -438,8 +530,8 @@ void DemSystem::column_phase()
   for (long k = 0; k < n; ++k)
   {
     const std::size_t i = static_cast<std::size_t>(k);
-    double fx = f.fx[i], fy = f.fy[i], fz = f.fz[i], tx = f.tx[i], ty = f.ty[i], tz = f.tz[i];
-    std::int32_t count = contact_count_[i];
+    double fx = 0, fy = 0, fz = 0, tx = 0, ty = 0, tz = 0;
+    std::int32_t count = 0;
     for (std::int32_t q = col_start[i]; q < col_start[i + 1]; ++q)
     {
       const std::size_t p = U(col_pair[q]);
@@ -451,13 +543,13 @@ void DemSystem::column_phase()
       ty += L.torque_j_y[p];
       tz += L.torque_j_z[p];
     }
-    f.fx[i] = fx;
-    f.fy[i] = fy;
-    f.fz[i] = fz;
-    f.tx[i] = tx;
-    f.ty[i] = ty;
-    f.tz[i] = tz;
-    contact_count_[i] = count;
+    f.fx[i] += fx;
+    f.fy[i] += fy;
+    f.fz[i] += fz;
+    f.tx[i] += tx;
+    f.ty[i] += ty;
+    f.tz[i] += tz;
+    contact_count_[i] += count;
   }
 }
 

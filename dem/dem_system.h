@@ -19,6 +19,7 @@
 #include "dem/contact_parameters.h"
 #include "dem/force_term.h"
 #include "dem/neighbour_list.h"
+#include "dem/pair_kernel.h"
 #include "dem/particle_exchange.h"
 #include "dem/particle_state.h"
 #include "dem/stability_guards.h"
@@ -206,6 +207,8 @@ private:
   // dem_advance.cpp for their order and barriers.
   void kick_and_drift_phase(StepFlags &mine);
   void pair_and_row_phase(StepFlags &mine);
+  PairKernelData pair_kernel_data();
+  int one_thread_pairs_rows_and_columns(PairKernelData D, std::vector<double> &scratch);
   void column_phase();
   void wall_phase(StepFlags &mine);
   void final_kick_phase(StepFlags &mine);

@@ -142,6 +142,9 @@ void NeighbourList::compute_cell_order(const ParticleState &s, const PeriodicBox
   {
     const int s[3] = {code % 3 - 1, (code / 3) % 3 - 1, code / 9 - 1};
     shifts_[static_cast<std::size_t>(code)] = {s[0] * box.length[0], s[1] * box.length[1], s[2] * box.length[2]};
+    for (int d = 0; d < 3; ++d)
+      shift_components_[static_cast<std::size_t>(d)][static_cast<std::size_t>(code)] =
+        s[d] * box.length[static_cast<std::size_t>(d)];
   }
 }
 

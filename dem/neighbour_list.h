@@ -55,6 +55,8 @@ public:
   Vector3 shift(std::size_t p) const { return shifts_[image[p]]; }
   // The 27 image shifts, indexed by image code.
   const Vector3 *shifts() const { return shifts_.data(); }
+  // One component (d = 0, 1, 2) of the 27 shifts, as an array (the pair kernel gathers them).
+  const double *shift_component(int d) const { return shift_components_[static_cast<std::size_t>(d)].data(); }
 
   // Rebuilds the list. Before: keeps the touching pairs' history keyed by the particles'
   // indices at the last build; then re-sorts all particle arrays in cell order through
@@ -89,6 +91,7 @@ public:
 
 private:
   std::array<Vector3, 27> shifts_{};
+  std::array<std::array<double, 27>, 3> shift_components_{};
   // Cell grid.
   std::array<double, 3> origin_{}, h_{};
   std::array<int, 3> n_{1, 1, 1};

@@ -32,8 +32,9 @@ inline int pair_loop(const PairKernelData &D, const RowTorques &T, std::int64_t 
   const std::int64_t columns = D.table_columns;
   const double dt = D.dt, guard = D.overlap_guard;
   double *__restrict hx = D.hx, *__restrict hy = D.hy, *__restrict hz = D.hz;
-  double *__restrict fx = D.fx, *__restrict fy = D.fy, *__restrict fz = D.fz;
-  double *__restrict tjx = D.tjx, *__restrict tjy = D.tjy, *__restrict tjz = D.tjz;
+  const std::int64_t base = D.slot_base;
+  double *__restrict fx = D.fx - base, *__restrict fy = D.fy - base, *__restrict fz = D.fz - base;
+  double *__restrict tjx = D.tjx - base, *__restrict tjy = D.tjy - base, *__restrict tjz = D.tjz - base;
   double *__restrict tix = T.x - p_begin, *__restrict tiy = T.y - p_begin, *__restrict tiz = T.z - p_begin;
   std::int32_t *__restrict touching = D.touching;
   const double *__restrict hamaker = D.hamaker, *__restrict asperity_i = D.asperity_i,

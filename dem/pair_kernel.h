@@ -9,9 +9,17 @@
 //     row needs it) and the torque on j (into the pair's slot);
 //   * while that is still in cache, each row of the block sums its pairs: force and torque
 //     of particle i from its own pairs, in pair order.
-// After a barrier each particle adds the pairs in which it is the partner (its column, in
-// ascending pair order). The order of every sum is fixed by the list alone, so the forces
-// have the same bits on any number of threads, with no atomics.
+// After a barrier each particle sums the pairs in which it is the partner (its column, in
+// ascending pair order, from zero) and adds that sum to its row's. The order of every sum is
+// fixed by the list alone, so the forces have the same bits on any number of threads, with
+// no atomics.
+//
+// On one thread the same sums are formed without the per-pair slots and the second pass:
+// rows are finished in particle order, and a pair (i, j) always has i < j, so when row i
+// is reached every pair in i's column has been seen. Each block's forces stay in a small
+// scratch; each pair subtracts its force from its partner's column sum at once (ascending
+// pair order, from zero, as the column pass does), and row i ends with column + row. Same
+// bits as on two threads, one stream of the pairs instead of two.
 //
 // The kernel's loop body is branch-free (a pair that does not touch goes through the same
 // arithmetic at a harmless stand-in geometry and its outputs are selected to zero), so it
@@ -52,6 +60,10 @@ struct PairKernelData
   const double *hamaker, *asperity_i, *asperity_j;
   double adhesion_cutoff, adhesion_range;
   bool adhesive;
+  // Pair p's force on i and torque on j go to fx[p − slot_base] … tjz[p − slot_base]: 0 when
+  // they are the list's own per-pair slots (the column phase reads them later), the block's
+  // first pair when they are a block's scratch (the one-thread path consumes them at once).
+  std::int64_t slot_base = 0;
 };
 
 // Torque on i of the pairs p_begin + k, k = 0 .. block size (a per-thread buffer).

@@ -591,12 +591,15 @@ TEST(DemEngine, MeasurementsAreSampledAtTheirIntervalAndWritten)
 
 // The vectorised pair kernel (whichever clone the CPU selects: AVX-512, AVX2 or SSE2) against
 // the contact law evaluated pair by pair in plain scalar code, summed in the order the engine
-// documents (each particle: its row in pair order from zero, then its column in ascending pair
-// order). Two species of different materials and sizes (the per-type coefficient lookup),
+// documents (each particle: its row in pair order from zero, plus its column in ascending pair
+// order from zero). Two species of different materials and sizes (the per-type coefficient lookup),
 // polydisperse, spinning, with tangential histories built up over earlier steps and pairs in
-// the list that do not touch: the forces, torques and histories must agree bit for bit.
-TEST(DemEngine, VectorisedPairKernelMatchesScalarContactLaw)
+// the list that do not touch: the forces, torques and histories must agree bit for bit, on
+// one thread (rows and columns in one pass) and on two (the column pass after a barrier).
+namespace {
+void pair_kernel_matches_scalar_contact_law(int threads)
 {
+  omp_set_num_threads(threads);
   Material a = elastic_material("carrier", 1e9, 0.35, 2200);
   a.friction = 0.45;
   a.polygon_angles = 12;
@@ -713,12 +716,16 @@ TEST(DemEngine, VectorisedPairKernelMatchesScalarContactLaw)
     }
     std::copy(a6, a6 + 6, &ref[6 * i]);
   }
-  for (std::size_t q = 0; q < P; ++q) // ascending pair order = each column's order
+  // Each column sums from zero in ascending pair order, and is then added to its row's sum.
+  std::vector<double> column(6 * n, 0.0);
+  for (std::size_t q = 0; q < P; ++q)
   {
     const std::size_t j = static_cast<std::size_t>(list.partner[q]);
-    ref[6 * j + 0] -= out[q].force_i.x, ref[6 * j + 1] -= out[q].force_i.y, ref[6 * j + 2] -= out[q].force_i.z;
-    ref[6 * j + 3] += out[q].torque_j.x, ref[6 * j + 4] += out[q].torque_j.y, ref[6 * j + 5] += out[q].torque_j.z;
+    column[6 * j + 0] -= out[q].force_i.x, column[6 * j + 1] -= out[q].force_i.y, column[6 * j + 2] -= out[q].force_i.z;
+    column[6 * j + 3] += out[q].torque_j.x, column[6 * j + 4] += out[q].torque_j.y, column[6 * j + 5] += out[q].torque_j.z;
   }
+  for (std::size_t k = 0; k < 6 * n; ++k)
+    ref[k] += column[k];
   std::printf("kernel vs scalar law: %zu particles (2 species), %zu listed pairs, %ld touching, %ld listed but apart\n",
               n, P, touching, listed_apart);
   ASSERT_GT(touching, 1000);
@@ -738,7 +745,15 @@ TEST(DemEngine, VectorisedPairKernelMatchesScalarContactLaw)
     mismatches += list.hist_x[q] != want.x || list.hist_y[q] != want.y || list.hist_z[q] != want.z ||
                   list.touching[q] != touch[q];
   }
-  EXPECT_EQ(mismatches, 0);
+  EXPECT_EQ(mismatches, 0) << "on " << threads << " thread(s)";
+}
+} // namespace
+
+TEST(DemEngine, VectorisedPairKernelMatchesScalarContactLaw)
+{
+  pair_kernel_matches_scalar_contact_law(1);
+  pair_kernel_matches_scalar_contact_law(2);
+  omp_set_num_threads(2);
 }
 
 namespace {

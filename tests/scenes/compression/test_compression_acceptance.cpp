@@ -60,49 +60,36 @@ struct Runs
   std::vector<RunResult> saturating; // 60 um, 0.7 mm, seeds 1–3, saturating carrier, the field sweep only
 };
 
-// The plate force of a set of runs in a window, summed over the runs (one periodic square of
-// three times the area): the field sweep is read on these sums. One small square's exponent
-// scatters by 0.075 between insertions at 80–130 mT (six seeds, saturating carrier: shifts
-// −0.59 … −0.77), three pooled by ~0.04.
-WindowMean pooled_over(const std::vector<RunResult> &runs, Window w)
-{
-  WindowMean sum;
-  for (const RunResult &r : runs)
-  {
-    const WindowMean m = mean_over(r.rows, w);
-    sum.fn += m.fn;
-    sum.ft += m.ft;
-    sum.touching += m.touching;
-    sum.field = m.field; // the same schedule in every run
-    sum.gap = m.gap;
-    sum.rows = sum.rows == 0 ? m.rows : std::min(sum.rows, m.rows);
-  }
-  return sum;
-}
-
 // The saturating carrier's M_s [A/m]: a soft ferrite carrier (about 30 emu/g); strong enough a
 // saturation at 130 mT (the beads keep about half of their linear moment) for the exponent to
 // move by 0.5–1, weak at 20 mT.
 constexpr double saturating_Ms = 150e3;
 
-// The hold at 0.6 mm, 130 mT, pooled over insertions: total beads, force and
-// area.
+// A window's means summed over insertions (one periodic square of their total area): beads
+// touching, force and area; the field and gap are the same in every run (one schedule). The
+// hold at 0.6 mm, 130 mT is read this way, and so is the field sweep: one small square's
+// exponent scatters by 0.075 between insertions at 80–130 mT (six seeds, saturating carrier:
+// shifts −0.59 … −0.77), three summed by ~0.04.
 struct Pooled
 {
-  double touching = 0, fn = 0, area = 0;
+  double touching = 0, fn = 0, area = 0, field = 0, gap = 0;
+  long rows = 0; // the fewest rows of any run in the window
   double density() const { return touching / area; }
   double per_bead() const { return fn / touching; }
   double pressure() const { return fn / area; }
 };
-Pooled pool(const std::vector<RunResult> &runs)
+Pooled pool(const std::vector<RunResult> &runs, Window w = hold_130)
 {
   Pooled p;
   for (const auto &r : runs)
   {
-    const WindowMean m = mean_over(r.rows, hold_130);
+    const WindowMean m = mean_over(r.rows, w);
     p.touching += m.touching;
     p.fn += m.fn;
     p.area += r.area;
+    p.field = m.field;
+    p.gap = m.gap;
+    p.rows = p.rows == 0 ? m.rows : std::min(p.rows, m.rows);
   }
   return p;
 }
@@ -180,7 +167,7 @@ void check_NormalForceGrowsAsBSquared(const Runs *runs)
   std::vector<double> b, f, b_low, f_low;
   for (const auto &h : field_holds())
   {
-    const WindowMean m = pooled_over(runs->d60, h.w);
+    const Pooled m = pool(runs->d60, h.w);
     ASSERT_GT(m.rows, 0) << h.field_mT << " mT";
     std::printf("B = %5.1f mT: F_n = %.4f mN, %.1f beads touching (three insertions)\n", m.field * 1e3, m.fn * 1e3,
                 m.touching);
@@ -274,7 +261,7 @@ void check_SaturatingCarrierLowersTheExponentAsItsMomentsSaturate(const Runs *ru
     for (const auto &h : field_holds())
       if (h.field_mT >= r.lo_mT && h.field_mT <= r.hi_mT)
       {
-        const WindowMean lin = pooled_over(runs->d60, h.w), sat = pooled_over(runs->saturating, h.w);
+        const Pooled lin = pool(runs->d60, h.w), sat = pool(runs->saturating, h.w);
         ASSERT_GT(lin.rows, 0);
         ASSERT_GT(sat.rows, 0);
         EXPECT_NEAR(sat.field, lin.field, 1e-9); // the same schedule
@@ -290,7 +277,7 @@ void check_SaturatingCarrierLowersTheExponentAsItsMomentsSaturate(const Runs *ru
     std::printf("%s: F ~ B^k, k = %.3f linear, %.3f saturating: shift %.3f; Froehlich-Kennelly: %.3f in a chain .. "
                 "%.3f in a layer of volume fraction %.3f (lone bead %.3f)\n",
                 r.name, k_lin, k_sat, k_sat - k_lin, chain, layer, phi, lone);
-    // ±0.1: 2.5 times the scatter of the exponent of three pooled insertions (pooled_over).
+    // ±0.1: 2.5 times the scatter of the exponent of three pooled insertions (pool).
     EXPECT_GT(k_sat - k_lin, chain - 0.1) << r.name;
     EXPECT_LT(k_sat - k_lin, layer + 0.1) << r.name;
     if (r.lo_mT == 20 && r.hi_mT == 50)

@@ -30,8 +30,10 @@
 //                fed() below: a state of `magbrush run` can be reused).
 //   nip_fed:     cases/kawamoto_nip_fed.yaml (the default: the layer supplied through the
 //                gap), the same way; the force error on the drum.
+//   full_roller: cases/kweon_full_roller.yaml (the closed loop: sump, guide, blade, nip,
+//                release), the same way; the force error on the sleeve.
 //
-//   bench_magnetic_staleness [nip|nip_quick|compression|both|regulation|nip_fed] [flow_us (nip, 300)] [until_us (compression, 500)]
+//   bench_magnetic_staleness [nip|nip_quick|compression|both|regulation|nip_fed|full_roller] [flow_us (nip, 300)] [until_us (compression, 500)]
 //                            [sample_us (2)] [modes (absolute,local,relative)] [refresh_us (the case's: 5)]
 //                            [descent_at_us (2500)] [descent_us (300; 0 = skip)]
 // Environment (knobs without a case key): MAGBRUSH_LOCAL_REGION_LIMIT, MAGBRUSH_LOCAL_BATCH,
@@ -336,9 +338,13 @@ ModeResult run_mode(Case c, const std::string &mode, const std::string &restart,
   // "+Q0" = no quiet steps, "+T0" = no held steps inside the engine's team, "+O0" = the compact
   // order as the exchanges leave it (not following the engine's);
   // "+F0.1" = magnetic_staleness 0.1; "+H1" = hold the dipoles (the close pairs' forces live),
-  // with "+L3" live pairs within 3 mean radii (+ skin), "+N10" their changes every 10 steps.
+  // with "+L3" live pairs within 3 mean radii (+ skin), "+N10" their changes every 10 steps;
+  // "+P20" = magnetic_refresh 20 us (so that rows with different intervals share one run).
   const std::vector<std::string> parts = split(mode, '+');
   c.dem.magnetic_staleness_mode = parts[0];
+  for (std::size_t k = 1; k < parts.size(); ++k)
+    if (parts[k][0] == 'P')
+      c.dem.magnetic_refresh = std::atof(parts[k].c_str() + 1) * 1e-6;
   dem::RunOptions options;
   options.restart_file = restart;
   // Every mode turns from the same checkpoint, written under another mode on purpose: its
@@ -382,8 +388,8 @@ ModeResult run_mode(Case c, const std::string &mode, const std::string &restart,
       settings.live_pair_radius = v;
     else if (parts[k][0] == 'N')
       settings.live_pair_steps = static_cast<int>(v);
-    else if (parts[k][0] == 'Q' || parts[k][0] == 'T' || parts[k][0] == 'O')
-      continue; // (the term's switches, below)
+    else if (parts[k][0] == 'Q' || parts[k][0] == 'T' || parts[k][0] == 'O' || parts[k][0] == 'P')
+      continue; // (the term's switches below; the interval above)
     else
       throw std::runtime_error("unknown mode variant " + parts[k]);
   }
@@ -574,7 +580,8 @@ void compression(const fs::path &dir, double until_us, double sample_us, const s
 // same `flow` window from it. Environment, to reuse a state written by
 // `magbrush run <case> --set dem.duration=...` (or `magbrush-dem`):
 // MAGBRUSH_BENCH_<SCENE>_RESTART (its dem/checkpoint.bin; `until` must be its time) and
-// MAGBRUSH_BENCH_<SCENE>_FIELDS (its field.output_dir), <SCENE> = REGULATION or NIP_FED.
+// MAGBRUSH_BENCH_<SCENE>_FIELDS (its field.output_dir), <SCENE> = REGULATION, NIP_FED or
+// FULL_ROLLER.
 struct FedScene
 {
   const char *case_file;  // under the source tree
@@ -586,6 +593,8 @@ struct FedScene
 
 const FedScene regulation_scene{"cases/kweon_regulation.yaml", "REGULATION",
                                 "Regulation cell (cases/kweon_regulation.yaml)", 0, "sleeve"};
+const FedScene full_roller_scene{"cases/kweon_full_roller.yaml", "FULL_ROLLER",
+                                 "Full roller (cases/kweon_full_roller.yaml)", 0, "sleeve"};
 const FedScene fed_nip_scene{"cases/kawamoto_nip_fed.yaml", "NIP_FED",
                              "Fed nip (cases/kawamoto_nip_fed.yaml)", 1, "drum"};
 
@@ -664,6 +673,8 @@ int main(int argc, char **argv)
       fed(regulation_scene, dir, until_us, flow_us, sample_us, modes);
     if (scene == "nip_fed")
       fed(fed_nip_scene, dir, until_us, flow_us, sample_us, modes);
+    if (scene == "full_roller")
+      fed(full_roller_scene, dir, until_us, flow_us, sample_us, modes);
   }
   catch (const std::exception &e)
   {

@@ -154,12 +154,8 @@ bool TwoSphereCorrection::can_admit(const BeadArrays &beads, std::size_t first) 
   double largest = 0.0;
   for (std::size_t b = 0; b < n; ++b)
     largest = std::max(largest, beads.radius[b]);
-  if (settings_.switch_end * largest + skin_ > R * (1.0 + 1e-12))
-    return false;
-  for (double L : box_)
-    if (L > 0.0 && R >= L)
-      return false;
-  return true;
+  // (A radius beyond a period is fine: admit() visits every image within reach.)
+  return !(settings_.switch_end * largest + skin_ > R * (1.0 + 1e-12));
 }
 
 bool TwoSphereCorrection::admit(const BeadArrays &beads, std::size_t first)
@@ -167,7 +163,12 @@ bool TwoSphereCorrection::admit(const BeadArrays &beads, std::size_t first)
   if (!can_admit(beads, first))
     return false;
   const std::size_t n = beads.n;
-  // Every image shift along the periodic axes within one period.
+  // Every image of every bead within the pair's reach of a newcomer. The positions are the
+  // magnetics' unwrapped ones (a bead keeps the image nearest its last position), so two
+  // beads may sit any number of periods apart, and a reach beyond a period (a quasi-2D slab
+  // of three or four diameters) meets several images of the same bead, and the newcomer's
+  // own: along a periodic axis the images j + s L with |Δ + s L| < reach are those with
+  // s in [⌈(−reach − Δ)/L⌉, ⌊(reach − Δ)/L⌋], Δ = x_j − x_c.
   const double *x[3] = {beads.x, beads.y, beads.z};
   admitted_.clear();
   for (std::size_t c = first; c < n; ++c)
@@ -175,24 +176,33 @@ bool TwoSphereCorrection::admit(const BeadArrays &beads, std::size_t first)
     {
       if (j < c && j >= first)
         continue; // (a pair of two newcomers: listed from the lower one)
-      for (int sx = -1; sx <= 1; ++sx)
-        for (int sy = -1; sy <= 1; ++sy)
-          for (int sz = -1; sz <= 1; ++sz)
+      const double reach = settings_.switch_end * 0.5 * (beads.radius[c] + beads.radius[j]) + skin_;
+      long lo[3], hi[3];
+      for (int d = 0; d < 3; ++d)
+      {
+        lo[d] = hi[d] = 0;
+        if (box_[d] > 0.0)
+        {
+          const double delta = x[d][j] - x[d][c];
+          lo[d] = static_cast<long>(std::ceil((-reach - delta) / box_[d]));
+          hi[d] = static_cast<long>(std::floor((reach - delta) / box_[d]));
+        }
+      }
+      for (long sx = lo[0]; sx <= hi[0]; ++sx)
+        for (long sy = lo[1]; sy <= hi[1]; ++sy)
+          for (long sz = lo[2]; sz <= hi[2]; ++sz)
           {
-            const int s[3] = {sx, sy, sz};
+            const long s[3] = {sx, sy, sz};
             double shift[3], r[3];
-            bool valid = true;
             for (int d = 0; d < 3; ++d)
             {
-              valid = valid && (s[d] == 0 || box_[d] > 0.0);
-              shift[d] = s[d] * box_[d];
+              shift[d] = static_cast<double>(s[d]) * box_[d];
               r[d] = x[d][j] - x[d][c] + shift[d]; // from the newcomer to j's image
             }
-            const bool zero = s[0] == 0 && s[1] == 0 && s[2] == 0;
+            const bool zero = sx == 0 && sy == 0 && sz == 0;
             const bool positive = sx > 0 || (sx == 0 && (sy > 0 || (sy == 0 && sz > 0)));
-            if (!valid || (j == c && (zero || !positive)))
-              continue;
-            const double reach = settings_.switch_end * 0.5 * (beads.radius[c] + beads.radius[j]) + skin_;
+            if (j == c && (zero || !positive))
+              continue; // (a bead and its own image: once per ± pair)
             if (r[0] * r[0] + r[1] * r[1] + r[2] * r[2] >= reach * reach)
               continue;
             MagneticNeighbourList::Pair p;

@@ -64,10 +64,10 @@ public:
   // The own pair list (cell-multipole far field): rebuilt when stale, like a Verlet list.
   void refresh_list(const BeadArrays &beads);
   // Beads appended (indices first … n−1): their pairs within reach join the list (a
-  // brute-force search over all beads and the nearest periodic images: a handful of
-  // newcomers), their forces start at zero. False, and nothing changed, when the list is not
-  // current or its radius does not cover the newcomers (larger beads, or a radius beyond a
-  // period: images farther than the next one).
+  // brute-force search over all beads and their periodic images: a handful of
+  // newcomers, every image within reach, however many periods the reach spans), their forces
+  // start at zero. False, and nothing changed, when the list is not current or its radius
+  // does not cover the newcomers (larger beads).
   bool can_admit(const BeadArrays &beads, std::size_t first) const;
   bool admit(const BeadArrays &beads, std::size_t first);
   // The list still holds every pair within switch_end (no bead moved half the skin).

@@ -232,26 +232,78 @@ void MagneticNeighbourList::append(std::size_t n, const double *x, const double 
 
 void MagneticNeighbourList::build_pair_incidence(std::size_t n)
 {
-  // Incidence (CSR), in increasing pair order for every bead.
+  // Incidence (CSR), in increasing pair order for every bead: a counting sort of the pair
+  // ends by bead. With several threads each takes a contiguous range of pairs and counts its
+  // ends per bead; a bead's entries are then laid out range after range, each range in pair
+  // order, so the result is the serial one on any number of threads. (Serial, this was ~3 %
+  // of a full-roller run's CPU time, on one thread while the other waited: a rebuild or an
+  // admission renews the incidence of every pair.)
+  const std::size_t np = pairs_.size();
   incident_begin_.assign(n + 1, 0);
-  for (const Pair &p : pairs_)
+  incident_pair_.resize(2 * np);
+  incident_first_.resize(2 * np);
+  constexpr std::size_t parallel_pairs = 65536; // (below it a team costs more than it saves)
+  const int wanted = np >= parallel_pairs ? omp_get_max_threads() : 1;
+  if (wanted == 1)
   {
-    ++incident_begin_[p.i + 1];
-    ++incident_begin_[p.j + 1];
+    for (const Pair &p : pairs_)
+    {
+      ++incident_begin_[p.i + 1];
+      ++incident_begin_[p.j + 1];
+    }
+    for (std::size_t b = 0; b < n; ++b)
+      incident_begin_[b + 1] += incident_begin_[b];
+    std::vector<std::size_t> &fill = fill_;
+    fill.assign(incident_begin_.begin(), incident_begin_.end() - 1);
+    for (std::size_t k = 0; k < np; ++k)
+    {
+      const Pair &p = pairs_[k];
+      incident_pair_[fill[p.i]] = static_cast<std::uint32_t>(k);
+      incident_first_[fill[p.i]++] = 1;
+      incident_pair_[fill[p.j]] = static_cast<std::uint32_t>(k);
+      incident_first_[fill[p.j]++] = 0;
+    }
+    return;
   }
-  for (std::size_t b = 0; b < n; ++b)
-    incident_begin_[b + 1] += incident_begin_[b];
-  incident_pair_.resize(2 * pairs_.size());
-  incident_first_.resize(2 * pairs_.size());
-  std::vector<std::size_t> &fill = fill_;
-  fill.assign(incident_begin_.begin(), incident_begin_.end() - 1);
-  for (std::size_t k = 0; k < pairs_.size(); ++k)
+#pragma omp parallel num_threads(wanted)
   {
-    const Pair &p = pairs_[k];
-    incident_pair_[fill[p.i]] = static_cast<std::uint32_t>(k);
-    incident_first_[fill[p.i]++] = 1;
-    incident_pair_[fill[p.j]] = static_cast<std::uint32_t>(k);
-    incident_first_[fill[p.j]++] = 0;
+    const std::size_t threads = static_cast<std::size_t>(omp_get_num_threads());
+    const std::size_t t = static_cast<std::size_t>(omp_get_thread_num());
+#pragma omp single
+    fill_.assign(threads * n, 0); // (the implicit barrier publishes it)
+    const std::size_t k0 = np * t / threads, k1 = np * (t + 1) / threads;
+    std::size_t *mine = fill_.data() + t * n;
+    for (std::size_t k = k0; k < k1; ++k)
+    {
+      ++mine[pairs_[k].i];
+      ++mine[pairs_[k].j];
+    }
+#pragma omp barrier
+#pragma omp single
+    {
+      // Each range's first slot per bead: after the bead's earlier entries and those of the
+      // ranges before it.
+      std::size_t at = 0;
+      for (std::size_t b = 0; b < n; ++b)
+      {
+        incident_begin_[b] = at;
+        for (std::size_t r = 0; r < threads; ++r)
+        {
+          const std::size_t count = fill_[r * n + b];
+          fill_[r * n + b] = at;
+          at += count;
+        }
+      }
+      incident_begin_[n] = at;
+    }
+    for (std::size_t k = k0; k < k1; ++k)
+    {
+      const Pair &p = pairs_[k];
+      incident_pair_[mine[p.i]] = static_cast<std::uint32_t>(k);
+      incident_first_[mine[p.i]++] = 1;
+      incident_pair_[mine[p.j]] = static_cast<std::uint32_t>(k);
+      incident_first_[mine[p.j]++] = 0;
+    }
   }
 }
 

@@ -178,7 +178,7 @@ private:
   std::vector<std::uint32_t> incident_pair_;
   std::vector<std::uint8_t> incident_first_;
 
-  std::vector<std::size_t> fill_; // build_pair_incidence(): scratch
+  std::vector<std::size_t> fill_; // build_pair_incidence(): scratch (per thread and bead)
   PairBlocks blocks_;             // build(): collect_pairs()' per-block buffers
   void build_incidence(std::size_t n, const double *const coord[3]);
   void build_pair_incidence(std::size_t n);

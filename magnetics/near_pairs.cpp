@@ -80,16 +80,15 @@ void NearPairs::build_rows()
   row_begin_.assign(begin.begin(), begin.end());
   row_other_.resize(begin[n]);
   row_tensor_.resize(6 * begin[n]);
-  // Where each pair sits in the two beads' rows (a self-image pair twice in one row).
+  // Where each pair sits in the two beads' rows (a self-image pair twice in one row, once per
+  // end): every (pair, end) slot is written by exactly one row.
   row_entry_.resize(2 * pairs.size());
-  for (std::size_t b = 0; b < n; ++b)
-    for (std::size_t q = begin[b]; q < begin[b + 1]; ++q)
-      row_entry_[2 * pair_of[q] + (first[q] ? 0 : 1)] = q;
 #pragma omp parallel for schedule(static) if (n >= bead_parallel_threshold)
   for (long b = 0; b < static_cast<long>(n); ++b)
     for (std::size_t q = begin[b]; q < begin[b + 1]; ++q)
     {
       const std::uint32_t k = pair_of[q];
+      row_entry_[2 * k + (first[q] ? 0 : 1)] = q;
       row_other_[q] = first[q] ? pairs[k].j : pairs[k].i;
       store_tensor(tensor_[k], &row_tensor_[6 * q]); // zero for an inactive (coincident) pair
     }

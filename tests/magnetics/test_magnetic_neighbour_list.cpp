@@ -2,6 +2,7 @@
 #include "magnetics/magnetic_neighbour_list.h"
 
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
@@ -93,5 +94,64 @@ TEST(MagneticNeighbourList, MatchesBruteForce)
     EXPECT_EQ(list.max_displacement(n, x.data(), y.data(), z.data()), 0.0);
     z[3] += 1.0;
     EXPECT_NEAR(list.max_displacement(n, x.data(), y.data(), z.data()), 1.0, 1e-12);
+  }
+}
+
+// The incidence of a large list (built by a team when there are ≥ 65,536 pairs) is the serial
+// one on any number of threads, and it is right: each bead's entries name exactly the pairs
+// that touch it, in increasing pair order, with the end (i or j) it is; a self-image pair
+// twice, first as i.
+TEST(MagneticNeighbourList, IncidenceOfALargeListIsTheSameOnAnyThreadCount)
+{
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const std::size_t n = 3000;
+  std::vector<double> x(n), y(n), z(n);
+  for (std::size_t k = 0; k < n; ++k)
+  {
+    x[k] = u(rng);
+    y[k] = 0.4 * u(rng);
+    z[k] = 0.05 * u(rng);
+  }
+  const std::array<double, 3> box = {1.0, 0.0, 0.05}; // (z: a slab narrower than the radius)
+  struct Incidence
+  {
+    std::vector<std::size_t> begin;
+    std::vector<std::uint32_t> pair;
+    std::vector<std::uint8_t> first;
+  };
+  Incidence by_threads[3];
+  const int max_threads = omp_get_max_threads();
+  for (int threads : {1, 2, 3})
+  {
+    omp_set_num_threads(threads);
+    MagneticNeighbourList list;
+    list.build(n, x.data(), y.data(), z.data(), box, 0.12);
+    ASSERT_GE(list.size(), 65536u) << "the list must be large enough for the team";
+    by_threads[threads - 1] = {list.incident_begin(), list.incident_pair(), list.incident_first()};
+    if (threads > 1)
+      continue;
+    // The serial incidence checked directly against the pairs.
+    const auto &pairs = list.pairs();
+    std::vector<std::vector<std::pair<std::uint32_t, std::uint8_t>>> expected(n);
+    for (std::size_t k = 0; k < pairs.size(); ++k)
+    {
+      expected[pairs[k].i].push_back({static_cast<std::uint32_t>(k), 1});
+      expected[pairs[k].j].push_back({static_cast<std::uint32_t>(k), 0});
+    }
+    for (std::size_t b = 0; b < n; ++b)
+    {
+      std::vector<std::pair<std::uint32_t, std::uint8_t>> found;
+      for (std::size_t q = list.incident_begin()[b]; q < list.incident_begin()[b + 1]; ++q)
+        found.push_back({list.incident_pair()[q], list.incident_first()[q]});
+      ASSERT_EQ(found, expected[b]) << "bead " << b;
+    }
+  }
+  omp_set_num_threads(max_threads);
+  for (int t : {1, 2})
+  {
+    EXPECT_EQ(by_threads[t].begin, by_threads[0].begin) << t + 1 << " threads";
+    EXPECT_EQ(by_threads[t].pair, by_threads[0].pair) << t + 1 << " threads";
+    EXPECT_EQ(by_threads[t].first, by_threads[0].first) << t + 1 << " threads";
   }
 }

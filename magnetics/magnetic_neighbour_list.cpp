@@ -233,38 +233,17 @@ void MagneticNeighbourList::append(std::size_t n, const double *x, const double 
 void MagneticNeighbourList::build_pair_incidence(std::size_t n)
 {
   // Incidence (CSR), in increasing pair order for every bead: a counting sort of the pair
-  // ends by bead. With several threads each takes a contiguous range of pairs and counts its
-  // ends per bead; a bead's entries are then laid out range after range, each range in pair
-  // order, so the result is the serial one on any number of threads. (Serial, this was ~3 %
-  // of a full-roller run's CPU time, on one thread while the other waited: a rebuild or an
-  // admission renews the incidence of every pair.)
+  // ends by bead. Each thread of the team (one for a small list) takes a contiguous range of
+  // pairs and counts its ends per bead; a bead's entries are then laid out range after range,
+  // each range in pair order, so the result is the same on any number of threads. (Serial,
+  // this was ~3 % of a full-roller run's CPU time, on one thread while the other waited: a
+  // rebuild or an admission renews the incidence of every pair.)
   const std::size_t np = pairs_.size();
   incident_begin_.assign(n + 1, 0);
   incident_pair_.resize(2 * np);
   incident_first_.resize(2 * np);
   constexpr std::size_t parallel_pairs = 65536; // (below it a team costs more than it saves)
   const int wanted = np >= parallel_pairs ? omp_get_max_threads() : 1;
-  if (wanted == 1)
-  {
-    for (const Pair &p : pairs_)
-    {
-      ++incident_begin_[p.i + 1];
-      ++incident_begin_[p.j + 1];
-    }
-    for (std::size_t b = 0; b < n; ++b)
-      incident_begin_[b + 1] += incident_begin_[b];
-    std::vector<std::size_t> &fill = fill_;
-    fill.assign(incident_begin_.begin(), incident_begin_.end() - 1);
-    for (std::size_t k = 0; k < np; ++k)
-    {
-      const Pair &p = pairs_[k];
-      incident_pair_[fill[p.i]] = static_cast<std::uint32_t>(k);
-      incident_first_[fill[p.i]++] = 1;
-      incident_pair_[fill[p.j]] = static_cast<std::uint32_t>(k);
-      incident_first_[fill[p.j]++] = 0;
-    }
-    return;
-  }
 #pragma omp parallel num_threads(wanted)
   {
     const std::size_t threads = static_cast<std::size_t>(omp_get_num_threads());

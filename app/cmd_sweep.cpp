@@ -13,7 +13,7 @@
 //   (error bars, the physical bound, the measured points) and the profiles side by side.
 //
 // Where the points run: serially (a plain `magbrush sweep`), on the ranks of an MPI job
-// (`mpirun -np K magbrush sweep`, point i on rank i mod K: app/sweep_ranks.h), or as the tasks of
+// (`mpirun -np K magbrush sweep`, the points dealt back and forth over the ranks: app/sweep_ranks.h), or as the tasks of
 // a Slurm job array (`--emit slurm` writes it, app/sweep_slurm.h; each task runs `--point i`).
 // Each point leaves its run time and status in <point>/sweep_point.csv, and the table is built
 // from the point folders by one process (the serial sweep, rank 0 after every rank finished, or
@@ -94,7 +94,9 @@ The options of the stages (named in brackets) go to the stages that declare them
 
 Beyond one process (the points are independent; the table is the same bit for bit but for
 run_time_s):
-  mpirun -np K magbrush sweep ...   point i runs on rank i mod K; rank 0 writes the table, the
+  mpirun -np K magbrush sweep ...   the points are dealt in rounds of K, forwards then backwards
+                       (K = 2: points 0, 3, 4, 7, ... on rank 0), which balances the ranks when
+                       the cost grows along the values; rank 0 writes the table, the
                        profiles and the plots once every rank has finished. Each rank's DEM gets
                        --threads if given, else its share of the node: min(the cores mpirun
                        binds it to, the node's cores / its ranks on the node). OpenMPI binds
@@ -704,10 +706,18 @@ int sweep(const cli::ParsedArguments &args)
   if (ranks.rank() == 0)
     std::cout << "magbrush sweep: " << plan.points.size() << " points into " << plan.sweep_dir.string() << "/\n";
   if (ranks.distributed())
-    std::cout << "magbrush sweep: rank " << ranks.rank() << " of " << ranks.size() << " runs points "
-              << ranks.rank() << ", " << ranks.rank() + ranks.size() << ", ... with "
-              << (args.has("--threads") ? args.value("--threads") : std::to_string(threads)) << " DEM threads"
-              << std::endl;
+  {
+    std::cout << "magbrush sweep: rank " << ranks.rank() << " of " << ranks.size() << " runs points";
+    const char *separator = " ";
+    for (std::size_t n = 0; n < plan.points.size(); ++n)
+      if (ranks.owns(n))
+      {
+        std::cout << separator << n;
+        separator = ", ";
+      }
+    std::cout << " with " << (args.has("--threads") ? args.value("--threads") : std::to_string(threads))
+              << " DEM threads" << std::endl;
+  }
   int failures = 0;
   for (std::size_t n = 0; n < plan.points.size(); ++n)
     if (ranks.owns(n) && run_point(plan, n, args, threads, ranks.rank()) != 0)

@@ -47,6 +47,13 @@ void forget_launcher_variables()
 
 } // namespace
 
+int rank_of_point(std::size_t point, int ranks)
+{
+  const std::size_t k = static_cast<std::size_t>(std::max(ranks, 1));
+  const std::size_t round = point / k, place = point % k;
+  return static_cast<int>(round % 2 == 0 ? place : k - 1 - place);
+}
+
 bool launched_by_mpi()
 {
   for (const char *v : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "PMI_SIZE"})

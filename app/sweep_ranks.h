@@ -1,7 +1,12 @@
 // The points of `magbrush sweep` dealt to the ranks of an MPI job: `mpirun -np K magbrush
-// sweep ...` runs point i on rank i mod K (deterministic: the same point always lands on the
-// same rank, whatever the run times), each rank running its points' pipelines one after the
-// other, then rank 0 alone writes the table once every rank has finished.
+// sweep ...` deals the points in rounds of K, forwards in even rounds and backwards in odd ones
+// (K = 2: points 0, 3, 4, 7, ... on rank 0 and 1, 2, 5, 6, ... on rank 1). The deal is
+// deterministic (the same point always lands on the same rank, whatever the run times); going
+// back and forth balances the ranks when the cost grows along the varied values, which is the
+// rule for a study (a wider blade gap, a deeper slab, a smaller bead: more particles), where
+// dealing i mod K gives the last rank the dearest point of every round. Each rank runs its
+// points' pipelines one after the other, then rank 0 alone writes the table once every rank has
+// finished.
 //
 // MPI is started only when the process was launched by an MPI launcher (mpirun/mpiexec/srun
 // set their variables in the environment); a plain `magbrush sweep` never touches MPI and runs
@@ -20,6 +25,10 @@
 
 namespace magbrush {
 
+// The rank that runs point `point` of a sweep on `ranks` ranks: rounds of `ranks` points, dealt
+// forwards in even rounds and backwards in odd ones.
+int rank_of_point(std::size_t point, int ranks);
+
 class SweepRanks
 {
 public:
@@ -33,8 +42,8 @@ public:
   int rank() const { return rank_; }
   int size() const { return size_; }
 
-  // Point `n` of a sweep runs on rank n mod size.
-  bool owns(std::size_t point) const { return static_cast<int>(point % static_cast<std::size_t>(size_)) == rank_; }
+  // Does this rank run point `point` of the sweep (the deal above)?
+  bool owns(std::size_t point) const { return rank_of_point(point, size_) == rank_; }
 
   // The DEM threads of this rank when the user gave none: its share of the node's cores,
   // min(cores this rank may run on, cores of the node / ranks on the node). The affinity set

@@ -106,7 +106,7 @@ MagneticStats InducedDipoles::compute(const BeadArrays &beads, const AppliedFiel
   if (settings_.hold_dipoles)
   {
     live_.select(beads, near_, settings_.live_pair_radius);
-    live_.rebase_all({beads, beta_, B_local_, p_}, near_, live_correction());
+    live_.rebase_all({beads, beta_, B_local_, p_}, live_correction());
   }
   return stats;
 }
@@ -521,14 +521,14 @@ const std::vector<double> *InducedDipoles::live_pair_changes(const BeadArrays &b
 {
   if (!live_pairs_held(beads))
     return nullptr;
-  return &live_.update({beads, beta_, B_local_, p_}, near_, live_correction());
+  return &live_.update({beads, beta_, B_local_, p_}, live_correction());
 }
 
 const std::vector<double> *InducedDipoles::live_pair_changes_in_team(const BeadArrays &beads)
 {
   if (!live_pairs_held(beads))
     return nullptr;
-  return &live_.update_in_team({beads, beta_, B_local_, p_}, near_, live_correction());
+  return &live_.update_in_team({beads, beta_, B_local_, p_}, live_correction());
 }
 
 void InducedDipoles::add_live_pair_changes(const BeadArrays &beads, const ForceArrays &out)
@@ -802,7 +802,7 @@ void InducedDipoles::solve_region_and_refresh_forces(const BeadArrays &beads, Ma
   const double t_forces = omp_get_wtime();
   reevaluate_local_forces(beads, stats);
   if (settings_.hold_dipoles) // the renewed pairs' forces are the live pairs' new base
-    live_.rebase({beads, beta_, B_local_, p_}, near_, live_correction(), local_.force_pairs());
+    live_.rebase({beads, beta_, B_local_, p_}, live_correction(), local_.force_pairs());
   stats.time_forces = omp_get_wtime() - t_forces;
   stats.local_moved = local_.moved().size();
   stats.local_region = local_.region().size();

@@ -10,6 +10,7 @@ namespace magbrush::magnetics {
 void LivePairs::clear()
 {
   pair_.clear();
+  ends_.clear();
   live_of_.clear();
   base_.clear();
   change_.clear();
@@ -23,6 +24,7 @@ void LivePairs::clear()
 void LivePairs::select(const BeadArrays &beads, const NearPairs &near, double reach_factor)
 {
   pair_.clear();
+  ends_.clear();
   live_of_.clear();
   base_.clear();
   append(beads, near, 0, reach_factor);
@@ -35,7 +37,7 @@ void LivePairs::append(const BeadArrays &beads, const NearPairs &near, std::size
     consider(beads, near, k, reach_factor);
   beads_ = beads.n;
   base_.resize(3 * pair_.size(), 0.0);
-  build_incidence(near);
+  build_incidence();
   change_.resize(3 * pair_.size());
   calls_ = 0;
 }
@@ -56,16 +58,17 @@ void LivePairs::consider(const BeadArrays &beads, const NearPairs &near, std::si
     return;
   live_of_[k] = static_cast<std::int32_t>(pair_.size());
   pair_.push_back(static_cast<std::uint32_t>(k));
+  ends_.push_back(pair);
 }
 
 // The incidence, in ascending live index per bead: a bead's sum runs in a fixed order.
-void LivePairs::build_incidence(const NearPairs &near)
+void LivePairs::build_incidence()
 {
   start_.assign(beads_ + 1, 0);
-  for (std::uint32_t k : pair_)
+  for (const auto &pair : ends_)
   {
-    ++start_[near.pairs()[k].i + 1];
-    ++start_[near.pairs()[k].j + 1];
+    ++start_[pair.i + 1];
+    ++start_[pair.j + 1];
   }
   for (std::size_t b = 0; b < beads_; ++b)
     start_[b + 1] += start_[b];
@@ -73,16 +76,16 @@ void LivePairs::build_incidence(const NearPairs &near)
   std::vector<std::uint32_t> fill(start_.begin(), start_.end() - 1);
   for (std::size_t m = 0; m < pair_.size(); ++m)
   {
-    const auto &pair = near.pairs()[pair_[m]];
+    const auto &pair = ends_[m];
     entry_[fill[pair.j]++] = static_cast<std::int32_t>(m + 1);
     entry_[fill[pair.i]++] = -static_cast<std::int32_t>(m + 1);
   }
 }
 
-void LivePairs::pair_force(const InducedState &s, const NearPairs &near, const TwoSphereCorrection *correction,
-                           std::size_t m, double F[3]) const
+void LivePairs::pair_force(const InducedState &s, const TwoSphereCorrection *correction, std::size_t m,
+                           double F[3]) const
 {
-  const auto &pair = near.pairs()[pair_[m]];
+  const auto &pair = ends_[m];
   const std::uint32_t i = pair.i, j = pair.j;
   const double r[3] = {s.beads.x[j] - s.beads.x[i] + pair.shift[0], s.beads.y[j] - s.beads.y[i] + pair.shift[1],
                        s.beads.z[j] - s.beads.z[i] + pair.shift[2]};
@@ -91,16 +94,16 @@ void LivePairs::pair_force(const InducedState &s, const NearPairs &near, const T
     correction->add(s, i, j, r, DipoleTensor::at(r), F);
 }
 
-void LivePairs::rebase_all(const InducedState &s, const NearPairs &near, const TwoSphereCorrection *correction)
+void LivePairs::rebase_all(const InducedState &s, const TwoSphereCorrection *correction)
 {
   const long n = static_cast<long>(pair_.size());
 #pragma omp parallel for schedule(static) if (n >= static_cast<long>(bead_parallel_threshold))
   for (long m = 0; m < n; ++m)
-    pair_force(s, near, correction, static_cast<std::size_t>(m), &base_[3 * m]);
+    pair_force(s, correction, static_cast<std::size_t>(m), &base_[3 * m]);
   calls_ = 0;
 }
 
-void LivePairs::rebase(const InducedState &s, const NearPairs &near, const TwoSphereCorrection *correction,
+void LivePairs::rebase(const InducedState &s, const TwoSphereCorrection *correction,
                        const std::vector<std::uint32_t> &near_pairs)
 {
   const long n = static_cast<long>(near_pairs.size());
@@ -111,13 +114,12 @@ void LivePairs::rebase(const InducedState &s, const NearPairs &near, const TwoSp
     if (k >= live_of_.size() || live_of_[k] < 0)
       continue;
     const auto m = static_cast<std::size_t>(live_of_[k]);
-    pair_force(s, near, correction, m, &base_[3 * m]);
+    pair_force(s, correction, m, &base_[3 * m]);
   }
   calls_ = 0;
 }
 
-const std::vector<double> &LivePairs::update(const InducedState &s, const NearPairs &near,
-                                             const TwoSphereCorrection *correction)
+const std::vector<double> &LivePairs::update(const InducedState &s, const TwoSphereCorrection *correction)
 {
   // The changes are evaluated every `every_` calls (and at the first call after a rebase) and
   // held in between: in one step a pair moves ~10⁻⁴ of a radius, far below the staleness
@@ -125,17 +127,16 @@ const std::vector<double> &LivePairs::update(const InducedState &s, const NearPa
   if (due())
   {
 #pragma omp parallel if (pair_.size() >= bead_parallel_threshold)
-    evaluate_changes(s, near, correction);
+    evaluate_changes(s, correction);
   }
   ++calls_;
   return bead_change_;
 }
 
-const std::vector<double> &LivePairs::update_in_team(const InducedState &s, const NearPairs &near,
-                                                     const TwoSphereCorrection *correction)
+const std::vector<double> &LivePairs::update_in_team(const InducedState &s, const TwoSphereCorrection *correction)
 {
   if (due())
-    evaluate_changes(s, near, correction);
+    evaluate_changes(s, correction);
   // (Every thread has read the count, in due(), before it advances.)
 #pragma omp barrier
 #pragma omp single nowait
@@ -143,7 +144,7 @@ const std::vector<double> &LivePairs::update_in_team(const InducedState &s, cons
   return bead_change_;
 }
 
-void LivePairs::evaluate_changes(const InducedState &s, const NearPairs &near, const TwoSphereCorrection *correction)
+void LivePairs::evaluate_changes(const InducedState &s, const TwoSphereCorrection *correction)
 {
   const long n = static_cast<long>(pair_.size());
   const long nb = static_cast<long>(beads_);
@@ -153,7 +154,7 @@ void LivePairs::evaluate_changes(const InducedState &s, const NearPairs &near, c
   for (long m = 0; m < n; ++m)
   {
     double F[3];
-    pair_force(s, near, correction, static_cast<std::size_t>(m), F);
+    pair_force(s, correction, static_cast<std::size_t>(m), F);
     for (int d = 0; d < 3; ++d)
       change_[3 * m + d] = F[d] - base_[3 * m + d];
   }
@@ -199,14 +200,16 @@ void LivePairs::read_state(StateIn &in, std::size_t beads, const NearPairs &near
   if (base_.size() != 3 * pair_.size())
     in.fail("is corrupt (live pairs and their base forces differ in number)");
   live_of_.assign(near_pairs, -1);
+  ends_.clear();
   for (std::size_t m = 0; m < pair_.size(); ++m)
   {
     if (pair_[m] >= near_pairs)
       in.fail("is corrupt (a live pair beyond the near pairs)");
     live_of_[pair_[m]] = static_cast<std::int32_t>(m);
+    ends_.push_back(near.pairs()[pair_[m]]);
   }
   beads_ = beads;
-  build_incidence(near);
+  build_incidence();
   change_.resize(3 * pair_.size());
 }
 

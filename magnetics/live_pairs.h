@@ -45,17 +45,14 @@ public:
   void append(const BeadArrays &beads, const NearPairs &near, std::size_t first_pair, double reach_factor);
   // The base forces at the current positions: of every live pair, or of the live ones among
   // the given near pairs (those whose stored force a local refresh renewed).
-  void rebase_all(const InducedState &s, const NearPairs &near, const TwoSphereCorrection *correction);
-  void rebase(const InducedState &s, const NearPairs &near, const TwoSphereCorrection *correction,
-              const std::vector<std::uint32_t> &near_pairs);
+  void rebase_all(const InducedState &s, const TwoSphereCorrection *correction);
+  void rebase(const InducedState &s, const TwoSphereCorrection *correction, const std::vector<std::uint32_t> &near_pairs);
   // Each bead's Σ ± (F_now − F_base) (3 per bead; forces only), evaluated at every
   // `steps`-th call since the last rebase and held in between (set_steps).
-  const std::vector<double> &update(const InducedState &s, const NearPairs &near,
-                                    const TwoSphereCorrection *correction);
+  const std::vector<double> &update(const InducedState &s, const TwoSphereCorrection *correction);
   // The same, called by EVERY thread of a team (the engine's, between its phases): the
   // passes are shared with `omp for`; the same bits as update().
-  const std::vector<double> &update_in_team(const InducedState &s, const NearPairs &near,
-                                            const TwoSphereCorrection *correction);
+  const std::vector<double> &update_in_team(const InducedState &s, const TwoSphereCorrection *correction);
   // The held state was scaled by the applied-field ratio (p, B ∝ ratio): base forces × ratio².
   void scale(double ratio2);
   void clear();
@@ -71,6 +68,11 @@ public:
 
 private:
   std::vector<std::uint32_t> pair_;     // the near pair of each live pair
+  // … and a copy of its beads and periodic shift, contiguous: the live pairs are a sparse
+  // subset (a few per cent) of the near pairs, and reading them through the near list cost a
+  // cache miss per pair, most of the updates' time (the near list never changes a pair in
+  // place; it is forgotten, and the live pairs cleared, when the beads are re-sorted).
+  std::vector<MagneticNeighbourList::Pair> ends_;
   std::vector<std::int32_t> live_of_;   // per near pair: its live index, or −1
   std::vector<double> base_, change_;   // 3 per live pair: force on j at r_base; F_now − F_base
   std::vector<double> bead_change_;     // 3 per bead: the changes held between evaluations
@@ -84,11 +86,10 @@ private:
   void consider(const BeadArrays &beads, const NearPairs &near, std::size_t k, double reach_factor);
   // The changes at the current positions and each bead's sum: every thread of the current
   // team (or one outside a parallel region) shares the passes.
-  void evaluate_changes(const InducedState &s, const NearPairs &near, const TwoSphereCorrection *correction);
-  void build_incidence(const NearPairs &near);
+  void evaluate_changes(const InducedState &s, const TwoSphereCorrection *correction);
+  void build_incidence();
   // The pair law at the current positions: the force on j of live pair m.
-  void pair_force(const InducedState &s, const NearPairs &near, const TwoSphereCorrection *correction,
-                  std::size_t m, double F[3]) const;
+  void pair_force(const InducedState &s, const TwoSphereCorrection *correction, std::size_t m, double F[3]) const;
 };
 
 } // namespace magbrush::magnetics

@@ -241,6 +241,12 @@ private:
   };
   std::vector<QuietMove> quiet_moved_;
   bool quiet_valid_ = false, quiet_steps_on_ = true;
+  // The size of the team whose threads all reset their sums at that check. The engine's team
+  // changes size between its runs (one thread while the scene is small); a thread whose sum
+  // was not reset then would decide otherwise than the others — a quiet step on one thread, a
+  // check with barriers on the other: the team deadlocked (found in the regulation cell, 2
+  // threads, at 1.3 ms). So the sums count only in a team of that size.
+  int quiet_team_ = 0;
   long quiet_steps_ = 0, steps_in_team_waiting_ = 0;
   // The held forces of a step in the team; `checked`: its positions were gathered and checked
   // (otherwise a quiet step); `gathered`: the positions were gathered at this step. Newcomers

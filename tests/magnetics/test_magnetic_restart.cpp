@@ -272,3 +272,34 @@ TEST(MagneticTeamSteps, HeldStepsInsideTheTeamGiveTheBitsOfTheSerialPath)
   }
   omp_set_num_threads(threads_before);
 }
+
+// The engine runs its team on fewer threads while a scene is small (and a user may change the
+// thread count between runs). The quiet steps' per-thread sums were valid only for the team
+// that reset them: a thread of a larger team later summed from a stale value and checked while
+// the others took a quiet step — the team deadlocked (the regulation cell at 1.3 ms, 2 threads).
+// Here the team alternates between 2 and 1 threads every few steps; the run must finish with
+// the bits of a run on one thread.
+TEST(MagneticTeamSteps, TeamSizeChangingBetweenRunsKeepsTheThreadsInStep)
+{
+  const int threads_before = omp_get_max_threads();
+  const Case c = parse_case_text(
+    brush_case("relative", "cell_multipole", "corrected", 2, ", magnetic_hold: dipoles"), "magnetic_team_size.yaml");
+  auto run = [&](bool alternate) {
+    omp_set_num_threads(1);
+    auto s = make_system(c, true);
+    for (int k = 0; k < 400; ++k)
+    {
+      if (alternate)
+        omp_set_num_threads(k / 7 % 2 == 0 ? 2 : 1);
+      s->step();
+    }
+    return s;
+  };
+  const auto alternating = run(true), one = run(false);
+  const MagneticForceTerm &m = magnetics_of(*alternating);
+  std::printf("alternating 2/1 threads: %ld steps held in the team, %ld quiet\n", m.steps_held_in_team(),
+              m.quiet_steps());
+  EXPECT_GT(m.quiet_steps(), 20);
+  EXPECT_TRUE(bit_identical(state_by_id(*alternating), state_by_id(*one)));
+  omp_set_num_threads(threads_before);
+}

@@ -389,7 +389,10 @@ void InducedDipoles::gather_local_field(std::size_t b, const std::vector<double>
   if (far_)
   {
     double s[3] = {B_far_[3 * b], B_far_[3 * b + 1], B_far_[3 * b + 2]};
-    near_.add_row_field(b, p, s);
+    if (near_.has_rows())
+      near_.add_row_field(b, p, s);
+    else // (beads admitted since the rows were built)
+      near_.add_row_field_through_list(b, p, s);
     B[0] += s[0];
     B[1] += s[1];
     B[2] += s[2];

@@ -53,6 +53,7 @@ void LocalRefresh::grow_region(const BeadArrays &beads, const NearPairs &near, d
 {
   const auto &pairs = near.pairs();
   const auto &begin = near.list().incident_begin();
+  const auto &end = near.list().incident_end();
   const auto &pair_of = near.list().incident_pair();
   const auto &first = near.list().incident_first();
   region_.clear();
@@ -60,7 +61,7 @@ void LocalRefresh::grow_region(const BeadArrays &beads, const NearPairs &near, d
   {
     add_once(in_region, region_, b);
     const double reach = region_radius * beads.radius[b];
-    for (std::size_t q = begin[b]; q < begin[b + 1]; ++q)
+    for (std::size_t q = begin[b]; q < end[b]; ++q)
     {
       const auto &pair = pairs[pair_of[q]];
       const double r[3] = {beads.x[pair.j] - beads.x[pair.i] + pair.shift[0],
@@ -81,11 +82,12 @@ bool LocalRefresh::region_too_large(std::size_t n, double limit) const
 const std::vector<std::uint32_t> &LocalRefresh::select_moved_pairs(const NearPairs &near)
 {
   const auto &begin = near.list().incident_begin();
+  const auto &end = near.list().incident_end();
   const auto &pair_of = near.list().incident_pair();
   pair_mark_.assign(near.pairs().size(), 0);
   moved_pairs_.clear();
   for (const std::uint32_t b : moved_)
-    for (std::size_t q = begin[b]; q < begin[b + 1]; ++q)
+    for (std::size_t q = begin[b]; q < end[b]; ++q)
       if (!pair_mark_[pair_of[q]])
       {
         pair_mark_[pair_of[q]] = 1;
@@ -125,12 +127,13 @@ void LocalRefresh::select_force_pairs(const NearPairs &near, const MagneticNeigh
 {
   const auto &pairs = near.pairs();
   const auto &begin = near.list().incident_begin();
+  const auto &end = near.list().incident_end();
   const auto &pair_of = near.list().incident_pair();
   gathered_.clear();
   force_pairs_.clear();
   correction_pairs_.clear();
   for (const std::uint32_t b : changed_)
-    for (std::size_t q = begin[b]; q < begin[b + 1]; ++q)
+    for (std::size_t q = begin[b]; q < end[b]; ++q)
       if (pair_mark_[pair_of[q]] != 2)
       {
         const std::uint32_t k = pair_of[q];
@@ -143,10 +146,11 @@ void LocalRefresh::select_force_pairs(const NearPairs &near, const MagneticNeigh
     return;
   const auto &cpairs = correction->pairs();
   const auto &cbegin = correction->incident_begin();
+  const auto &cend = correction->incident_end();
   const auto &cpair = correction->incident_pair();
   correction_mark_.assign(cpairs.size(), 0);
   for (const std::uint32_t b : changed_)
-    for (std::size_t q = cbegin[b]; q < cbegin[b + 1]; ++q)
+    for (std::size_t q = cbegin[b]; q < cend[b]; ++q)
       if (!correction_mark_[cpair[q]])
       {
         const std::uint32_t k = cpair[q];

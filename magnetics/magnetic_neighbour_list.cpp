@@ -11,6 +11,15 @@ namespace magbrush::magnetics {
 
 namespace {
 
+// Spare slots kept after a row of `count` incidence entries, for the pairs of beads appended
+// later. A fed scene admits newcomers every few microseconds between two builds, and the
+// beads near the inflow gain partners at each admission; without the spare slots every
+// admission laid out the whole incidence again (and the near pairs' rows with it), O(pairs)
+// for a few dozen new beads: ~16 % of a full-roller run. A quarter of the row plus four
+// keeps all but a few admissions in place (MagneticNeighbourList::relayouts() counts them)
+// for a quarter more memory in the arrays indexed by slot.
+std::size_t spare_slots(std::size_t count) { return 4 + count / 4; }
+
 // The cell grid along one axis. Periodic axes: nc cells of width L/nc ≥ list radius (one
 // cell when the box is narrower than the radius); a bead looks `reach` cells either way,
 // wrapping with an image shift. Open axes: cells of width ≥ list radius over the bounding
@@ -203,6 +212,7 @@ void MagneticNeighbourList::clear()
   x_ref_.clear();
   pairs_.clear();
   incident_begin_.clear();
+  incident_end_.clear();
   incident_pair_.clear();
   incident_first_.clear();
 }
@@ -217,17 +227,67 @@ void MagneticNeighbourList::build_incidence(std::size_t n, const double *const c
   built_ = true;
 }
 
-void MagneticNeighbourList::append(std::size_t n, const double *x, const double *y, const double *z,
+bool MagneticNeighbourList::append(std::size_t n, const double *x, const double *y, const double *z,
                                    const std::vector<Pair> &more)
 {
   const std::size_t first = particle_count();
+  const std::size_t first_pair = pairs_.size();
   pairs_.insert(pairs_.end(), more.begin(), more.end());
-  build_pair_incidence(n);
+  const bool kept = append_incidence(first, n, first_pair);
+  if (!kept)
+  {
+    build_pair_incidence(n);
+    ++relayouts_;
+  }
   const double *coord[3] = {x, y, z};
   x_ref_.resize(3 * n);
   for (std::size_t b = first; b < n; ++b)
     for (int d = 0; d < 3; ++d)
       x_ref_[3 * b + d] = coord[d][b];
+  return kept;
+}
+
+// The pairs from first_pair on into the rows' spare slots (the beads from first_bead on get
+// rows after the last one), in pair order: each row stays in increasing pair order, as
+// build_pair_incidence() would lay it out. Nothing is written unless every new entry fits.
+bool MagneticNeighbourList::append_incidence(std::size_t first_bead, std::size_t n, std::size_t first_pair)
+{
+  if (incident_end_.size() != first_bead || incident_begin_.size() != first_bead + 1)
+    return false;
+  const std::size_t np = pairs_.size();
+  fill_.assign(n, 0); // new entries per bead
+  for (std::size_t k = first_pair; k < np; ++k)
+  {
+    ++fill_[pairs_[k].i];
+    ++fill_[pairs_[k].j];
+  }
+  const auto fits = [&](std::uint32_t b) {
+    return b >= first_bead || incident_end_[b] + fill_[b] <= incident_begin_[b + 1];
+  };
+  for (std::size_t k = first_pair; k < np; ++k)
+    if (!fits(pairs_[k].i) || !fits(pairs_[k].j))
+      return false;
+  std::size_t at = incident_begin_[first_bead];
+  incident_begin_.resize(n + 1);
+  incident_end_.resize(n);
+  for (std::size_t b = first_bead; b < n; ++b)
+  {
+    incident_begin_[b] = incident_end_[b] = at;
+    at += fill_[b] + spare_slots(fill_[b]);
+  }
+  incident_begin_[n] = at;
+  incident_pair_.resize(at);
+  incident_first_.resize(at);
+  for (std::size_t k = first_pair; k < np; ++k)
+  {
+    const std::size_t qi = incident_end_[pairs_[k].i]++; // (i before j: a self-image pair's order)
+    incident_pair_[qi] = static_cast<std::uint32_t>(k);
+    incident_first_[qi] = 1;
+    const std::size_t qj = incident_end_[pairs_[k].j]++;
+    incident_pair_[qj] = static_cast<std::uint32_t>(k);
+    incident_first_[qj] = 0;
+  }
+  return true;
 }
 
 void MagneticNeighbourList::build_pair_incidence(std::size_t n)
@@ -237,11 +297,10 @@ void MagneticNeighbourList::build_pair_incidence(std::size_t n)
   // pairs and counts its ends per bead; a bead's entries are then laid out range after range,
   // each range in pair order, so the result is the same on any number of threads. (Serial,
   // this was ~3 % of a full-roller run's CPU time, on one thread while the other waited: a
-  // rebuild or an admission renews the incidence of every pair.)
+  // rebuild renews the incidence of every pair; an admission only appends, see append().)
   const std::size_t np = pairs_.size();
   incident_begin_.assign(n + 1, 0);
-  incident_pair_.resize(2 * np);
-  incident_first_.resize(2 * np);
+  incident_end_.resize(n);
   constexpr std::size_t parallel_pairs = 65536; // (below it a team costs more than it saves)
   const int wanted = np >= parallel_pairs ? omp_get_max_threads() : 1;
 #pragma omp parallel num_threads(wanted)
@@ -261,7 +320,7 @@ void MagneticNeighbourList::build_pair_incidence(std::size_t n)
 #pragma omp single
     {
       // Each range's first slot per bead: after the bead's earlier entries and those of the
-      // ranges before it.
+      // ranges before it; then the row's spare slots.
       std::size_t at = 0;
       for (std::size_t b = 0; b < n; ++b)
       {
@@ -272,8 +331,12 @@ void MagneticNeighbourList::build_pair_incidence(std::size_t n)
           fill_[r * n + b] = at;
           at += count;
         }
+        incident_end_[b] = at;
+        at += spare_slots(at - incident_begin_[b]);
       }
       incident_begin_[n] = at;
+      incident_pair_.resize(at);
+      incident_first_.resize(at);
     }
     for (std::size_t k = k0; k < k1; ++k)
     {
@@ -313,9 +376,21 @@ void MagneticNeighbourList::write_state(StateOut &out) const
   out.put(box_);
   out.put_array(x_ref_);
   out.put_array(pairs_);
-  out.put_array(incident_begin_);
-  out.put_array(incident_pair_);
-  out.put_array(incident_first_);
+  // The incidence without its spare slots (the layout is the list's own business; the
+  // entries, row by row, are what a restart must have).
+  const std::size_t n = incident_end_.size();
+  std::vector<std::size_t> begin(incident_begin_.empty() ? 0 : n + 1, 0);
+  std::vector<std::uint32_t> pair;
+  std::vector<std::uint8_t> first;
+  for (std::size_t b = 0; b < n; ++b)
+  {
+    pair.insert(pair.end(), incident_pair_.begin() + incident_begin_[b], incident_pair_.begin() + incident_end_[b]);
+    first.insert(first.end(), incident_first_.begin() + incident_begin_[b], incident_first_.begin() + incident_end_[b]);
+    begin[b + 1] = pair.size();
+  }
+  out.put_array(begin);
+  out.put_array(pair);
+  out.put_array(first);
 }
 
 void MagneticNeighbourList::read_state(StateIn &in)
@@ -325,9 +400,33 @@ void MagneticNeighbourList::read_state(StateIn &in)
   box_ = in.get<std::array<double, 3>>();
   in.get_array(x_ref_);
   in.get_array(pairs_);
-  in.get_array(incident_begin_);
-  in.get_array(incident_pair_);
-  in.get_array(incident_first_);
+  std::vector<std::size_t> begin;
+  std::vector<std::uint32_t> pair;
+  std::vector<std::uint8_t> first;
+  in.get_array(begin);
+  in.get_array(pair);
+  in.get_array(first);
+  if (!begin.empty() && (begin.front() != 0 || begin.back() != pair.size() || first.size() != pair.size() ||
+                         !std::is_sorted(begin.begin(), begin.end())))
+    in.fail("is corrupt (magnetic neighbour list incidence)");
+  // Laid out again with every row's spare slots.
+  const std::size_t n = begin.empty() ? 0 : begin.size() - 1;
+  incident_begin_.assign(begin.empty() ? 0 : n + 1, 0);
+  incident_end_.resize(n);
+  incident_pair_.clear();
+  incident_first_.clear();
+  for (std::size_t b = 0; b < n; ++b)
+  {
+    incident_begin_[b] = incident_pair_.size();
+    incident_pair_.insert(incident_pair_.end(), pair.begin() + begin[b], pair.begin() + begin[b + 1]);
+    incident_first_.insert(incident_first_.end(), first.begin() + begin[b], first.begin() + begin[b + 1]);
+    incident_end_[b] = incident_pair_.size();
+    const std::size_t spare = spare_slots(begin[b + 1] - begin[b]);
+    incident_pair_.resize(incident_pair_.size() + spare, 0);
+    incident_first_.resize(incident_first_.size() + spare, 0);
+  }
+  if (n > 0)
+    incident_begin_[n] = incident_pair_.size();
 }
 
 } // namespace magbrush::magnetics

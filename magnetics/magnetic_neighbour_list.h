@@ -67,10 +67,18 @@ public:
                  const std::array<double, 3> &box, double list_radius, std::vector<Pair> &pairs);
 
   // Beads appended (indices particle_count() … n−1, positions x, y, z of all n) with their
-  // pairs `more` (each touching an appended bead): the pairs join at the end, the incidence
-  // is rebuilt, and the appended beads' positions become their reference; the other beads
-  // keep theirs (their displacement still counts from the build).
-  void append(std::size_t n, const double *x, const double *y, const double *z, const std::vector<Pair> &more);
+  // pairs `more` (each touching an appended bead): the pairs join at the end, and the
+  // appended beads' positions become their reference; the other beads keep theirs (their
+  // displacement still counts from the build). The new pairs' incidence entries go into the
+  // spare slots that every row keeps after its entries (see incident_end()), the appended
+  // beads' rows after the last row: no earlier entry moves, and the cost is that of the new
+  // pairs, not of the list, and it returns true. When some row has no room left, the
+  // incidence is laid out afresh (every row with new spare slots) and it returns false.
+  // Either way every row lists its pairs in increasing pair order, as a build would.
+  bool append(std::size_t n, const double *x, const double *y, const double *z, const std::vector<Pair> &more);
+  // Appends that had to lay the incidence out afresh (a row out of spare slots), since the
+  // list was built.
+  long relayouts() const { return relayouts_; }
 
   // Forgets the pairs (the bead indices they refer to changed) but keeps the memory: the
   // next build fills the same buffers. built() is false afterwards.
@@ -156,11 +164,14 @@ public:
   // The positions at build time (x, y, z interleaved), the reference of max_displacement.
   const std::vector<double> &reference_positions() const { return x_ref_; }
 
-  // Incidence of the pairs on the beads (CSR): the pairs touching bead b are
-  //   incident_pair[incident_begin[b] .. incident_begin[b+1]), in increasing pair order,
-  // with incident_first[k] = 1 when b is the pair's i (0 when its j). A self-image pair
-  // appears twice, once as i and once as j.
+  // Incidence of the pairs on the beads (CSR with spare slots): the pairs touching bead b are
+  //   incident_pair[incident_begin[b] .. incident_end[b]), in increasing pair order,
+  // with incident_first[q] = 1 when b is the pair's i (0 when its j). A self-image pair
+  // appears twice, once as i and once as j. The slots from incident_end[b] to
+  // incident_begin[b+1] are spare (room for the pairs of beads appended later; their
+  // contents mean nothing), so arrays indexed by slot are incident_begin[n] long.
   const std::vector<std::size_t> &incident_begin() const { return incident_begin_; }
+  const std::vector<std::size_t> &incident_end() const { return incident_end_; }
   const std::vector<std::uint32_t> &incident_pair() const { return incident_pair_; }
   const std::vector<std::uint8_t> &incident_first() const { return incident_first_; }
 
@@ -174,14 +185,17 @@ private:
   std::array<double, 3> box_{0.0, 0.0, 0.0};
   std::vector<double> x_ref_; // positions at build time (x, y, z interleaved)
   std::vector<Pair> pairs_;
-  std::vector<std::size_t> incident_begin_;
+  std::vector<std::size_t> incident_begin_; // n + 1: row b's first slot, then the total
+  std::vector<std::size_t> incident_end_;   // n: one past row b's last entry
   std::vector<std::uint32_t> incident_pair_;
   std::vector<std::uint8_t> incident_first_;
+  long relayouts_ = 0;
 
-  std::vector<std::size_t> fill_; // build_pair_incidence(): scratch (per thread and bead)
+  std::vector<std::size_t> fill_; // build_pair_incidence(), append(): scratch (per thread and bead)
   PairBlocks blocks_;             // build(): collect_pairs()' per-block buffers
   void build_incidence(std::size_t n, const double *const coord[3]);
   void build_pair_incidence(std::size_t n);
+  bool append_incidence(std::size_t first_bead, std::size_t n, std::size_t first_pair);
 };
 
 } // namespace magbrush::magnetics

@@ -51,15 +51,15 @@ void NearPairs::evaluate_tensor(const BeadArrays &beads, std::size_t k)
 
 void NearPairs::appended(const BeadArrays &beads, std::size_t first_pair)
 {
-  const bool rows = !row_entry_.empty() && row_entry_.size() == 2 * first_pair;
   const std::size_t np = list_.pairs().size();
   tensor_.resize(np);
   r_.resize(3 * np);
   active_.resize(np);
   for (std::size_t k = first_pair; k < np; ++k)
     evaluate_tensor(beads, k);
-  if (rows)
-    build_rows();
+  // The rows are left as they are, out of date (has_rows() is false now): rebuilding them is
+  // O(pairs) for the few dozen beads of an admission (it was ~12 % of a full-roller run). The
+  // sweeps read the partners through the list until the next full evaluation builds them.
 }
 
 void NearPairs::update_rows(std::size_t k)
@@ -73,24 +73,30 @@ void NearPairs::update_rows(std::size_t k)
 void NearPairs::build_rows()
 {
   const auto &begin = list_.incident_begin();
+  const auto &end = list_.incident_end();
   const auto &pair_of = list_.incident_pair();
   const auto &first = list_.incident_first();
   const auto &pairs = list_.pairs();
-  const std::size_t n = begin.size() - 1;
-  row_begin_.assign(begin.begin(), begin.end());
-  row_other_.resize(begin[n]);
-  row_tensor_.resize(6 * begin[n]);
+  const std::size_t n = end.size();
+  // The rows are packed (the list's spare slots left out): a sweep streams through them.
+  row_begin_.resize(n + 1);
+  row_begin_[0] = 0;
+  for (std::size_t b = 0; b < n; ++b)
+    row_begin_[b + 1] = row_begin_[b] + (end[b] - begin[b]);
+  row_other_.resize(row_begin_[n]);
+  row_tensor_.resize(6 * row_begin_[n]);
   // Where each pair sits in the two beads' rows (a self-image pair twice in one row, once per
   // end): every (pair, end) slot is written by exactly one row.
   row_entry_.resize(2 * pairs.size());
 #pragma omp parallel for schedule(static) if (n >= bead_parallel_threshold)
   for (long b = 0; b < static_cast<long>(n); ++b)
-    for (std::size_t q = begin[b]; q < begin[b + 1]; ++q)
+    for (std::size_t q = begin[b]; q < end[b]; ++q)
     {
+      const std::size_t e = row_begin_[b] + (q - begin[b]);
       const std::uint32_t k = pair_of[q];
-      row_entry_[2 * k + (first[q] ? 0 : 1)] = q;
-      row_other_[q] = first[q] ? pairs[k].j : pairs[k].i;
-      store_tensor(tensor_[k], &row_tensor_[6 * q]); // zero for an inactive (coincident) pair
+      row_entry_[2 * k + (first[q] ? 0 : 1)] = e;
+      row_other_[e] = first[q] ? pairs[k].j : pairs[k].i;
+      store_tensor(tensor_[k], &row_tensor_[6 * e]); // zero for an inactive (coincident) pair
     }
 }
 
@@ -113,13 +119,38 @@ void NearPairs::add_row_field(std::size_t b, const std::vector<double> &p, doubl
   s[2] = sz;
 }
 
-void NearPairs::add_list_field(std::size_t b, const std::vector<double> &p, double B[3]) const
+void NearPairs::add_row_field_through_list(std::size_t b, const std::vector<double> &p, double s[3]) const
 {
+  // add_row_field() term for term (every pair, an inactive one's zero tensor included, in
+  // the same order with the same arithmetic), so that a sweep gives the same bits either way.
   const auto &begin = list_.incident_begin();
+  const auto &end = list_.incident_end();
   const auto &pair_of = list_.incident_pair();
   const auto &first = list_.incident_first();
   const auto &pairs = list_.pairs();
-  for (std::size_t q = begin[b]; q < begin[b + 1]; ++q)
+  double sx = s[0], sy = s[1], sz = s[2];
+  for (std::size_t q = begin[b]; q < end[b]; ++q)
+  {
+    const std::uint32_t k = pair_of[q];
+    const double *pk = &p[3 * (first[q] ? pairs[k].j : pairs[k].i)];
+    const DipoleTensor &T = tensor_[k];
+    sx += T.xx * pk[0] + T.xy * pk[1] + T.xz * pk[2];
+    sy += T.xy * pk[0] + T.yy * pk[1] + T.yz * pk[2];
+    sz += T.xz * pk[0] + T.yz * pk[1] + T.zz * pk[2];
+  }
+  s[0] = sx;
+  s[1] = sy;
+  s[2] = sz;
+}
+
+void NearPairs::add_list_field(std::size_t b, const std::vector<double> &p, double B[3]) const
+{
+  const auto &begin = list_.incident_begin();
+  const auto &end = list_.incident_end();
+  const auto &pair_of = list_.incident_pair();
+  const auto &first = list_.incident_first();
+  const auto &pairs = list_.pairs();
+  for (std::size_t q = begin[b]; q < end[b]; ++q)
   {
     const std::uint32_t k = pair_of[q];
     if (!active_[k])
@@ -136,7 +167,7 @@ void NearPairs::write_state(StateOut &out) const
   out.put_array(tensor_);
   out.put_array(r_);
   out.put_array(active_);
-  out.put<std::uint8_t>(!row_entry_.empty() && row_entry_.size() == 2 * list_.pairs().size());
+  out.put<std::uint8_t>(has_rows());
 }
 
 void NearPairs::read_state(StateIn &in)

@@ -40,11 +40,13 @@ public:
   void update_rows(std::size_t k);
 
   // Beads and pairs were appended to the list (MagneticNeighbourList::append): the tensors
-  // of the pairs from `first_pair` on are evaluated, and the rows rebuilt if there were any.
+  // of the pairs from `first_pair` on are evaluated; the rows are out of date from then on.
   void appended(const BeadArrays &beads, std::size_t first_pair);
 
-  // Builds the per-bead rows from the tensors (the sweeps of the cell-multipole path).
+  // Builds the per-bead rows from the tensors (the sweeps of the cell-multipole path), and
+  // whether they are there and current (built for every pair of the list).
   void build_rows();
+  bool has_rows() const { return !row_entry_.empty() && row_entry_.size() == 2 * list_.pairs().size(); }
 
   bool active(std::size_t k) const { return active_[k]; }
   const double *r(std::size_t k) const { return &r_[3 * k]; }
@@ -53,6 +55,9 @@ public:
   // The partners' field at bead b, Σ_k T_bk p_k: through the rows, ADDED to s (which the
   // caller starts from the far field); through the list, ADDED to B.
   void add_row_field(std::size_t b, const std::vector<double> &p, double s[3]) const;
+  // The same sum, bit for bit, read through the list's incidence and the tensors (the rows
+  // out of date: beads admitted since the last full evaluation).
+  void add_row_field_through_list(std::size_t b, const std::vector<double> &p, double s[3]) const;
   void add_list_field(std::size_t b, const std::vector<double> &p, double B[3]) const;
 
   // Forget the pairs (the caller re-sorted its beads: pair indices refer to the old order);
@@ -70,8 +75,9 @@ private:
   std::vector<DipoleTensor> tensor_;
   std::vector<double> r_;
   std::vector<unsigned char> active_;
-  // Rows: the other bead and a copy of the pair tensor (6 per entry), CSR in row_begin_;
-  // row_entry_[2k + side] = the entry of pair k in its i row (side 0) and j row (side 1).
+  // Rows: the other bead and a copy of the pair tensor (6 per entry), CSR in row_begin_ (the
+  // list's incidence packed); row_entry_[2k + side] = the entry of pair k in its i row
+  // (side 0) and j row (side 1).
   std::vector<std::size_t> row_begin_;
   std::vector<std::uint32_t> row_other_;
   std::vector<double> row_tensor_;

@@ -94,11 +94,12 @@ void StalenessTracker::admit(const BeadArrays &beads, std::size_t first, const N
   if (settings_.staleness_mode != StalenessMode::relative || close_of_pair_.size() != first_pair)
     return;
   const auto &begin = near.list().incident_begin();
+  const auto &end = near.list().incident_end();
   const auto &pair_of = near.list().incident_pair();
   // (An inert bead's pairs include those a newcomer just formed with it, k ≥ first_pair,
   // which are not watched yet: watch_pair() below skips them as inert.)
   for (const std::uint32_t b : inert)
-    for (std::size_t q = begin[b]; q < begin[b + 1]; ++q)
+    for (std::size_t q = begin[b]; q < end[b]; ++q)
       if (pair_of[q] < first_pair && close_of_pair_[pair_of[q]] >= 0)
         close_[static_cast<std::size_t>(close_of_pair_[pair_of[q]])].limit2 = std::numeric_limits<double>::infinity();
   close_of_pair_.resize(near.pairs().size(), -1);

@@ -11,9 +11,10 @@ void add_incident_pair_forces(const MagneticNeighbourList &list, const std::vect
                               std::size_t b, double F[3])
 {
   const auto &begin = list.incident_begin();
+  const auto &end = list.incident_end();
   const auto &pair_of = list.incident_pair();
   const auto &first = list.incident_first();
-  for (std::size_t q = begin[b]; q < begin[b + 1]; ++q)
+  for (std::size_t q = begin[b]; q < end[b]; ++q)
   {
     const double *Fp = &pair_force[3 * pair_of[q]];
     const double sign = first[q] ? -1.0 : 1.0;

@@ -347,8 +347,8 @@ bool MagneticForceTerm::add_forces_in_team_if_held(const dem::ParticleState &sta
   // so none is made and the positions are not even gathered. Each thread keeps its own copy
   // of the sum (the same on all); the flag is written outside the team or after a barrier.
   const auto me = static_cast<std::size_t>(omp_get_thread_num());
-  const bool tracked = quiet_valid_ && omp_get_num_threads() == quiet_team_ &&
-                       static_cast<std::size_t>(omp_get_num_threads()) <= quiet_moved_.size();
+  // (quiet_team_ is recorded only by a team that fits quiet_moved_, so this also bounds me.)
+  const bool tracked = quiet_valid_ && omp_get_num_threads() == quiet_team_;
   if (tracked && quiet_steps_on_)
   {
     const double moved = quiet_moved_[me].moved + step_move;

@@ -144,6 +144,14 @@ void CoulombTerm::particles_reordered(const std::vector<std::int32_t> &order)
     i = new_index[i];
 }
 
+void CoulombTerm::particles_changed(const std::vector<std::int32_t> & /*origin*/)
+{
+  // Particles entered or left: the compact order no longer names the charged particles — also
+  // when as many entered as left, so that the count alone would not tell — so they are
+  // selected again and the cells rebuilt.
+  must_select_ = true;
+}
+
 void CoulombTerm::write_state(dem::CheckpointWriter &out) const
 {
   out.put<std::uint64_t>(state_size_);

@@ -49,6 +49,7 @@ public:
   const char *name() const override { return "Coulomb"; }
   void add_forces(const dem::ParticleState &state, dem::ForceBuffers &forces, double t) override;
   void particles_reordered(const std::vector<std::int32_t> &order) override;
+  void particles_changed(const std::vector<std::int32_t> &origin) override;
   void write_state(dem::CheckpointWriter &out) const override;
   void read_state(dem::CheckpointReader &in) override;
 

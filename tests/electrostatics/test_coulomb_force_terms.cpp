@@ -272,3 +272,33 @@ TEST(PairImages, UniformSheetOnPhotoconductorDropsThePotentialBySigmaLOverEps)
     }
   }
 }
+
+TEST(CoulombTerm, AnExchangeOfAsManyParticlesAsLeftSelectsTheChargesAgain)
+{
+  // Before: +q, −q and an uncharged particle. The −q particle leaves and a +q one enters in the
+  // same exchange: the count stays 3, the charged set changes. The term must then act on the
+  // new pair of charges, as a fresh term does (it used to keep reading the old indices: the
+  // newcomer felt nothing).
+  const std::array<double, 3> box = {0.0, 0.0, 1e-3};
+  dem::ParticleState before;
+  before.add({0.2e-3, 0.2e-3, 0.5e-3}, 4e-6, 1000.0, 0, 2e-15);
+  before.add({0.3e-3, 0.2e-3, 0.5e-3}, 4e-6, 1000.0, 0, -2e-15);
+  before.add({0.6e-3, 0.3e-3, 0.5e-3}, 25e-6, 1000.0, 1, 0.0);
+  dem::ParticleState after;
+  after.add({0.2e-3, 0.2e-3, 0.5e-3}, 4e-6, 1000.0, 0, 2e-15);
+  after.add({0.6e-3, 0.3e-3, 0.5e-3}, 25e-6, 1000.0, 1, 0.0);
+  after.add({0.25e-3, 0.25e-3, 0.5e-3}, 4e-6, 1000.0, 0, 2e-15);
+  CoulombTerm term(settings(4, 25e-6, 1.0), box);
+  forces_of(term, before, 0.0);
+  term.particles_changed({0, 2, -1});
+  const auto f = forces_of(term, after, 1e-9);
+  CoulombTerm fresh(settings(4, 25e-6, 1.0), box);
+  const auto g = forces_of(fresh, after, 1e-9);
+  ASSERT_GT(std::abs(g.fx[2]), 0.0);
+  for (std::size_t i = 0; i < 3; ++i)
+  {
+    EXPECT_EQ(f.fx[i], g.fx[i]) << i;
+    EXPECT_EQ(f.fy[i], g.fy[i]) << i;
+    EXPECT_EQ(f.fz[i], g.fz[i]) << i;
+  }
+}

@@ -155,7 +155,9 @@ void CoulombTerm::particles_changed(const std::vector<std::int32_t> & /*origin*/
 void CoulombTerm::write_state(dem::CheckpointWriter &out) const
 {
   out.put<std::uint64_t>(state_size_);
-  out.put<std::uint8_t>(must_select_ || must_rebuild_ ? 1 : 0);
+  // 0: the held far field is current; 1: rebuild it at the next step; 2: select the charged
+  // particles again first (an exchange happened since the last step).
+  out.put<std::uint8_t>(must_select_ ? 2 : must_rebuild_ ? 1 : 0);
   out.put_array(index_);
   for (const auto *v : {&q_, &radius_, &x_, &y_, &z_, &bx_, &by_, &bz_})
     out.put_array(*v);
@@ -168,7 +170,8 @@ void CoulombTerm::write_state(dem::CheckpointWriter &out) const
 void CoulombTerm::read_state(dem::CheckpointReader &in)
 {
   state_size_ = static_cast<std::size_t>(in.get<std::uint64_t>());
-  const bool stale = in.get<std::uint8_t>() != 0;
+  const std::uint8_t pending = in.get<std::uint8_t>();
+  const bool stale = pending != 0;
   in.get_array(index_);
   for (auto *v : {&q_, &radius_, &x_, &y_, &z_, &bx_, &by_, &bz_})
     in.get_array(*v);
@@ -178,7 +181,7 @@ void CoulombTerm::read_state(dem::CheckpointReader &in)
   in.get_array(far_E);
   in.get_array(far_phi);
   E_.assign(3 * index_.size(), 0.0);
-  must_select_ = false;
+  must_select_ = pending == 2;
   must_rebuild_ = stale;
   if (!stale && !index_.empty())
   {

@@ -6,7 +6,8 @@
 // population is charged, unless `electric.coulomb: false`.
 //
 // The charged particles are gathered into a compact order of the term's own (fixed when they
-// are selected; the engine's re-sorting only changes which engine index each reads), with
+// are selected; the engine's re-sorting only changes which engine index each reads; particles
+// entering or leaving make it select them again at the next step), with
 // positions unwrapped along periodic axes. Per step, F_i = q_i E_i with E = the held far field
 // + the exact near pairs at the current positions. The far field is evaluated again (and the
 // cells rebuilt) when `electric.coulomb_refresh` has elapsed, when some charge moved a quarter

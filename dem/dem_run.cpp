@@ -42,7 +42,7 @@ std::string DemRun::checkpoint_path() const { return (fs::path(out_dir_) / "chec
 
 // The checkpoint must be the state of this case: only run control may differ, unless the user
 // said --restart-anyway (restart_check.h). The file's checksum is verified on the way.
-void DemRun::check_restart_case() const
+std::string DemRun::check_restart_case() const
 {
   const CheckpointIdentity written = CheckpointReader(options_.restart_file).identity();
   const std::vector<CaseDifference> differences = case_differences(written, identity_);
@@ -54,8 +54,13 @@ void DemRun::check_restart_case() const
   if (!added.empty())
     log_ << "restart: keys newer than the checkpoint, at their defaults (what the program that wrote it did):\n"
          << describe(added);
+  // The measurements continue the checkpoint's only when they measure as they did.
+  std::string afresh;
+  for (const CaseDifference &d : control)
+    if (is_measurement_key(d.key))
+      afresh = d.key + " changed";
   if (scene.empty())
-    return;
+    return afresh;
   if (!options_.restart_anyway)
     throw std::runtime_error("checkpoint '" + options_.restart_file + "' was written by case hash " + written.case_hash +
                              ", this case has " + identity_.case_hash + "; they differ in " +
@@ -64,6 +69,63 @@ void DemRun::check_restart_case() const
                              "restart with the case that wrote it, or pass --restart-anyway to continue its "
                              "state under this case (the run is then not a continuation of the one that wrote it)");
   log_ << "restart anyway (--restart-anyway): the checkpoint's case differs in\n" << describe(scene);
+  return "the scene changed (--restart-anyway)";
+}
+
+// After the engine's state, in the same checksummed file:
+//   "measurements", their count, then per measurement its name and its state as one block
+// (a block is read through its own stream, so that a measurement that reads more or less
+// than it wrote is caught at its own door rather than misreading the next one).
+void DemRun::write_measurement_states(StateOut &out) const
+{
+  out.put_string("measurements");
+  out.put<std::uint64_t>(measurements_.size());
+  for (const auto &m : measurements_)
+  {
+    MemoryStateOut block;
+    m->write_state(block);
+    out.put_string(m->name());
+    out.put_string(block.bytes());
+  }
+}
+
+void DemRun::read_measurement_states(StateIn &in, const std::string &afresh_because)
+{
+  auto afresh = [this](const std::string &why) {
+    if (!measurements_.empty())
+      log_ << "restart: the measurements start afresh at the restart (" << why
+           << "): their files cover the continuation only\n";
+  };
+  if (in.remaining() == 0)
+    return afresh("the checkpoint holds none: written by a magbrush that kept them out of checkpoints");
+  if (in.get_string() != "measurements")
+    in.fail("is corrupt (what follows the engine's state is not the measurements)");
+  const auto n = in.get<std::uint64_t>();
+  std::vector<std::pair<std::string, std::string>> blocks;
+  for (std::uint64_t k = 0; k < n && in.remaining() > 0; ++k)
+  {
+    std::string name = in.get_string();
+    blocks.emplace_back(std::move(name), in.get_string());
+  }
+  if (blocks.size() != n)
+    in.fail("is corrupt (fewer measurements than it says it holds)");
+  if (!afresh_because.empty())
+    return afresh(afresh_because);
+  bool same = blocks.size() == measurements_.size();
+  for (std::size_t k = 0; same && k < blocks.size(); ++k)
+    same = blocks[k].first == measurements_[k]->name();
+  if (!same)
+    return afresh("the checkpoint holds other measurements than this run makes");
+  for (std::size_t k = 0; k < blocks.size(); ++k)
+  {
+    MemoryStateIn block(std::move(blocks[k].second),
+                        "checkpoint '" + options_.restart_file + "', measurement '" + blocks[k].first + "',");
+    measurements_[k]->read_state(block);
+    if (block.remaining() != 0)
+      block.fail("holds more than the measurement reads: restart with the magbrush that wrote it");
+  }
+  if (!measurements_.empty())
+    log_ << "restart: the measurements continue from the checkpoint (their files cover the whole run)\n";
 }
 
 // Atomically, keeping the one before it.
@@ -74,7 +136,7 @@ void DemRun::write_checkpoint()
   last_checkpoint_step_ = system_->step_count();
   const std::string path = checkpoint_path();
   keep_previous_checkpoint(path);
-  system_->write_checkpoint(path, identity_);
+  system_->write_checkpoint(path, identity_, [this](StateOut &out) { write_measurement_states(out); });
   ++checkpoints_;
   char line[256];
   std::snprintf(line, sizeof line, "checkpoint at t = %.6g s (step %ld): %s\n", system_->time(),
@@ -213,8 +275,9 @@ void DemRun::run()
   const bool restart = !options_.restart_file.empty();
   if (restart)
   {
-    check_restart_case();
-    s.read_checkpoint(options_.restart_file);
+    const std::string measurements_afresh = check_restart_case();
+    s.read_checkpoint(options_.restart_file,
+                      [&](StateIn &in) { read_measurement_states(in, measurements_afresh); });
     log_ << "restarted from '" << options_.restart_file << "' at step " << s.step_count() << ", t = " << s.time()
          << " s\n";
   }

@@ -9,8 +9,9 @@
 //
 // Checkpoints are written every dem.checkpoint_interval of simulated time, every
 // dem.checkpoint_wall_interval of wall time and at the end; each replaces checkpoint.bin
-// atomically and the one before it is kept as checkpoint.previous.bin. A restart checks that
-// the checkpoint was written by this case (restart_check.h).
+// atomically and the one before it is kept as checkpoint.previous.bin. A checkpoint holds the
+// measurements' accumulated state too, so a restarted run writes the files of the whole run.
+// A restart checks that the checkpoint was written by this case (restart_check.h).
 #pragma once
 
 #include "dem/checkpoint_file.h"
@@ -73,7 +74,11 @@ private:
   long checkpoints_ = 0;
   long last_checkpoint_step_ = -1;
 
-  void check_restart_case() const;
+  // Refuses a checkpoint of another scene (unless --restart-anyway); returns why the
+  // measurements must start afresh ("" = they continue the checkpoint's).
+  std::string check_restart_case() const;
+  void write_measurement_states(StateOut &out) const;
+  void read_measurement_states(StateIn &in, const std::string &afresh_because);
   void write_checkpoint();
   void log_setup() const;
   void log_timings(double wall) const;

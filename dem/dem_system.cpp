@@ -765,7 +765,8 @@ auto checkpoint_arrays(State &s, Forces &f)
 
 void DemSystem::write_checkpoint(const std::string &path) { write_checkpoint(path, CheckpointIdentity{}); }
 
-void DemSystem::write_checkpoint(const std::string &path, const CheckpointIdentity &identity)
+void DemSystem::write_checkpoint(const std::string &path, const CheckpointIdentity &identity,
+                                 const std::function<void(StateOut &)> &appendix)
 {
   CheckpointWriter out(path, identity);
   out.put(step_);
@@ -810,10 +811,12 @@ void DemSystem::write_checkpoint(const std::string &path, const CheckpointIdenti
   out.put_array(std::vector<char>(exchange.begin(), exchange.end()));
   if (exchange_)
     exchange_->write_state(out);
+  if (appendix)
+    appendix(out);
   out.commit();
 }
 
-void DemSystem::read_checkpoint(const std::string &path)
+void DemSystem::read_checkpoint(const std::string &path, const std::function<void(StateIn &)> &appendix)
 {
   CheckpointReader in(path);
   const long step = in.get<long>();
@@ -893,6 +896,8 @@ void DemSystem::read_checkpoint(const std::string &path)
             "' where this run has '" + exchange + "': restart with the case that wrote it");
   if (exchange_)
     exchange_->read_state(in);
+  if (appendix)
+    appendix(in);
   forces_ = saved_forces;
   contact_count_ = saved_counts;
   step_ = step;

@@ -31,6 +31,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -130,10 +131,14 @@ public:
   // Checkpoint: the complete dynamic state (particles in their current order, forces,
   // neighbour list with contact history, wall slots, clock, each force term's own state),
   // with the identity of the case that wrote it (checkpoint_file.h). Written atomically.
+  // `appendix` writes what the caller keeps beside the engine (a run's measurements) after the
+  // engine's state, inside the same checksummed file; read_checkpoint hands its `appendix` the
+  // stream positioned there (nothing left to read in a file written without one).
   void write_checkpoint(const std::string &path);
-  void write_checkpoint(const std::string &path, const CheckpointIdentity &identity);
+  void write_checkpoint(const std::string &path, const CheckpointIdentity &identity,
+                        const std::function<void(StateOut &)> &appendix = {});
   // Replaces the state by the checkpoint's; the case must be the same scene.
-  void read_checkpoint(const std::string &path);
+  void read_checkpoint(const std::string &path, const std::function<void(StateIn &)> &appendix = {});
 
   // Maximum number of walls one particle may touch at once.
   static constexpr int max_wall_contacts = WallContactSlots::per_particle;

@@ -4,9 +4,16 @@
 // accumulates what it needs, and writes its files (CSV, atomically) at the end of the run.
 //
 // Measurements only read the engine state; they never change the dynamics, so a run gives
-// the same particles with or without them. They are not part of checkpoints: after a restart
-// they start accumulating afresh from the restart time (say so in their output).
+// the same particles with or without them. What they have gathered is part of every
+// checkpoint (write_state / read_state, framed by the run: dem/dem_run.cpp), so that a run
+// restarted from one writes the files of the whole run, the same bytes as had it never
+// stopped, and a run killed between checkpoints loses only what came after the last one.
+// A restart that changes what is measured or how (a key of the nip, dma, development,
+// flow_report, statistics or compression sections) starts them afresh at the restart time,
+// as their files say (the first sample's time).
 #pragma once
+
+#include "common/state_stream.h"
 
 #include <limits>
 #include <string>
@@ -56,6 +63,12 @@ public:
   // the physical bounds they are to be judged against (a key ending in "_bound" bounds the key
   // before it, e.g. tma_kg_per_m2 and tma_kg_per_m2_bound).
   virtual std::vector<SummaryValue> summary() const { return {}; }
+  // Everything sample() has accumulated (series, sums, the previous sample a difference is
+  // taken against), written so that read_state() into a measurement built from the same case
+  // continues as if it had sampled all along. Settings and what the constructor derives from
+  // the case are not written.
+  virtual void write_state(StateOut &out) const = 0;
+  virtual void read_state(StateIn &in) = 0;
 };
 
 } // namespace magbrush::dem

@@ -15,13 +15,19 @@ bool is_run_control_key(const std::string &key)
   for (const char *k : exact)
     if (key == k)
       return true;
-  // Where to write, and whole sections that only say what to measure and how to judge it: the
-  // measurements are not in a checkpoint (a restart starts them afresh) and sampling them does
-  // not change the particles' bits, so a continued run may average over a new window
-  // (--set dma.average_from=30ms) without --restart-anyway.
-  static const char *const run_control_sections[] = {"output.",      "nip.",        "dma.",
-                                                     "development.", "flow_report.", "statistics."};
-  for (const char *prefix : run_control_sections)
+  // Where to write, and whole sections that only say what to measure and how to judge it:
+  // sampling does not change the particles' bits, so a continued run may average over a new
+  // window (--set dma.average_from=30ms) without --restart-anyway; its measurements then start
+  // afresh at the restart (is_measurement_key).
+  return key.rfind("output.", 0) == 0 || is_measurement_key(key);
+}
+
+bool is_measurement_key(const std::string &key)
+{
+  if (key == "compression.sample_interval" || key == "compression.map_interval")
+    return true;
+  static const char *const sections[] = {"nip.", "dma.", "development.", "flow_report.", "statistics."};
+  for (const char *prefix : sections)
     if (key.rfind(prefix, 0) == 0)
       return true;
   return false;

@@ -31,6 +31,10 @@ struct CaseDifference
 // the output directory and formats, and every key of the measurement-only sections (nip.*,
 // dma.*, development.*, flow_report.*, statistics.*: windows, sampling, averaging).
 bool is_run_control_key(const std::string &key);
+// Keys that say what a measurement samples and how it judges it (the measurement-only sections
+// and compression.sample_interval / map_interval): a restart that changes one starts the
+// measurements afresh rather than continuing the checkpoint's (dem/measurement.h).
+bool is_measurement_key(const std::string &key);
 
 // The keys whose values differ between the checkpoint's case and this one, in the order of
 // the checkpoint's keys (then those only this case has, flagged when at their defaults).

@@ -149,4 +149,30 @@ const bool registered = register_measurement({"chain inclination", [](const Case
                                               }});
 } // namespace
 
+
+// The fabric sums per bin (Measurement::write_state).
+void ChainInclination::write_state(StateOut &out) const
+{
+  for (const auto *a : {&ftt_, &fnn_, &ftn_, &count_})
+    out.put_array(*a);
+  out.put(samples_);
+  out.put(t_first_);
+  out.put(t_last_);
+}
+
+void ChainInclination::read_state(StateIn &in)
+{
+  const std::size_t bins = ftt_.size();
+  for (auto *a : {&ftt_, &fnn_, &ftn_, &count_})
+  {
+    in.get_array(*a);
+    if (a->size() != bins)
+      in.fail("holds a chain profile of " + std::to_string(a->size()) + " bins, this case's has " +
+              std::to_string(bins));
+  }
+  samples_ = in.get<long>();
+  t_first_ = in.get<double>();
+  t_last_ = in.get<double>();
+}
+
 } // namespace magbrush::dem

@@ -46,6 +46,8 @@ public:
   double interval() const override { return settings_.sample_interval; }
   void sample(const DemSystem &system) override;
   void write(const std::string &directory) const override;
+  void write_state(StateOut &out) const override;
+  void read_state(StateIn &in) override;
 
   long samples() const { return samples_; }
   std::vector<ChainBin> bins() const;

@@ -211,4 +211,24 @@ const bool registered =
                         }});
 } // namespace
 
+
+// The line the flux is counted through, the rows and the series (Measurement::write_state).
+void DeveloperMassPerArea::write_state(StateOut &out) const
+{
+  centre_line_.write_state(out);
+  out.put(previous_time_);
+  out.put_array(rows_);
+  for (const auto *s : {&dma_, &dma_flux_, &concentration_, &blade_radial_, &blade_along_, &held_})
+    s->write_state(out);
+}
+
+void DeveloperMassPerArea::read_state(StateIn &in)
+{
+  centre_line_.read_state(in);
+  previous_time_ = in.get<double>();
+  in.get_array(rows_);
+  for (auto *s : {&dma_, &dma_flux_, &concentration_, &blade_radial_, &blade_along_, &held_})
+    s->read_state(in);
+}
+
 } // namespace magbrush::dem

@@ -105,4 +105,26 @@ const bool registered =
                         }});
 } // namespace
 
+
+// The two lines' previous samples, the rows and the series (Measurement::write_state).
+void DeveloperRelease::write_state(StateOut &out) const
+{
+  before_line_.write_state(out);
+  after_line_.write_state(out);
+  out.put(previous_time_);
+  out.put_array(rows_);
+  arriving_.write_state(out);
+  carried_back_.write_state(out);
+}
+
+void DeveloperRelease::read_state(StateIn &in)
+{
+  before_line_.read_state(in);
+  after_line_.read_state(in);
+  previous_time_ = in.get<double>();
+  in.get_array(rows_);
+  arriving_.read_state(in);
+  carried_back_.read_state(in);
+}
+
 } // namespace magbrush::dem

@@ -134,4 +134,26 @@ const bool registered = register_measurement({"flow report", [](const Case &c) -
                                               }});
 } // namespace
 
+
+// The flux line's previous sample, the rows and the averaging window (Measurement::write_state).
+void FlowReport::write_state(StateOut &out) const
+{
+  flux_.write_state(out);
+  out.put_array(rows_);
+  supplied_flux_.write_state(out);
+  supplied_areal_.write_state(out);
+  out.put(window_first_row_);
+}
+
+void FlowReport::read_state(StateIn &in)
+{
+  flux_.read_state(in);
+  in.get_array(rows_);
+  supplied_flux_.read_state(in);
+  supplied_areal_.read_state(in);
+  window_first_row_ = in.get<long>();
+  if (window_first_row_ >= static_cast<long>(rows_.size()))
+    in.fail("is corrupt (the flow report's window starts after its last row)");
+}
+
 } // namespace magbrush::dem

@@ -52,4 +52,36 @@ LineFluxSample LineFlux::sample(double time, const ParticleState &s)
   return out;
 }
 
+// Written as three arrays rather than the structs, so that no padding byte reaches the file.
+void LineFlux::write_state(StateOut &out) const
+{
+  out.put<std::uint8_t>(first_);
+  std::vector<std::int32_t> ids;
+  std::vector<double> angles, masses;
+  for (const Seen &s : before_)
+  {
+    ids.push_back(s.id);
+    angles.push_back(s.angle);
+    masses.push_back(s.mass);
+  }
+  out.put_array(ids);
+  out.put_array(angles);
+  out.put_array(masses);
+}
+
+void LineFlux::read_state(StateIn &in)
+{
+  first_ = in.get<std::uint8_t>() != 0;
+  std::vector<std::int32_t> ids;
+  std::vector<double> angles, masses;
+  in.get_array(ids);
+  in.get_array(angles);
+  in.get_array(masses);
+  if (angles.size() != ids.size() || masses.size() != ids.size())
+    in.fail("is corrupt (a line flux's previous sample has arrays of different lengths)");
+  before_.clear();
+  for (std::size_t k = 0; k < ids.size(); ++k)
+    before_.push_back({ids[k], angles[k], masses[k]});
+}
+
 } // namespace magbrush::dem

@@ -14,6 +14,8 @@
 
 #include "dem/particle_state.h"
 
+#include "common/state_stream.h"
+
 #include <cstdint>
 #include <limits>
 #include <vector>
@@ -40,6 +42,10 @@ public:
 
   // Counts the crossings since the previous call and the areal mass now.
   LineFluxSample sample(double time, const ParticleState &state);
+
+  // The previous sample the next crossings are counted against (checkpoints).
+  void write_state(StateOut &out) const;
+  void read_state(StateIn &in);
 
 private:
   double angle_, sense_, window_, R_, Lz_;

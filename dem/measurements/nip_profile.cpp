@@ -400,4 +400,40 @@ const bool registered = register_measurement({"nip profile", [](const Case &c) -
                                               }});
 } // namespace
 
+
+// The profile's sums and the per-sample series (Measurement::write_state).
+void NipProfile::write_state(StateOut &out) const
+{
+  for (const auto *a : {&fn_, &ft_, &slip_, &slip2_, &chain_})
+    out.put_array(*a);
+  out.put_array(count_);
+  out.put(fn_sliding_);
+  out.put(fn_sliding_downstream_);
+  out.put(samples_);
+  out.put(t_first_);
+  out.put(t_last_);
+  for (const auto *s : {&normal_force_, &tangential_force_, &touching_, &centre_slip_, &centre_chain_})
+    s->write_state(out);
+}
+
+void NipProfile::read_state(StateIn &in)
+{
+  const std::size_t bins = fn_.size();
+  for (auto *a : {&fn_, &ft_, &slip_, &slip2_, &chain_})
+    in.get_array(*a);
+  in.get_array(count_);
+  for (const auto *a : {&fn_, &ft_, &slip_, &slip2_, &chain_})
+    if (a->size() != bins)
+      in.fail("holds a nip profile of " + std::to_string(a->size()) + " bins, this case's has " + std::to_string(bins));
+  if (count_.size() != bins)
+    in.fail("holds a nip profile of " + std::to_string(count_.size()) + " bins, this case's has " + std::to_string(bins));
+  fn_sliding_ = in.get<double>();
+  fn_sliding_downstream_ = in.get<double>();
+  samples_ = in.get<long>();
+  t_first_ = in.get<double>();
+  t_last_ = in.get<double>();
+  for (auto *s : {&normal_force_, &tangential_force_, &touching_, &centre_slip_, &centre_chain_})
+    s->read_state(in);
+}
+
 } // namespace magbrush::dem

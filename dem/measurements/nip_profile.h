@@ -90,6 +90,8 @@ public:
   double interval() const override { return settings_.sample_interval; }
   void sample(const DemSystem &system) override;
   void write(const std::string &directory) const override;
+  void write_state(StateOut &out) const override;
+  void read_state(StateIn &in) override;
 
   // The same accumulation from hand-made contacts (what sample() extracts from the engine).
   void add_sample(double time, const std::vector<DrumContact> &contacts);

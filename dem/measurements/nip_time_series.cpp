@@ -169,4 +169,23 @@ const bool registered = register_measurement({"nip time series", [](const Case &
                                               }});
 } // namespace
 
+
+// Each bead's region at the last sample (the next crossings are counted against it), the net
+// counts and the rows (Measurement::write_state).
+void NipTimeSeries::write_state(StateOut &out) const
+{
+  out.put_array(region_);
+  out.put(entered_);
+  out.put(left_);
+  out.put_array(rows_);
+}
+
+void NipTimeSeries::read_state(StateIn &in)
+{
+  in.get_array(region_);
+  entered_ = in.get<long>();
+  left_ = in.get<long>();
+  in.get_array(rows_);
+}
+
 } // namespace magbrush::dem

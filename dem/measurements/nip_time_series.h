@@ -50,6 +50,8 @@ public:
   double interval() const override { return settings_.sample_interval; }
   void sample(const DemSystem &system) override;
   void write(const std::string &directory) const override;
+  void write_state(StateOut &out) const override;
+  void read_state(StateIn &in) override;
   std::vector<SummaryValue> summary() const override;
 
   // The bead budget from plain arrays (tests): ids, positions, radii at one time.

@@ -266,4 +266,103 @@ void PlateCompression::write(const std::string &directory) const
   write_file_atomically((fs::path(directory) / "contact_maps.csv").string(), index);
 }
 
+
+// The open window's sums, the closed windows, the contact maps and when the next is due
+// (Measurement::write_state). A map's beads are written field by field (no padding bytes).
+namespace {
+void write_map_state(StateOut &out, const PlateContactMap &map)
+{
+  out.put(map.time);
+  out.put(map.gap);
+  out.put(map.field);
+  std::vector<std::int32_t> ids;
+  std::vector<double> values;
+  for (const PlateContactBead &b : map.beads)
+  {
+    ids.push_back(b.id);
+    values.insert(values.end(), {b.u, b.v, b.radius, b.fn, b.ft_u, b.ft_v});
+  }
+  out.put_array(ids);
+  out.put_array(values);
+}
+
+PlateContactMap read_map_state(StateIn &in)
+{
+  PlateContactMap map;
+  map.time = in.get<double>();
+  map.gap = in.get<double>();
+  map.field = in.get<double>();
+  std::vector<std::int32_t> ids;
+  std::vector<double> values;
+  in.get_array(ids);
+  in.get_array(values);
+  if (values.size() != 6 * ids.size())
+    in.fail("is corrupt (a plate contact map)");
+  for (std::size_t k = 0; k < ids.size(); ++k)
+  {
+    const double *v = &values[6 * k];
+    map.beads.push_back({ids[k], v[0], v[1], v[2], v[3], v[4], v[5]});
+  }
+  return map;
+}
+
+void write_rows(StateOut &out, const std::vector<PlateCompressionRow> &rows)
+{
+  std::vector<double> values;
+  std::vector<long> samples;
+  for (const PlateCompressionRow &r : rows)
+  {
+    values.insert(values.end(), {r.time, r.gap, r.field, r.fn, r.ft_u, r.ft_v, r.ft, r.touching});
+    samples.push_back(r.samples);
+  }
+  out.put_array(values);
+  out.put_array(samples);
+}
+
+std::vector<PlateCompressionRow> read_rows(StateIn &in)
+{
+  std::vector<double> values;
+  std::vector<long> samples;
+  in.get_array(values);
+  in.get_array(samples);
+  if (values.size() != 8 * samples.size())
+    in.fail("is corrupt (the plate compression's rows)");
+  std::vector<PlateCompressionRow> rows;
+  for (std::size_t k = 0; k < samples.size(); ++k)
+  {
+    const double *v = &values[8 * k];
+    rows.push_back({v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], samples[k]});
+  }
+  return rows;
+}
+} // namespace
+
+void PlateCompression::write_state(StateOut &out) const
+{
+  write_rows(out, {sum_});
+  write_rows(out, rows_);
+  out.put(next_map_);
+  out.put<std::uint64_t>(maps_.size());
+  for (const PlateContactMap &m : maps_)
+    write_map_state(out, m);
+  write_map_state(out, last_map_);
+}
+
+void PlateCompression::read_state(StateIn &in)
+{
+  const auto sum = read_rows(in);
+  if (sum.size() != 1)
+    in.fail("is corrupt (the plate compression's open window)");
+  sum_ = sum.front();
+  rows_ = read_rows(in);
+  next_map_ = in.get<double>();
+  const auto n_maps = in.get<std::uint64_t>();
+  if (n_maps > in.remaining())
+    in.fail("is corrupt (more contact maps than the file holds)");
+  maps_.clear();
+  for (std::uint64_t k = 0; k < n_maps; ++k)
+    maps_.push_back(read_map_state(in));
+  last_map_ = read_map_state(in);
+}
+
 } // namespace magbrush::dem

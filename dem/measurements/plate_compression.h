@@ -78,6 +78,8 @@ public:
   double interval() const override { return settings_.sample_interval; }
   void sample(const DemSystem &system) override;
   void write(const std::string &directory) const override;
+  void write_state(StateOut &out) const override;
+  void read_state(StateIn &in) override;
 
   // Results so far (the current, unfinished window is not included).
   const std::vector<PlateCompressionRow> &rows() const { return rows_; }
@@ -101,7 +103,6 @@ private:
 
   // The window being accumulated.
   PlateCompressionRow sum_;
-  double window_start_ = -1.0;
   double next_map_ = 0.0;
   std::vector<PlateCompressionRow> rows_;
   std::vector<PlateContactMap> maps_;

@@ -34,6 +34,9 @@ public:
   void clear() { values_.clear(); }
   std::size_t size() const { return values_.size(); }
   const std::vector<double> &values() const { return values_; }
+  // The samples, for checkpoints (Measurement::write_state).
+  void write_state(StateOut &out) const { out.put_array(values_); }
+  void read_state(StateIn &in) { in.get_array(values_); }
 
   double mean() const; // NaN when empty
   // Standard error of the mean by block averaging over `blocks` contiguous blocks of equal

@@ -286,4 +286,80 @@ const bool registered =
                         }});
 } // namespace
 
+
+// The toner on the drum at the last sample (arrivals and departures are counted against it),
+// the transfer profile, the series and the rows (Measurement::write_state). The toner and the
+// rows are written field by field, so that no padding byte reaches the file.
+void TonerDevelopment::write_state(StateOut &out) const
+{
+  std::vector<std::int32_t> ids;
+  std::vector<double> x, y, mass, charge;
+  for (const DrumToner &t : before_)
+  {
+    ids.push_back(t.id);
+    x.push_back(t.x);
+    y.push_back(t.y);
+    mass.push_back(t.mass);
+    charge.push_back(t.charge);
+  }
+  out.put_array(ids);
+  for (const auto *a : {&x, &y, &mass, &charge})
+    out.put_array(*a);
+  out.put_array(arrived_);
+  out.put_array(left_);
+  out.put(previous_time_);
+  out.put(first_time_);
+  out.put(last_time_);
+  for (const auto *s : {&tma_, &fog_, &q_over_m_, &ratio_, &transfer_})
+    s->write_state(out);
+  std::vector<double> values;
+  std::vector<long> counts;
+  for (const Row &r : rows_)
+  {
+    values.insert(values.end(), {r.time, r.tma, r.fog, r.q_over_m, r.ratio, r.transfer});
+    counts.insert(counts.end(), {r.image_toner, r.dark_toner});
+  }
+  out.put_array(values);
+  out.put_array(counts);
+}
+
+void TonerDevelopment::read_state(StateIn &in)
+{
+  std::vector<std::int32_t> ids;
+  std::vector<double> x, y, mass, charge;
+  in.get_array(ids);
+  for (auto *a : {&x, &y, &mass, &charge})
+  {
+    in.get_array(*a);
+    if (a->size() != ids.size())
+      in.fail("is corrupt (the toner on the drum has arrays of different lengths)");
+  }
+  before_.clear();
+  for (std::size_t k = 0; k < ids.size(); ++k)
+    before_.push_back({ids[k], x[k], y[k], mass[k], charge[k]});
+  const std::size_t bins = arrived_.size();
+  in.get_array(arrived_);
+  in.get_array(left_);
+  if (arrived_.size() != bins || left_.size() != bins)
+    in.fail("holds a transfer profile of " + std::to_string(arrived_.size()) + " bins, this case's has " +
+            std::to_string(bins));
+  previous_time_ = in.get<double>();
+  first_time_ = in.get<double>();
+  last_time_ = in.get<double>();
+  for (auto *s : {&tma_, &fog_, &q_over_m_, &ratio_, &transfer_})
+    s->read_state(in);
+  std::vector<double> values;
+  std::vector<long> counts;
+  in.get_array(values);
+  in.get_array(counts);
+  if (values.size() % 6 != 0 || counts.size() != values.size() / 3)
+    in.fail("is corrupt (the development rows)");
+  rows_.clear();
+  for (std::size_t k = 0; k < counts.size() / 2; ++k)
+  {
+    const double *v = &values[6 * k];
+    rows_.push_back({v[0], v[1], v[2], v[3], v[4], v[5], counts[2 * k], counts[2 * k + 1]});
+  }
+}
+
 } // namespace magbrush::dem

@@ -75,6 +75,8 @@ public:
   double interval() const override { return settings_.sample_interval; }
   void sample(const DemSystem &system) override;
   void write(const std::string &directory) const override;
+  void write_state(StateOut &out) const override;
+  void read_state(StateIn &in) override;
   std::vector<SummaryValue> summary() const override;
 
   // The same from hand-made records (what sample() extracts from the engine).

@@ -554,6 +554,8 @@ public:
   {
     std::ofstream(dir + "/samples.txt") << times.size() << "\n";
   }
+  void write_state(StateOut &out) const override { out.put_array(times); }
+  void read_state(StateIn &in) override { in.get_array(times); }
   std::vector<double> times;
 
 private:
@@ -586,6 +588,57 @@ TEST(DemEngine, MeasurementsAreSampledAtTheirIntervalAndWritten)
   int n = 0;
   in >> n;
   EXPECT_EQ(n, 10);
+  std::filesystem::remove_all(dir);
+}
+
+// A measurement's state is in every checkpoint: a run restarted from one continues it (the
+// samples before the restart and after, as one run), the log says so; a restart that changes
+// what is measured (a statistics key) starts it afresh and says why.
+TEST(DemEngine, MeasurementsContinueAcrossARestartUnlessHowTheyMeasureChanged)
+{
+  Material m = elastic_material("m", 1e7, 0.3, 2000);
+  Case c = single_species_case(m);
+  c.populations[0].count = 1;
+  c.populations[0].insert_box = std::array<Vec3, 2>{Vec3{0, 0, 0}, Vec3{3e-3, 3e-3, 3e-3}};
+  c.dem.time_step = 1e-6;
+  c.dem.duration = 50e-6;
+  const auto dir = magbrush::testing::test_temp_dir("dem_measurement_restart");
+  RunOptions o;
+  o.output_dir = (dir / "first").string();
+  o.threads = 1;
+  auto run_with_counter = [](const Case &cs, const RunOptions &opts, std::ostringstream &log) {
+    DemRun run(cs, opts, log);
+    auto counter = std::make_unique<SampleCounter>(10e-6);
+    const SampleCounter &seen = *counter;
+    run.add_measurement(std::move(counter));
+    run.run();
+    return seen.times;
+  };
+  std::ostringstream log1;
+  ASSERT_EQ(run_with_counter(c, o, log1).size(), 5u); // 10 ... 50 µs
+
+  Case longer = c;
+  longer.dem.duration = 100e-6;
+  RunOptions r = o;
+  r.restart_file = (dir / "first" / "checkpoint.bin").string();
+  r.output_dir = (dir / "continued").string();
+  std::ostringstream log2;
+  const std::vector<double> continued = run_with_counter(longer, r, log2);
+  ASSERT_EQ(continued.size(), 10u) << log2.str();
+  for (std::size_t k = 0; k < continued.size(); ++k)
+    EXPECT_NEAR(continued[k], 10e-6 * static_cast<double>(k + 1), 1e-12);
+  EXPECT_NE(log2.str().find("the measurements continue from the checkpoint"), std::string::npos) << log2.str();
+
+  Case judged_otherwise = longer;
+  judged_otherwise.statistics.blocks = longer.statistics.blocks + 2;
+  r.output_dir = (dir / "afresh").string();
+  std::ostringstream log3;
+  const std::vector<double> afresh = run_with_counter(judged_otherwise, r, log3);
+  ASSERT_EQ(afresh.size(), 5u) << log3.str(); // 60 ... 100 µs
+  EXPECT_NEAR(afresh.front(), 60e-6, 1e-12);
+  EXPECT_NE(log3.str().find("the measurements start afresh at the restart (statistics.blocks changed)"),
+            std::string::npos)
+      << log3.str();
   std::filesystem::remove_all(dir);
 }
 

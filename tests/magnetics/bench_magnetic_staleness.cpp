@@ -110,6 +110,10 @@ public:
   const char *name() const override { return "held magnetic force error"; }
   double interval() const override { return interval_; }
   void write(const std::string &) const override {}
+  // The probe measures the window of the run it is attached to: a restarted run opens its
+  // window again at its first sample (nothing is carried over).
+  void write_state(StateOut &) const override {}
+  void read_state(StateIn &) override {}
 
   void sample(const dem::DemSystem &system) override
   {

@@ -21,6 +21,8 @@ public:
   double interval() const override { return 0.0; }
   void sample(const DemSystem &) override {}
   void write(const std::string &) const override {}
+  void write_state(StateOut &) const override {}
+  void read_state(StateIn &) override {}
 };
 
 // Applies only to cases named "wants_probe".

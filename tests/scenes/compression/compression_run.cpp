@@ -42,6 +42,9 @@ public:
   const char *name() const override { return "plate sliding (test)"; }
   double interval() const override { return interval_; }
   void write(const std::string &) const override {}
+  // The test's runs are never restarted: a restart would be a misuse of the sampler.
+  void write_state(StateOut &) const override {}
+  void read_state(StateIn &) override { throw std::logic_error("the plate sliding sampler is not restartable"); }
   void sample(const dem::DemSystem &system) override
   {
     const double t = system.time();

@@ -11,11 +11,9 @@
 //   release sector             developer release
 //   compression box            plate compression (windows, contact maps)
 #include <gtest/gtest.h>
+#include "tests/cli_run.h"
 #include "tests/test_temp_dir.h"
 
-#include <sys/wait.h>
-
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <ostream>
@@ -27,25 +25,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct CliResult
-{
-  int code;
-  std::string output;
-};
+using magbrush::testing::CliResult;
 
 CliResult run(const std::string &program, const std::string &args)
 {
-  const std::string cmd = std::string(MAGBRUSH_BINARY_DIR) + "/bin/" + program + " " + args + " 2>&1";
-  CliResult r{-1, {}};
-  FILE *p = popen(cmd.c_str(), "r");
-  if (!p)
-    return r;
-  char buf[4096];
-  while (fgets(buf, sizeof buf, p))
-    r.output += buf;
-  const int status = pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
+  return magbrush::testing::run_program(program, args);
 }
 
 std::string contents(const fs::path &file)

@@ -3,6 +3,7 @@
 // bit, the messages of a refused time step and an impossible insertion, a restart under
 // another case (refused) or other run control (proceeds), and a killed run's checkpoints.
 #include <gtest/gtest.h>
+#include "tests/cli_run.h"
 #include "tests/test_temp_dir.h"
 #include <hdf5.h>
 
@@ -62,26 +63,9 @@ dem:
   gravity: [0, 0, -9.81 m/s^2]
 )";
 
-struct CliResult
-{
-  int code;
-  std::string output;
-};
+using magbrush::testing::CliResult;
 
-CliResult run_dem(const std::string &args)
-{
-  const std::string cmd = std::string(MAGBRUSH_BINARY_DIR) + "/bin/magbrush-dem " + args + " 2>&1";
-  CliResult r{-1, {}};
-  FILE *p = popen(cmd.c_str(), "r");
-  if (!p)
-    return r;
-  char buf[4096];
-  while (fgets(buf, sizeof buf, p))
-    r.output += buf;
-  const int status = pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+CliResult run_dem(const std::string &args) { return magbrush::testing::run_program("magbrush-dem", args); }
 
 std::vector<double> read_dataset(const std::string &file, const char *name)
 {

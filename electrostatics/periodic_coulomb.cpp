@@ -4,6 +4,10 @@
 
 #include <omp.h>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -24,6 +28,66 @@ inline void add_coulomb(double rx, double ry, double rz, double q, double &ex, d
   ey += qir3 * ry;
   ez += qir3 * rz;
   phi += q * ir;
+}
+
+// One near row: the field and potential at target (tx, ty, tz) of the sources src[k] shifted by
+// shift[3k..3k+2], summed in a fixed order (so the bits do not depend on the thread count).
+// With SSE2 (every x86-64) the row is taken two entries at a time, even and odd entries in the
+// two lanes of one register, and the lanes added at the end, then the odd one out: the square
+// root and the division — most of a pair's cost — go two to an instruction. Without SSE2 the
+// same order in scalar code, so the two builds give the same bits.
+struct RowSum
+{
+  double ex = 0.0, ey = 0.0, ez = 0.0, phi = 0.0;
+};
+
+inline RowSum near_row_sum(double tx, double ty, double tz, const std::uint32_t *src, const double *shift,
+                           std::uint32_t count, const double *sx, const double *sy, const double *sz,
+                           const double *sq)
+{
+  RowSum out;
+  std::uint32_t k = 0;
+#if defined(__SSE2__)
+  __m128d ex = _mm_setzero_pd(), ey = _mm_setzero_pd(), ez = _mm_setzero_pd(), ph = _mm_setzero_pd();
+  const __m128d one = _mm_set1_pd(1.0), t_x = _mm_set1_pd(tx), t_y = _mm_set1_pd(ty), t_z = _mm_set1_pd(tz);
+  for (; k + 1 < count; k += 2)
+  {
+    const std::uint32_t a = src[k], b = src[k + 1];
+    const double *ha = shift + 3 * k, *hb = shift + 3 * k + 3;
+    // (_mm_set_pd takes the high lane first: entry k in the low lane.)
+    const __m128d rx = _mm_sub_pd(_mm_sub_pd(t_x, _mm_set_pd(sx[b], sx[a])), _mm_set_pd(hb[0], ha[0]));
+    const __m128d ry = _mm_sub_pd(_mm_sub_pd(t_y, _mm_set_pd(sy[b], sy[a])), _mm_set_pd(hb[1], ha[1]));
+    const __m128d rz = _mm_sub_pd(_mm_sub_pd(t_z, _mm_set_pd(sz[b], sz[a])), _mm_set_pd(hb[2], ha[2]));
+    const __m128d q = _mm_set_pd(sq[b], sq[a]);
+    const __m128d r2 = _mm_add_pd(_mm_add_pd(_mm_mul_pd(rx, rx), _mm_mul_pd(ry, ry)), _mm_mul_pd(rz, rz));
+    const __m128d ir = _mm_div_pd(one, _mm_sqrt_pd(r2));
+    const __m128d qir3 = _mm_mul_pd(_mm_mul_pd(_mm_mul_pd(q, ir), ir), ir);
+    ex = _mm_add_pd(ex, _mm_mul_pd(qir3, rx));
+    ey = _mm_add_pd(ey, _mm_mul_pd(qir3, ry));
+    ez = _mm_add_pd(ez, _mm_mul_pd(qir3, rz));
+    ph = _mm_add_pd(ph, _mm_mul_pd(q, ir));
+  }
+  auto lanes = [](__m128d v) { return _mm_cvtsd_f64(v) + _mm_cvtsd_f64(_mm_unpackhi_pd(v, v)); };
+  out = {lanes(ex), lanes(ey), lanes(ez), lanes(ph)};
+#else
+  RowSum even, odd;
+  for (; k + 1 < count; k += 2)
+  {
+    const std::uint32_t a = src[k], b = src[k + 1];
+    add_coulomb(tx - sx[a] - shift[3 * k], ty - sy[a] - shift[3 * k + 1], tz - sz[a] - shift[3 * k + 2], sq[a],
+                even.ex, even.ey, even.ez, even.phi);
+    add_coulomb(tx - sx[b] - shift[3 * k + 3], ty - sy[b] - shift[3 * k + 4], tz - sz[b] - shift[3 * k + 5], sq[b],
+                odd.ex, odd.ey, odd.ez, odd.phi);
+  }
+  out = {even.ex + odd.ex, even.ey + odd.ey, even.ez + odd.ez, even.phi + odd.phi};
+#endif
+  if (k < count)
+  {
+    const std::uint32_t a = src[k];
+    add_coulomb(tx - sx[a] - shift[3 * k], ty - sy[a] - shift[3 * k + 1], tz - sz[a] - shift[3 * k + 2], sq[a], out.ex,
+                out.ey, out.ez, out.phi);
+  }
+  return out;
 }
 } // namespace
 
@@ -195,18 +259,14 @@ void PeriodicCoulomb::field(const double *x, const double *y, const double *z, c
 #pragma omp parallel for schedule(static) if (n >= parallel_threshold)
   for (long i = 0; i < n; ++i)
   {
-    double ex = 0.0, ey = 0.0, ez = 0.0, p = 0.0;
-    for (std::uint32_t k = row_begin_[i]; k < row_begin_[i + 1]; ++k)
-    {
-      const std::uint32_t s = row_source_[k];
-      add_coulomb(sx_[i] - sx_[s] - row_shift_[3 * k], sy_[i] - sy_[s] - row_shift_[3 * k + 1],
-                  sz_[i] - sz_[s] - row_shift_[3 * k + 2], sq_[s], ex, ey, ez, p);
-    }
-    E[3 * i] = far_E_[3 * i] + coulomb_constant * ex;
-    E[3 * i + 1] = far_E_[3 * i + 1] + coulomb_constant * ey;
-    E[3 * i + 2] = far_E_[3 * i + 2] + coulomb_constant * ez;
+    const std::uint32_t first = row_begin_[i];
+    const RowSum near = near_row_sum(sx_[i], sy_[i], sz_[i], row_source_.data() + first, row_shift_.data() + 3 * first,
+                                     row_begin_[i + 1] - first, sx_.data(), sy_.data(), sz_.data(), sq_.data());
+    E[3 * i] = far_E_[3 * i] + coulomb_constant * near.ex;
+    E[3 * i + 1] = far_E_[3 * i + 1] + coulomb_constant * near.ey;
+    E[3 * i + 2] = far_E_[3 * i + 2] + coulomb_constant * near.ez;
     if (phi)
-      phi[i] = far_phi_[i] + coulomb_constant * p;
+      phi[i] = far_phi_[i] + coulomb_constant * near.phi;
   }
 }
 

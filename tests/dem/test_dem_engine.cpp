@@ -561,15 +561,21 @@ public:
 private:
   double every_;
 };
+
+// One bead falling in a box, 1 µs steps: a run whose measurements are all there is to it.
+Case one_bead_case()
+{
+  Case c = single_species_case(elastic_material("m", 1e7, 0.3, 2000));
+  c.populations[0].count = 1;
+  c.populations[0].insert_box = std::array<Vec3, 2>{Vec3{0, 0, 0}, Vec3{3e-3, 3e-3, 3e-3}};
+  c.dem.time_step = 1e-6;
+  return c;
+}
 } // namespace
 
 TEST(DemEngine, MeasurementsAreSampledAtTheirIntervalAndWritten)
 {
-  Material m = elastic_material("m", 1e7, 0.3, 2000);
-  Case c = single_species_case(m);
-  c.populations[0].count = 1;
-  c.populations[0].insert_box = std::array<Vec3, 2>{Vec3{0, 0, 0}, Vec3{3e-3, 3e-3, 3e-3}};
-  c.dem.time_step = 1e-6;
+  Case c = one_bead_case();
   c.dem.duration = 100e-6;
   const std::string dir = (magbrush::testing::test_temp_dir("dem_measurement") / "out").string();
   RunOptions o;
@@ -596,11 +602,7 @@ TEST(DemEngine, MeasurementsAreSampledAtTheirIntervalAndWritten)
 // what is measured (a statistics key) starts it afresh and says why.
 TEST(DemEngine, MeasurementsContinueAcrossARestartUnlessHowTheyMeasureChanged)
 {
-  Material m = elastic_material("m", 1e7, 0.3, 2000);
-  Case c = single_species_case(m);
-  c.populations[0].count = 1;
-  c.populations[0].insert_box = std::array<Vec3, 2>{Vec3{0, 0, 0}, Vec3{3e-3, 3e-3, 3e-3}};
-  c.dem.time_step = 1e-6;
+  Case c = one_bead_case();
   c.dem.duration = 50e-6;
   const auto dir = magbrush::testing::test_temp_dir("dem_measurement_restart");
   RunOptions o;

@@ -8,10 +8,8 @@ namespace magbrush::dem {
 
 bool is_run_control_key(const std::string &key)
 {
-  static const char *const exact[] = {"dem.duration",           "dem.output_interval",
-                                      "dem.checkpoint_interval", "dem.checkpoint_wall_interval",
-                                      "dem.threads",             "compression.sample_interval",
-                                      "compression.map_interval"};
+  static const char *const exact[] = {"dem.duration", "dem.output_interval", "dem.checkpoint_interval",
+                                      "dem.checkpoint_wall_interval", "dem.threads"};
   for (const char *k : exact)
     if (key == k)
       return true;

@@ -75,7 +75,17 @@ std::string DemRun::check_restart_case() const
 // After the engine's state, in the same checksummed file:
 //   "measurements", their count, then per measurement its name and its state as one block
 // (a block is read through its own stream, so that a measurement that reads more or less
-// than it wrote is caught at its own door rather than misreading the next one).
+// than it wrote is caught at its own door rather than misreading the next one). The name
+// carries the state's layout from version 2 on ("developer mass per area (state v2)"), so a
+// block in another layout reads as another measurement: started afresh, not misread.
+namespace {
+std::string state_label(const Measurement &m)
+{
+  const int version = m.state_version();
+  return version == 1 ? std::string(m.name()) : std::string(m.name()) + " (state v" + std::to_string(version) + ")";
+}
+} // namespace
+
 void DemRun::write_measurement_states(StateOut &out) const
 {
   out.put_string("measurements");
@@ -84,7 +94,7 @@ void DemRun::write_measurement_states(StateOut &out) const
   {
     MemoryStateOut block;
     m->write_state(block);
-    out.put_string(m->name());
+    out.put_string(state_label(*m));
     out.put_string(block.bytes());
   }
 }
@@ -111,11 +121,14 @@ void DemRun::read_measurement_states(StateIn &in, const std::string &afresh_beca
     in.fail("is corrupt (fewer measurements than it says it holds)");
   if (!afresh_because.empty())
     return afresh(afresh_because);
-  bool same = blocks.size() == measurements_.size();
-  for (std::size_t k = 0; same && k < blocks.size(); ++k)
-    same = blocks[k].first == measurements_[k]->name();
-  if (!same)
+  if (blocks.size() != measurements_.size())
     return afresh("the checkpoint holds other measurements than this run makes");
+  for (std::size_t k = 0; k < blocks.size(); ++k)
+    if (blocks[k].first != state_label(*measurements_[k]))
+      return afresh(blocks[k].first.rfind(measurements_[k]->name(), 0) == 0
+                        ? "the checkpoint keeps the " + std::string(measurements_[k]->name()) +
+                              " in another layout than this magbrush's ('" + state_label(*measurements_[k]) + "')"
+                        : "the checkpoint holds other measurements than this run makes");
   for (std::size_t k = 0; k < blocks.size(); ++k)
   {
     MemoryStateIn block(std::move(blocks[k].second),

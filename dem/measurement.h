@@ -69,6 +69,10 @@ public:
   // the case are not written.
   virtual void write_state(StateOut &out) const = 0;
   virtual void read_state(StateIn &in) = 0;
+  // The layout of that state: raised whenever write_state() writes something else, so that a
+  // checkpoint written in the old layout starts this measurement afresh (the log says why)
+  // instead of being misread. Version 1 is the first layout and is written without a tag.
+  virtual int state_version() const { return 1; }
 };
 
 } // namespace magbrush::dem

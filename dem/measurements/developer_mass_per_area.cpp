@@ -112,11 +112,12 @@ void DeveloperMassPerArea::add_sample(double time, const ParticleState &s, const
   Row row;
   row.time = time;
   const double window_centre = blade_angle_ + sense_ * settings_.after_blade;
-  double mass = 0.0, toner = 0.0, front = 0.0;
+  double mass = 0.0, toner = 0.0, front = 0.0, gap_mass = 0.0, gap_momentum = 0.0;
+  const double gap_half_angle = gap_ / R_;
   for (std::size_t i = 0; i < s.size(); ++i)
   {
     const double a = angle_from(s.x[i], s.y[i], window_centre);
-    const double height = std::hypot(s.x[i], s.y[i]) - R_;
+    const double r = std::hypot(s.x[i], s.y[i]), height = r - R_;
     if (std::abs(a) <= 0.5 * settings_.window && height <= settings_.height)
     {
       mass += s.mass[i];
@@ -127,6 +128,12 @@ void DeveloperMassPerArea::add_sample(double time, const ParticleState &s, const
     const double b = angle_from(s.x[i], s.y[i], blade_angle_);
     if (b < 0.0 && b >= -settings_.front_window)
       front += s.mass[i];
+    if (std::abs(b) <= gap_half_angle && height <= gap_)
+    {
+      // angular speed about the axis, in the sense the sleeve turns
+      gap_mass += s.mass[i];
+      gap_momentum += s.mass[i] * sense_ * (s.x[i] * s.vy[i] - s.y[i] * s.vx[i]) / (r * r);
+    }
   }
   row.dma = mass / (R_ * settings_.window * Lz_);
   row.toner_concentration = mass > toner ? toner / (mass - toner) : nan;
@@ -136,6 +143,7 @@ void DeveloperMassPerArea::add_sample(double time, const ParticleState &s, const
   row.blade_radial = (force_on_blade.x * c + force_on_blade.y * sn) / Lz_;
   row.blade_along = sense_ * (-force_on_blade.x * sn + force_on_blade.y * c) / Lz_;
   row.held_in_front = front / Lz_;
+  row.gap_speed_ratio = gap_mass > 0.0 && speed_ > 0.0 ? gap_momentum / gap_mass / (speed_ / R_) : nan;
   rows_.push_back(row);
 
   if (time < settings_.average_from)
@@ -148,6 +156,8 @@ void DeveloperMassPerArea::add_sample(double time, const ParticleState &s, const
   blade_radial_.add(row.blade_radial);
   blade_along_.add(row.blade_along);
   held_.add(row.held_in_front);
+  if (!std::isnan(row.gap_speed_ratio))
+    gap_speed_.add(row.gap_speed_ratio);
 }
 
 std::vector<SummaryValue> DeveloperMassPerArea::summary() const
@@ -169,6 +179,8 @@ std::vector<SummaryValue> DeveloperMassPerArea::summary() const
               "the same along the sleeve's motion at the blade tip"),
       sampled("developer_held_in_front_of_blade_kg_per_m", held_, true, "kg/m",
               "developer mass in the sector just before the blade tip per slab length"),
+      sampled("blade_gap_speed_ratio", gap_speed_, false, "1",
+              "speed of the developer in the blade's gap / the sleeve's (below 1: the sleeve slides under it)"),
   };
   if (concentration_.size() > 0)
     out.push_back(sampled("toner_concentration_after_blade", concentration_, false, "1",
@@ -187,11 +199,11 @@ std::string DeveloperMassPerArea::csv() const
                 settings_.after_blade * 180.0 / M_PI, settings_.height * 1e3, dma_bound());
   o << line;
   o << "time_s,dma_kg_per_m2,dma_flux_kg_per_m2,toner_concentration,blade_force_N_per_m,blade_drag_N_per_m,"
-       "held_in_front_kg_per_m\n";
+       "held_in_front_kg_per_m,gap_speed_ratio\n";
   for (const Row &r : rows_)
   {
-    std::snprintf(line, sizeof line, "%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n", r.time, r.dma, r.dma_flux,
-                  r.toner_concentration, r.blade_radial, r.blade_along, r.held_in_front);
+    std::snprintf(line, sizeof line, "%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.4g\n", r.time, r.dma, r.dma_flux,
+                  r.toner_concentration, r.blade_radial, r.blade_along, r.held_in_front, r.gap_speed_ratio);
     o << line;
   }
   return o.str();
@@ -218,7 +230,7 @@ void DeveloperMassPerArea::write_state(StateOut &out) const
   centre_line_.write_state(out);
   out.put(previous_time_);
   out.put_array(rows_);
-  for (const auto *s : {&dma_, &dma_flux_, &concentration_, &blade_radial_, &blade_along_, &held_})
+  for (const auto *s : {&dma_, &dma_flux_, &concentration_, &blade_radial_, &blade_along_, &held_, &gap_speed_})
     s->write_state(out);
 }
 
@@ -227,7 +239,7 @@ void DeveloperMassPerArea::read_state(StateIn &in)
   centre_line_.read_state(in);
   previous_time_ = in.get<double>();
   in.get_array(rows_);
-  for (auto *s : {&dma_, &dma_flux_, &concentration_, &blade_radial_, &blade_along_, &held_})
+  for (auto *s : {&dma_, &dma_flux_, &concentration_, &blade_radial_, &blade_along_, &held_, &gap_speed_})
     s->read_state(in);
 }
 

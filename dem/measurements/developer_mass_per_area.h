@@ -17,6 +17,11 @@
 //  * the developer held in front of the blade: the mass in the sector dma.front_window just
 //    before the tip, at any distance from the sleeve, per slab length (Kweon Fig. 5: the
 //    accumulation that the auxiliary guide wall removes);
+//  * the speed of the developer in the blade's gap against the sleeve's: the mass-weighted
+//    angular speed of the particles under the tip (within gap / R of it on either side, below
+//    the gap's height) over the sleeve's. 1: the sleeve carries the layer through the gap;
+//    below 1 the sleeve slides under a layer the blade and the pile in front hold back, and
+//    the DMA falls with it (the blade jams: docs/regulation.md, the smooth sleeve);
 // (The fraction released after the nip, dma.release_*, is developer_release.h's.)
 //
 // The summary (dem/summary.csv, gathered by `magbrush sweep`) gives the means over the samples
@@ -46,6 +51,7 @@ public:
 
   const char *name() const override { return "developer mass per area"; }
   double interval() const override { return settings_.sample_interval; }
+  int state_version() const override { return 2; } // 2: the gap's speed ratio
   void sample(const DemSystem &system) override;
   void write(const std::string &directory) const override;
   void write_state(StateOut &out) const override;
@@ -67,6 +73,7 @@ private:
     double time = 0, dma = 0, dma_flux = 0, toner_concentration = 0;
     double blade_radial = 0, blade_along = 0; // [N/m]
     double held_in_front = 0;                 // [kg/m]
+    double gap_speed_ratio = 0;               // developer in the gap / sleeve (NaN: gap empty)
   };
 
   DmaSettings settings_;
@@ -78,7 +85,7 @@ private:
   LineFlux centre_line_;
   double previous_time_ = -1.0;
   std::vector<Row> rows_;
-  SampleSeries dma_, dma_flux_, concentration_, blade_radial_, blade_along_, held_;
+  SampleSeries dma_, dma_flux_, concentration_, blade_radial_, blade_along_, held_, gap_speed_;
 
   // Angle of p from `angle` in the sense the sleeve turns, in (−π, π].
   double angle_from(double px, double py, double angle) const;

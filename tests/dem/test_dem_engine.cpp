@@ -556,7 +556,9 @@ public:
   }
   void write_state(StateOut &out) const override { out.put_array(times); }
   void read_state(StateIn &in) override { in.get_array(times); }
+  int state_version() const override { return version; }
   std::vector<double> times;
+  int version = 1;
 
 private:
   double every_;
@@ -608,9 +610,10 @@ TEST(DemEngine, MeasurementsContinueAcrossARestartUnlessHowTheyMeasureChanged)
   RunOptions o;
   o.output_dir = (dir / "first").string();
   o.threads = 1;
-  auto run_with_counter = [](const Case &cs, const RunOptions &opts, std::ostringstream &log) {
+  auto run_with_counter = [](const Case &cs, const RunOptions &opts, std::ostringstream &log, int version = 1) {
     DemRun run(cs, opts, log);
     auto counter = std::make_unique<SampleCounter>(10e-6);
+    counter->version = version;
     const SampleCounter &seen = *counter;
     run.add_measurement(std::move(counter));
     run.run();
@@ -641,6 +644,23 @@ TEST(DemEngine, MeasurementsContinueAcrossARestartUnlessHowTheyMeasureChanged)
   EXPECT_NE(log3.str().find("the measurements start afresh at the restart (statistics.blocks changed)"),
             std::string::npos)
       << log3.str();
+
+  // A measurement whose state has a new layout (state_version 2) does not read the old one.
+  r.output_dir = (dir / "new_layout").string();
+  std::ostringstream log4;
+  ASSERT_EQ(run_with_counter(longer, r, log4, 2).size(), 5u) << log4.str();
+  EXPECT_NE(log4.str().find("keeps the sample counter in another layout than this magbrush's ('sample counter (state "
+                            "v2)')"),
+            std::string::npos)
+      << log4.str();
+  // ... and continues from a checkpoint in its own.
+  RunOptions v2 = r;
+  v2.restart_file = (dir / "new_layout" / "checkpoint.bin").string();
+  v2.output_dir = (dir / "new_layout_continued").string();
+  Case longest = longer;
+  longest.dem.duration = 150e-6;
+  std::ostringstream log5;
+  EXPECT_EQ(run_with_counter(longest, v2, log5, 2).size(), 10u) << log5.str();
   std::filesystem::remove_all(dir);
 }
 

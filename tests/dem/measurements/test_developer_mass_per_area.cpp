@@ -21,8 +21,8 @@ constexpr double deg = M_PI / 180.0;
 constexpr double R = 10e-3, Lz = 0.2e-3;
 
 // A roller scene with a generated doctor blade at 270 deg, gap 0.5 mm, sleeve turning
-// counter-clockwise at 400 rpm; `extra` adds keys (dma.*).
-Case blade_case(const std::string &extra = "")
+// counter-clockwise at 400 rpm (or `rpm`); `extra` adds keys (dma.*).
+Case blade_case(const std::string &extra = "", const std::string &rpm = "400 rpm")
 {
   const std::string text = R"(
 name: dma_test
@@ -32,7 +32,7 @@ roller:
   magnet_radius: 9.3 mm
   poles:
     - {name: N1, angle: 0 deg, strength: 100 kA/m, polarity: N}
-sleeve: {diameter: 20 mm, thickness: 0.5 mm, rpm: 400 rpm}
+sleeve: {diameter: 20 mm, thickness: 0.5 mm, rpm: )" + rpm + R"(}
 blades:
   - {name: doctor, kind: doctor_blade, angle: 270 deg, gap: 0.5 mm, thickness: 1.5 mm, length: 8 mm}
 materials:
@@ -116,6 +116,36 @@ TEST(DeveloperMassPerArea, BladeLoadAlongItsRadiusAndAlongTheSleevesMotion)
     {
       EXPECT_NEAR(v.value, 2e-3 / Lz, 1e-9);
     }
+  }
+}
+
+// A layer in the blade's gap turning at a fraction of the sleeve's angular speed, under a layer
+// above the gap's height turning faster: the ratio is the fraction, whatever the sense of turning.
+TEST(DeveloperMassPerArea, SpeedInTheGapAgainstTheSleeves)
+{
+  for (const char *rpm : {"400 rpm", "-400 rpm"})
+  {
+    const Case c = blade_case("", rpm);
+    DeveloperMassPerArea dma(c);
+    const double omega = c.sleeve->omega();
+    ParticleState s = ring(360, 0.2e-3, 0.0, 1e-10); // in the gap (0.5 mm)
+    const std::size_t in_gap = s.size();
+    const ParticleState above = ring(360, 0.7e-3, 0.0, 1e-10);
+    for (std::size_t i = 0; i < above.size(); ++i)
+      s.add(above.position(i), above.radius[i], above.mass[i] / (4.0 / 3.0 * M_PI * std::pow(above.radius[i], 3)), 0,
+            0.0);
+    for (std::size_t i = 0; i < s.size(); ++i)
+    {
+      const double w = (i < in_gap ? 0.6 : 2.0) * omega; // rigid turning at w
+      s.vx[i] = -w * s.y[i];
+      s.vy[i] = w * s.x[i];
+    }
+    dma.add_sample(0.0, s, Vector3{});
+    double ratio = std::nan("");
+    for (const auto &v : dma.summary())
+      if (v.key == "blade_gap_speed_ratio")
+        ratio = v.value;
+    EXPECT_NEAR(ratio, 0.6, 1e-12) << rpm;
   }
 }
 

@@ -29,6 +29,7 @@
 #include "coupling/units.h"
 #include "common/atomic_file.h"
 #include "common/child_process.h"
+#include "common/study_repeats.h"
 #include "common/study_table.h"
 
 #include <chrono>
@@ -59,7 +60,8 @@ const cli::CommandSpec &sweep_command_line()
     cli::CommandSpec s;
     s.program = "magbrush sweep";
     s.usage = "magbrush sweep CASE --vary key=v1,v2[,...] [--vary key=...] [--set key=value ...]\n"
-              "                      [--name NAME] [--no-keep-layer] [--skip STAGE[,STAGE]] [options of the stages]\n"
+              "                      [--repeats N] [--name NAME] [--no-keep-layer] [--skip STAGE[,STAGE]]\n"
+              "                      [options of the stages]\n"
               "                      [--point INDEX | --merge | --emit slurm]\n"
               "       mpirun -np K magbrush sweep CASE --vary ...";
     s.description = R"(Runs the pipeline (check, field, dem, report; the Gmsh meshes are not needed per point) once
@@ -78,6 +80,13 @@ then compares the nip profiles of all points:
                        significant_drift (1: a drift beyond two of its standard errors, a
                        trend; 0: noise) and drift_resolution, the run time of the point, and with --measured the measured value, the
                        relative error and a within-tolerance flag
+  sweep_mean.csv       with --repeats N: one row per point, every key's mean over its N
+                       repeats (dem.seed = the case's seed + 0 .. N-1, the last varied key of
+                       sweep_summary.csv) with the standard error from the spread between the
+                       repeats (<key>_stderr: what a short or transient run needs; a run's own
+                       block-averaged error sees only its window), the drifts averaged, the
+                       verdicts combined (steady only when every repeat is), the repeats that
+                       ran, the summed run time; the plots then show these means
   sweep_profiles.csv   every point's profile along the nip (long format), for nip scenes
   sweep_<key>.png      each key with a standard error against the (first) varied value, with
                        its physical bound (<key>_bound), the measured points and, per point,
@@ -113,6 +122,8 @@ run_time_s):
     s.positionals = {{"CASE", "the case file"}};
     s.options = {{"--vary", {}, "key=v1,v2", "the values of one key to run (repeatable: every combination)", true},
                  cli::set_option(),
+                 {"--repeats", {}, "N", "run every point N times with other seeds (dem.seed + 0 .. N-1) and tabulate\n"
+                                        "their means with the standard error of their spread (sweep_mean.csv)"},
                  {"--name", {}, "NAME", "the sweep's folder is sweep_NAME (default: the varied keys' names)"},
                  {"--no-keep-layer", {}, "", "do not rescale the count, diameter_std and time step with a diameter"},
                  {"--skip", {}, "STAGE[,STAGE]", "stages not run at each point (default: mesh)"},
@@ -300,6 +311,17 @@ MeasuredComparison compare_with(const MeasuredSeries &series, const std::vector<
   return m;
 }
 
+// --repeats' value: a whole number of runs per point, 1 (the default) to 1000.
+std::size_t repeats_of(const cli::ParsedArguments &args)
+{
+  const std::string text = args.value("--repeats", "1");
+  char *end = nullptr;
+  const long long n = std::strtoll(text.c_str(), &end, 10);
+  if (text.empty() || *end != '\0' || n < 1 || n > 1000)
+    throw cli::UsageError("--repeats expects a whole number of runs per point, 1 to 1000, found '" + text + "'");
+  return static_cast<std::size_t>(n);
+}
+
 // The sweep as its arguments define it: the same in every process that takes part (each MPI
 // rank, each Slurm array task, the merge step), so that point n is the same point everywhere.
 struct SweepPlan
@@ -310,6 +332,7 @@ struct SweepPlan
   std::vector<Vary> vary;
   std::optional<MeasuredSeries> measured;
   double tolerance = 0.1;
+  std::size_t repeats = 1; // > 1: the last entry of vary is dem.seed, one value per repeat
   Case base;
   fs::path sweep_dir;
   std::vector<std::vector<std::size_t>> points; // per point: the index of its value of each --vary
@@ -341,6 +364,19 @@ SweepPlan plan_sweep(const cli::ParsedArguments &args)
     for (const auto &v : plan.vary)
       plan.name += (plan.name.empty() ? "" : "_") + v.key.substr(v.key.find_last_of('.') + 1);
   plan.sweep_dir = fs::path(plan.base.output.directory) / ("sweep_" + plan.name);
+  plan.repeats = repeats_of(args);
+  if (plan.repeats > 1)
+  {
+    // The repeats are the last varied key, so that a point's repeats are neighbours in the
+    // table (and their folders sit side by side: p0_..._seed-1, p1_..._seed-2, ...).
+    for (const auto &v : plan.vary)
+      if (v.key == "dem.seed")
+        throw cli::UsageError("--repeats draws the seeds itself: do not also vary dem.seed");
+    Vary seeds{"dem.seed", {}};
+    for (std::size_t r = 0; r < plan.repeats; ++r)
+      seeds.values.push_back(std::to_string(plan.base.dem.seed + r));
+    plan.vary.push_back(seeds);
+  }
 
   // Every combination (the last --vary runs fastest).
   plan.points.assign(1, {});
@@ -510,6 +546,61 @@ int run_point(const SweepPlan &plan, std::size_t n, const cli::ParsedArguments &
   return rc;
 }
 
+// sweep_mean.csv: the repeats of each point (neighbours in the run table, the seed varied
+// last) as one row: the varied values without the seed, the number of repeats that ran, every
+// key's mean with the standard error of the repeats' spread (common/study_repeats.h), the
+// summed run time and whether every repeat ran.
+std::string means_of_repeats_csv(const SweepPlan &plan, const std::vector<StudyPoint> &runs,
+                                 const std::vector<std::string> &run_header, const std::vector<double> &run_first_x)
+{
+  const std::size_t varied = plan.vary.size(), seed_given = varied - 1, seed_si = 2 * varied - 1;
+  auto without_seed = [&](const std::vector<std::string> &cells) {
+    std::vector<std::string> out;
+    for (std::size_t k = 0; k < cells.size(); ++k)
+      if (k != seed_given && k != seed_si)
+        out.push_back(cells[k]);
+    return out;
+  };
+  std::vector<StudyPoint> means;
+  std::vector<double> first_x;
+  for (std::size_t first = 0; first < runs.size(); first += plan.repeats)
+  {
+    StudyPoint mean;
+    mean.label = "p" + std::to_string(first / plan.repeats);
+    for (std::size_t k = 0; k + 1 < varied; ++k)
+      mean.label += "_" + label_of(plan.vary[k].key, plan.vary[k].values[plan.points[first][k]]);
+    mean.leading = without_seed(runs[first].leading);
+    std::vector<std::vector<SummaryRow>> summaries;
+    double run_time = 0.0;
+    std::size_t ran = 0;
+    for (std::size_t r = first; r < first + plan.repeats; ++r)
+    {
+      run_time += std::atof(runs[r].trailing[0].c_str());
+      if (runs[r].trailing[1] != "ok")
+        continue;
+      summaries.push_back(runs[r].summary);
+      ++ran;
+    }
+    mean.leading.push_back(std::to_string(ran));
+    mean.summary = mean_of_repeats(summaries);
+    char cell[64];
+    std::snprintf(cell, sizeof cell, "%.1f", run_time);
+    mean.trailing = {cell, ran == plan.repeats ? "ok" : std::to_string(plan.repeats - ran) + " of " +
+                                                          std::to_string(plan.repeats) + " repeats failed"};
+    means.push_back(mean);
+    first_x.push_back(run_first_x[first]);
+  }
+  std::vector<std::string> header = without_seed(run_header);
+  header.push_back("repeats");
+  std::optional<MeasuredComparison> comparison;
+  if (plan.measured)
+    comparison = compare_with(*plan.measured, first_x, plan.tolerance);
+  return study_table_csv("magbrush sweep of " + plan.case_path + ": the mean of " + std::to_string(plan.repeats) +
+                             " repeats per point (dem.seed " + plan.vary.back().values.front() + " .. " +
+                             plan.vary.back().values.back() + "), standard errors from their spread",
+                         header, {"run_time_s", "status"}, means, comparison);
+}
+
 // The table, the profiles and the plots from every point's folder. Returns 1 when a point
 // failed or has not run (its row says which), else 0.
 int merge_points(const SweepPlan &plan)
@@ -587,6 +678,12 @@ int merge_points(const SweepPlan &plan)
                                               {"run_time_s", "status"}, table, comparison);
   fs::create_directories(plan.sweep_dir);
   write_text_atomically((plan.sweep_dir / "sweep_summary.csv").string(), summary);
+  if (plan.repeats > 1)
+  {
+    const std::string means = means_of_repeats_csv(plan, table, leading_header, first_x);
+    write_text_atomically((plan.sweep_dir / "sweep_mean.csv").string(), means);
+    std::cout << "\nmagbrush sweep: " << (plan.sweep_dir / "sweep_mean.csv").string() << "\n" << means;
+  }
   write_text_atomically((plan.sweep_dir / "sweep_profiles.csv").string(), profiles.str());
   std::cout << "\nmagbrush sweep: " << (plan.sweep_dir / "sweep_summary.csv").string() << "\n" << summary;
 

@@ -3,7 +3,9 @@
 
     plot_sweep.py --dir RESULTS/sweep_NAME [--key KEY ...]
 
-Reads sweep_summary.csv there and writes (atomically) sweep_<key>.png for every key that has a
+Reads sweep_summary.csv there (or, where the sweep ran --repeats, sweep_mean.csv: the mean of
+each point's repeats with the standard error of their spread) and writes (atomically)
+sweep_<key>.png for every key that has a
 standard error, a physical bound (<key>_bound) or a measured comparison (or the keys named with
 --key): the mean with its standard-error bars against the first varied value (in SI), the bound
 as a dashed line, the measured points with their relative error and the within-tolerance flag,
@@ -90,7 +92,12 @@ def plot_keys(plt, directory, header, rows, requested):
         errors = [number(r[col[key + "_stderr"]]) if key + "_stderr" in col else 0.0 for r in rows]
         errors = [0.0 if e != e else e for e in errors]
         fig, ax = plt.subplots(figsize=(7, 4.2))
-        ax.errorbar(xs, ys, yerr=errors, fmt="o-", capsize=4, label="magbrush (± standard error)")
+        if "repeats" in col:
+            counts = sorted({r[col["repeats"]] for r in rows})
+            label = f"magbrush, mean of {'/'.join(counts)} repeats (± standard error of their spread)"
+        else:
+            label = "magbrush (± standard error)"
+        ax.errorbar(xs, ys, yerr=errors, fmt="o-", capsize=4, label=label)
         if key + "_bound" in col:
             bound = [number(r[col[key + "_bound"]]) for r in rows]
             ax.plot(xs, bound, "k--", lw=1.2, label="physical bound")
@@ -138,8 +145,9 @@ def main():
     except ImportError as e:
         print(f"plot_sweep.py: {e}", file=sys.stderr)
         return 3
+    table = "sweep_mean.csv" if os.path.exists(os.path.join(args.dir, "sweep_mean.csv")) else "sweep_summary.csv"
     try:
-        summary_header, summary_rows = read(os.path.join(args.dir, "sweep_summary.csv"))
+        summary_header, summary_rows = read(os.path.join(args.dir, table))
     except (OSError, IndexError) as e:
         print(f"plot_sweep.py: cannot read the sweep summary: {e}", file=sys.stderr)
         return 2

@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -155,5 +156,80 @@ TEST(Sweep, ADiameterStudyOfAPopulationGivenByMassScalesItsSpreadAndTheStep)
   EXPECT_EQ(resolved("populations.carrier.count"), "0");
   EXPECT_EQ(resolved("populations.carrier.diameter_std"), "5 um");
   EXPECT_EQ(resolved("dem.time_step"), "20 ns");
+  fs::remove_all(dir);
+}
+
+// --repeats N runs every point with the seeds seed .. seed + N-1 (the last varied key, so
+// that a point's repeats are neighbours) and writes sweep_mean.csv: one row per point, each
+// key's mean over its repeats with the standard error of their spread. The runs' summaries
+// are written by hand here (the points run no stage), so that the means are known exactly;
+// the merge then reads them as it reads a real run's.
+TEST(Sweep, RepeatsAreAveragedWithTheStandardErrorOfTheirSpread)
+{
+  const fs::path dir = magbrush::testing::test_temp_dir("app_sweep_repeats");
+  std::ofstream(dir / "box.yaml") << magbrush::testing::sweep_box_case;
+  const std::vector<std::string> sweep = {"sweep", (dir / "box.yaml").string(), "--vary",
+                                          "populations.carrier.diameter=100um,120um", "--repeats", "3", "--skip",
+                                          "mesh,field,dem,report", "--set", "output.directory=" + (dir / "out").string()};
+  const Result r = magbrush_run(dir, sweep);
+  ASSERT_EQ(r.status, 0) << r.output;
+  const fs::path folder = dir / "out" / "sweep_diameter"; // named by the varied key, not the seeds
+  const double tma[2][3] = {{1.0e-4, 2.0e-4, 6.0e-4}, {3.0e-4, 3.0e-4, 3.0e-4}};
+  const char *labels[2][3] = {{"p0_diameter-100um_seed-1", "p1_diameter-100um_seed-2", "p2_diameter-100um_seed-3"},
+                              {"p3_diameter-120um_seed-1", "p4_diameter-120um_seed-2", "p5_diameter-120um_seed-3"}};
+  for (int p = 0; p < 2; ++p)
+    for (int k = 0; k < 3; ++k)
+    {
+      ASSERT_TRUE(fs::exists(folder / labels[p][k])) << labels[p][k] << "\n" << r.output;
+      fs::create_directories(folder / labels[p][k] / "dem");
+      std::ofstream(folder / labels[p][k] / "dem" / "summary.csv")
+        << "key,value,standard_error,drift,drift_standard_error\n"
+        << "tma_kg_per_m2," << tma[p][k] << ",1e-9,0.1,0.01\nsteady_state," << (p == 1 || k != 1 ? 1 : 0)
+        << ",nan,nan,nan\n";
+    }
+  std::vector<std::string> merge = sweep;
+  merge.push_back("--merge");
+  const Result merged = magbrush_run(dir, merge);
+  ASSERT_EQ(merged.status, 0) << merged.output;
+
+  const auto runs = magbrush::testing::read_csv_rows(folder / "sweep_summary.csv");
+  ASSERT_EQ(runs.size(), 7u); // every run, with its seed
+  const auto rows = magbrush::testing::read_csv_rows(folder / "sweep_mean.csv");
+  ASSERT_EQ(rows.size(), 3u) << merged.output;
+  const auto &h = rows[0];
+  auto column = [&](const std::string &name) {
+    for (std::size_t k = 0; k < h.size(); ++k)
+      if (h[k] == name)
+        return k;
+    ADD_FAILURE() << "no column " << name;
+    return std::size_t(0);
+  };
+  for (const auto &name : h)
+    EXPECT_EQ(name.find("dem.seed"), std::string::npos) << "the seed is not a point's coordinate in the means";
+  EXPECT_EQ(rows[1][column("point")], "p0_diameter-100um");
+  EXPECT_EQ(rows[1][column("populations.carrier.diameter")], "100um");
+  EXPECT_EQ(rows[2][column("populations.carrier.diameter")], "120um");
+  EXPECT_EQ(rows[1][column("repeats")], "3");
+  // 1, 2, 6 (e-4): mean 3e-4, standard error √(7/3) e-4 from the spread, not the runs' 1e-9.
+  EXPECT_NEAR(std::stod(rows[1][column("tma_kg_per_m2")]), 3.0e-4, 1e-10);
+  EXPECT_NEAR(std::stod(rows[1][column("tma_kg_per_m2_stderr")]), std::sqrt(7.0 / 3.0) * 1e-4, 1e-9);
+  EXPECT_NEAR(std::stod(rows[2][column("tma_kg_per_m2_stderr")]), 0.0, 1e-12);
+  EXPECT_NEAR(std::stod(rows[1][column("tma_kg_per_m2_drift")]), 0.1, 1e-9);
+  // One repeat of the first point drifted: the point is not steady; every repeat of the second was.
+  EXPECT_EQ(rows[1][column("steady_state")], "0");
+  EXPECT_EQ(rows[2][column("steady_state")], "1");
+  EXPECT_EQ(rows[1][column("status")], "ok");
+
+  // The seeds are the repeats': varying them as well is refused, as is a repeat count of 0.
+  std::vector<std::string> both = sweep;
+  both.insert(both.begin() + 4, {"--vary", "dem.seed=4,5"});
+  const Result refused = magbrush_run(dir, both);
+  EXPECT_NE(refused.status, 0);
+  EXPECT_NE(refused.output.find("do not also vary dem.seed"), std::string::npos) << refused.output;
+  std::vector<std::string> none = sweep;
+  none[5] = "0";
+  const Result zero = magbrush_run(dir, none);
+  EXPECT_NE(zero.status, 0);
+  EXPECT_NE(zero.output.find("--repeats expects a whole number of runs per point"), std::string::npos) << zero.output;
   fs::remove_all(dir);
 }

@@ -178,6 +178,7 @@ std::vector<ResolvedEntry> resolved_entries(const Case &c)
     e.q(at + ".charge_to_mass_std", "populations[].charge_to_mass_std", p.charge_to_mass_std);
     e.q(at + ".wrong_sign_fraction", "populations[].wrong_sign_fraction", p.wrong_sign_fraction);
     e.b(at + ".counter_charge", "populations[].counter_charge", p.counter_charge);
+    e.b(at + ".attached", "populations[].attached", p.attached);
     if (p.insert_box)
     {
       const auto &bx = *p.insert_box;

@@ -59,6 +59,11 @@ std::vector<KeySpec> particle_keys()
               "Carrier only: the carriers carry the opposite of the total charge of all other particles, "
               "shared by surface area, so that the developer is neutral.")
           .def("false"),
+      boolean("populations[].attached",
+              "Toner with a concentration only: placed touching the carriers' surfaces at random points, "
+              "each carrier carrying the concentration times its own mass, as developer carries its toner "
+              "(instead of at random in the insertion region).")
+          .def("false"),
       Key("populations[].insert_box", KeyType::box, "Insertion box [[xmin, ymin, zmin], [xmax, ymax, zmax]].")
           .dim(D::length),
       quantity("populations[].layer_thickness", D::length, "Insert as a layer of this thickness on the sleeve.")

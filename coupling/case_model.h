@@ -127,6 +127,7 @@ struct Population
   double charge_to_mass_std = 0.0; // spread of q/m between particles [C/kg]
   double wrong_sign_fraction = 0.0; // share of particles charged against the sign of q/m
   bool counter_charge = false;   // carrier: carries minus the charge of all other particles
+  bool attached = false;         // toner with a concentration: placed touching the carriers
   // Where they are inserted: a box (min, max corners) in the scene frame, or, when
   // layer_thickness > 0, a layer of this thickness on the sleeve surface.
   std::optional<std::array<Vec3, 2>> insert_box;

@@ -926,6 +926,7 @@ private:
     p.charge_to_mass_std = q(s, "charge_to_mass_std");
     p.wrong_sign_fraction = q(s, "wrong_sign_fraction");
     p.counter_charge = flag(s, "counter_charge");
+    p.attached = flag(s, "attached");
     if (has(s, "insert_box"))
     {
       const auto &n = leaf(s, "insert_box").numbers;

@@ -274,7 +274,12 @@ void check_populations(const Case &c, std::vector<CaseIssue> &out)
           out.push_back({path + ".insert_box", "the box's first corner must be below its second in x, y and z"});
           break;
         }
-    if (!p.insert_box && p.layer_thickness <= 0.0 && !fed_from_empty)
+    if (p.attached && (p.kind != ParticleKind::toner || p.concentration <= 0.0))
+      out.push_back({path + ".attached", "only toner given by a concentration is attached to the carriers "
+                                         "(each carrier carries the concentration times its own mass)"});
+    if (p.attached && p.kind == ParticleKind::toner && (p.insert_box || p.layer_thickness > 0.0))
+      out.push_back({path + ".attached", "attached toner sits on the carriers: give no insert_box or layer_thickness"});
+    if (!p.insert_box && p.layer_thickness <= 0.0 && !fed_from_empty && !p.attached)
       out.push_back({path, "say where the particles go: insert_box or layer_thickness"});
     if (p.layer_thickness > 0.0 && !c.sleeve)
       out.push_back({path + ".layer_thickness", "a layer on the sleeve needs a sleeve"});

@@ -71,6 +71,67 @@ private:
            static_cast<long long>(c & 0x1FFFFF);
   }
 };
+// Toner as developer carries it: on the carriers. Carrier by carrier (in the order placed),
+// each is owed the concentration times its own mass and gets toner touching its surface at
+// random points, clear of every particle and wall; a toner that finds no room on its carrier
+// is owed to the next one. The diameters were drawn to the concentration times the whole
+// carrier mass, so the owed mass runs out with them; the last few that the running balance
+// leaves over go to the carriers in turn.
+void attach_to_carriers(const Case &c, const DemWalls &walls, const PeriodicBox &box, std::size_t species,
+                        const std::vector<double> &d, const std::vector<double> &charge, PlacementGrid &grid,
+                        std::mt19937_64 &rng, ParticleState &particles)
+{
+  const Population &p = c.populations[species];
+  const double rho = c.material(p.material).density;
+  std::vector<std::size_t> carriers;
+  for (std::size_t k = 0; k < particles.size(); ++k)
+    if (c.populations[static_cast<std::size_t>(particles.species[k])].kind == ParticleKind::carrier)
+      carriers.push_back(k);
+  if (carriers.empty())
+    throw std::invalid_argument("population '" + p.name + "': attached toner needs carriers placed before it");
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  // One try: toner `t` at a random point of carrier `k`'s surface, touching it.
+  auto try_on = [&](std::size_t k, std::size_t t) {
+    const double rt = 0.5 * d[t], reach = (particles.radius[k] + rt) * (1.0 + 1e-9);
+    for (int attempt = 0; attempt < 50; ++attempt)
+    {
+      const double cz = 2.0 * u(rng) - 1.0, ph = 2.0 * M_PI * u(rng), sn = std::sqrt(1.0 - cz * cz);
+      Vector3 q{particles.x[k] + reach * sn * std::cos(ph), particles.y[k] + reach * sn * std::sin(ph),
+                particles.z[k] + reach * cz};
+      double *coordinate[3] = {&q.x, &q.y, &q.z};
+      for (int a = 0; a < 3; ++a)
+        if (box.periodic(a))
+        {
+          const double L = box.length[static_cast<std::size_t>(a)];
+          *coordinate[a] -= L * std::floor(*coordinate[a] / L);
+        }
+      bool clear = !grid.overlaps(particles, q, rt);
+      for (std::size_t w = 0; clear && w < walls.size(); ++w)
+        clear = walls.distance(w, q, 0.0) >= rt;
+      if (!clear)
+        continue;
+      grid.add(q, particles.size());
+      particles.add(q, rt, rho, static_cast<int>(species), charge[t]);
+      return true;
+    }
+    return false;
+  };
+  std::size_t t = 0;
+  double owed = 0.0;
+  for (std::size_t k : carriers)
+  {
+    owed += p.concentration * particles.mass[k];
+    while (t < d.size() && owed >= 0.5 * sphere_mass(d[t], rho) && try_on(k, t))
+      owed -= sphere_mass(d[t++], rho);
+  }
+  for (std::size_t turn = 0; t < d.size() && turn < 4 * carriers.size(); ++turn)
+    if (try_on(carriers[turn % carriers.size()], t))
+      ++t;
+  if (t < d.size())
+    throw std::runtime_error("insertion of population '" + p.name + "': " + std::to_string(d.size() - t) + " of " +
+                             std::to_string(d.size()) + " toner found no room on the carriers' surfaces (a lower "
+                             "concentration, or carriers farther apart)");
+}
 } // namespace
 
 std::vector<double> draw_diameters(const Case &c, const Population &p, double carrier_mass,
@@ -151,6 +212,11 @@ void insert_populations(const Case &c, const DemWalls &walls, const PeriodicBox 
       continue; // fed by the inflow only
     std::sort(d.begin(), d.end(), std::greater<double>()); // largest first: jams last
     const std::vector<double> charge = draw_charges(p, d, mat.density, charge_rng);
+    if (p.attached)
+    {
+      attach_to_carriers(c, walls, box, s, d, charge, grid, rng, particles);
+      continue;
+    }
     // The region's sampler, given the radius.
     std::function<Vector3(double)> sample;
     double region_volume = 0.0;

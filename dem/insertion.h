@@ -1,8 +1,10 @@
 // Populations and insertion: draws each population's diameters (normal, mean ± std,
 // truncated to positive values) until its count, mass or toner concentration is reached,
 // then places the spheres without overlap at random in the population's region (a box, or a
-// layer on the sleeve), largest first, by random sequential addition. The engine then lets
-// them settle (DemSettings::settle_time).
+// layer on the sleeve), largest first, by random sequential addition — or, for toner given
+// by a concentration with `attached: true`, touching the carriers' surfaces at random points,
+// each carrier carrying the concentration times its own mass, as developer carries its toner.
+// The engine then lets them settle (DemSettings::settle_time).
 #pragma once
 
 #include "dem/neighbour_list.h"

@@ -71,6 +71,20 @@ private:
            static_cast<long long>(c & 0x1FFFFF);
   }
 };
+// Adds the sphere (q, r) when it is clear of every particle placed so far and of the walls.
+bool place_if_clear(const Vector3 &q, double r, double density, std::size_t species, double charge,
+                    const DemWalls &walls, PlacementGrid &grid, ParticleState &particles)
+{
+  if (grid.overlaps(particles, q, r))
+    return false;
+  for (std::size_t w = 0; w < walls.size(); ++w)
+    if (walls.distance(w, q, 0.0) < r)
+      return false;
+  grid.add(q, particles.size());
+  particles.add(q, r, density, static_cast<int>(species), charge);
+  return true;
+}
+
 // Toner as developer carries it: on the carriers. Carrier by carrier (in the order placed),
 // each is owed the concentration times its own mass and gets toner touching its surface at
 // random points, clear of every particle and wall; a toner that finds no room on its carrier
@@ -105,14 +119,8 @@ void attach_to_carriers(const Case &c, const DemWalls &walls, const PeriodicBox 
           const double L = box.length[static_cast<std::size_t>(a)];
           *coordinate[a] -= L * std::floor(*coordinate[a] / L);
         }
-      bool clear = !grid.overlaps(particles, q, rt);
-      for (std::size_t w = 0; clear && w < walls.size(); ++w)
-        clear = walls.distance(w, q, 0.0) >= rt;
-      if (!clear)
-        continue;
-      grid.add(q, particles.size());
-      particles.add(q, rt, rho, static_cast<int>(species), charge[t]);
-      return true;
+      if (place_if_clear(q, rt, rho, species, charge[t], walls, grid, particles))
+        return true;
     }
     return false;
   };
@@ -264,15 +272,7 @@ void insert_populations(const Case &c, const DemWalls &walls, const PeriodicBox 
       bool placed = false;
       for (int attempt = 0; attempt < 5000 && !placed; ++attempt)
       {
-        const Vector3 q = sample(r);
-        bool clear = !grid.overlaps(particles, q, r);
-        for (std::size_t w = 0; clear && w < walls.size(); ++w)
-          clear = walls.distance(w, q, 0.0) >= r;
-        if (!clear)
-          continue;
-        grid.add(q, particles.size());
-        particles.add(q, r, mat.density, static_cast<int>(s), charge[k]);
-        placed = true;
+        placed = place_if_clear(sample(r), r, mat.density, s, charge[k], walls, grid, particles);
       }
       if (!placed)
         throw std::runtime_error(

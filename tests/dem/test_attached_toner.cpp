@@ -7,6 +7,8 @@
 
 #include "coupling/case_parser.h"
 
+#include "tests/case_error.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -128,17 +130,7 @@ TEST(AttachedToner, TonerPlacedInTheBoxMostlyTouchesNothing)
 
 TEST(AttachedToner, OnlyTonerGivenByAConcentrationIsAttachedAndItTakesNoRegion)
 {
-  auto error_of = [](const std::string &yaml) -> std::string {
-    try
-    {
-      parse_case_text(yaml, "developer.yaml");
-    }
-    catch (const CaseError &e)
-    {
-      return e.what();
-    }
-    return "";
-  };
+  auto error_of = [](const std::string &yaml) { return magbrush::testing::case_error_of(yaml, "developer.yaml"); };
   std::string by_count = developer("attached: true");
   by_count.replace(by_count.find("concentration: 5 %"), 18, "count: 100");
   const std::string count = error_of(by_count);

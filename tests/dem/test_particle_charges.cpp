@@ -7,6 +7,8 @@
 
 #include "coupling/case_parser.h"
 
+#include "tests/case_error.h"
+
 #include "tests/test_temp_dir.h"
 
 #include <gtest/gtest.h>
@@ -149,17 +151,7 @@ TEST(ParticleCharges, ChargesChangeNoParticleSizeOrPlace)
 
 TEST(ParticleCharges, BadChargeInputIsRefusedWithTheKey)
 {
-  auto error_of = [](const std::string &yaml) -> std::string {
-    try
-    {
-      parse_case_text(yaml, "developer.yaml");
-    }
-    catch (const CaseError &e)
-    {
-      return e.what();
-    }
-    return "";
-  };
+  auto error_of = [](const std::string &yaml) { return magbrush::testing::case_error_of(yaml, "developer.yaml"); };
   // A q/m in the wrong unit names the key and the unit expected.
   std::string yaml = developer("");
   yaml.replace(yaml.find("-30 uC/g"), 8, "-30 uC");

@@ -100,7 +100,17 @@ def plot_keys(plt, directory, header, rows, requested):
         ax.errorbar(xs, ys, yerr=errors, fmt="o-", capsize=4, label=label)
         if key + "_bound" in col:
             bound = [number(r[col[key + "_bound"]]) for r in rows]
+            # Values far below their bound (a transient's TMA at 1 % of the neutralisation
+            # bound) would lie flat on the axis: a log scale shows both (a zero bound, at zero
+            # contrast, is then left out of the line).
+            finite = [b for b in bound if b == b and b > 0]
+            log = bool(finite) and all(y == y and y > 0 for y in ys) and max(ys) < 0.05 * max(finite)
+            if log:
+                ax.set_yscale("log")
+                bound = [b if b > 0 else float("nan") for b in bound]
             ax.plot(xs, bound, "k--", lw=1.2, label="physical bound")
+            if log:
+                ax.plot([], [], " ", label="log scale: the values lie below 5 % of the bound")
         measured = "measured_" + key
         if measured in col:
             mys = [number(r[col[measured]]) for r in rows]

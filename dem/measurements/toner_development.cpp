@@ -92,6 +92,7 @@ TonerDevelopment::TonerDevelopment(const Case &c)
   for (const auto &p : c.populations)
   {
     is_toner_.push_back(p.kind == ParticleKind::toner);
+    is_carrier_.push_back(p.kind == ParticleKind::carrier);
     if (p.kind == ParticleKind::toner && toner_q_over_m_ == 0.0)
       toner_q_over_m_ = p.charge_to_mass;
   }
@@ -125,10 +126,48 @@ void TonerDevelopment::sample(const DemSystem &system)
     if (s < is_toner_.size() && is_toner_[s])
       toner_.push_back({p.id[r.particle], p.x[r.particle], p.y[r.particle], p.mass[r.particle], p.charge[r.particle]});
   }
-  add_sample(system.time(), toner_);
+  add_sample(system.time(), toner_, toner_share_on_carriers(system, is_toner_, is_carrier_));
 }
 
-void TonerDevelopment::add_sample(double time, const std::vector<DrumToner> &on_drum_now)
+double TonerDevelopment::toner_share_on_carriers(const DemSystem &system, const std::vector<std::uint8_t> &is_toner,
+                                                 const std::vector<std::uint8_t> &is_carrier)
+{
+  const ParticleState &p = system.particles();
+  const NeighbourList &list = system.neighbour_list();
+  const double range = system.contact_table().adhesion_range();
+  auto species_is = [&](const std::vector<std::uint8_t> &flags, std::size_t k) {
+    const auto s = static_cast<std::size_t>(p.species[k]);
+    return s < flags.size() && flags[s];
+  };
+  std::vector<std::uint8_t> on(p.size(), 0);
+  for (std::size_t q = 0; q < list.pairs(); ++q)
+  {
+    const auto i = static_cast<std::size_t>(list.owner[q]), j = static_cast<std::size_t>(list.partner[q]);
+    const bool toner_carrier = species_is(is_toner, i) && species_is(is_carrier, j);
+    const bool carrier_toner = species_is(is_carrier, i) && species_is(is_toner, j);
+    if (!toner_carrier && !carrier_toner)
+      continue;
+    bool held = list.touching[q] != 0;
+    if (!held && range > 0.0)
+    {
+      const Vector3 s = list.shift(q);
+      const double dx = p.x[j] - p.x[i] + s.x, dy = p.y[j] - p.y[i] + s.y, dz = p.z[j] - p.z[i] + s.z;
+      held = std::sqrt(dx * dx + dy * dy + dz * dz) - p.radius[i] - p.radius[j] <= range;
+    }
+    if (held)
+      on[toner_carrier ? i : j] = 1;
+  }
+  double all = 0.0, carried = 0.0;
+  for (std::size_t k = 0; k < p.size(); ++k)
+    if (species_is(is_toner, k))
+    {
+      all += p.mass[k];
+      carried += on[k] ? p.mass[k] : 0.0;
+    }
+  return all > 0.0 ? carried / all : std::numeric_limits<double>::quiet_NaN();
+}
+
+void TonerDevelopment::add_sample(double time, const std::vector<DrumToner> &on_drum_now, double on_carriers)
 {
   std::vector<DrumToner> now = on_drum_now;
   std::sort(now.begin(), now.end(), [](const DrumToner &a, const DrumToner &b) { return a.id < b.id; });
@@ -188,7 +227,9 @@ void TonerDevelopment::add_sample(double time, const std::vector<DrumToner> &on_
     else
       m_dark += t.mass, ++n_dark;
   }
-  Row row{time, nan, nan, nan, nan, nan, n_image, n_dark};
+  Row row{time, nan, nan, nan, nan, nan, on_carriers, n_image, n_dark};
+  if (!std::isnan(on_carriers))
+    on_carriers_.add(on_carriers);
   if (image_area > 0.0)
   {
     row.tma = m_image / image_area;
@@ -231,6 +272,8 @@ std::vector<SummaryValue> TonerDevelopment::summary() const
       sampled("neutralisation_ratio", ratio_, false, "1", "developed charge per area / (eps0 epsr dV / L)"),
       sampled("toner_transfer_rate_kg_per_s_m", transfer_, true, "kg/(s m)",
               "toner mass arriving on the drum per time and slab depth"),
+      sampled("toner_on_carriers_fraction", on_carriers_, false, "1",
+              "toner mass within the adhesion range of a carrier / all toner mass (the whole scene)"),
       contrast,
   };
 }
@@ -241,12 +284,12 @@ std::string TonerDevelopment::csv() const
   o << "# toner on the drum between x = " << settings_.measure_from * 1e3 << " and " << settings_.measure_to * 1e3
     << " mm after the nip (magbrush toner development); NaN: no area or no toner\n";
   o << "time_s,tma_kg_per_m2,fog_kg_per_m2,developed_q_over_m_C_per_kg,neutralisation_ratio,"
-       "transfer_rate_kg_per_s_m,image_toner,dark_toner\n";
+       "transfer_rate_kg_per_s_m,toner_on_carriers_fraction,image_toner,dark_toner\n";
   char line[256];
   for (const Row &r : rows_)
   {
-    std::snprintf(line, sizeof line, "%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%ld,%ld\n", r.time, r.tma, r.fog, r.q_over_m,
-                  r.ratio, r.transfer, r.image_toner, r.dark_toner);
+    std::snprintf(line, sizeof line, "%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%ld,%ld\n", r.time, r.tma, r.fog,
+                  r.q_over_m, r.ratio, r.transfer, r.on_carriers, r.image_toner, r.dark_toner);
     o << line;
   }
   return o.str();
@@ -310,13 +353,13 @@ void TonerDevelopment::write_state(StateOut &out) const
   out.put(previous_time_);
   out.put(first_time_);
   out.put(last_time_);
-  for (const auto *s : {&tma_, &fog_, &q_over_m_, &ratio_, &transfer_})
+  for (const auto *s : {&tma_, &fog_, &q_over_m_, &ratio_, &transfer_, &on_carriers_})
     s->write_state(out);
   std::vector<double> values;
   std::vector<long> counts;
   for (const Row &r : rows_)
   {
-    values.insert(values.end(), {r.time, r.tma, r.fog, r.q_over_m, r.ratio, r.transfer});
+    values.insert(values.end(), {r.time, r.tma, r.fog, r.q_over_m, r.ratio, r.transfer, r.on_carriers});
     counts.insert(counts.end(), {r.image_toner, r.dark_toner});
   }
   out.put_array(values);
@@ -346,19 +389,19 @@ void TonerDevelopment::read_state(StateIn &in)
   previous_time_ = in.get<double>();
   first_time_ = in.get<double>();
   last_time_ = in.get<double>();
-  for (auto *s : {&tma_, &fog_, &q_over_m_, &ratio_, &transfer_})
+  for (auto *s : {&tma_, &fog_, &q_over_m_, &ratio_, &transfer_, &on_carriers_})
     s->read_state(in);
   std::vector<double> values;
   std::vector<long> counts;
   in.get_array(values);
   in.get_array(counts);
-  if (values.size() % 6 != 0 || counts.size() != values.size() / 3)
+  if (values.size() % 7 != 0 || counts.size() != 2 * (values.size() / 7))
     in.fail("is corrupt (the development rows)");
   rows_.clear();
   for (std::size_t k = 0; k < counts.size() / 2; ++k)
   {
-    const double *v = &values[6 * k];
-    rows_.push_back({v[0], v[1], v[2], v[3], v[4], v[5], counts[2 * k], counts[2 * k + 1]});
+    const double *v = &values[7 * k];
+    rows_.push_back({v[0], v[1], v[2], v[3], v[4], v[5], v[6], counts[2 * k], counts[2 * k + 1]});
   }
 }
 

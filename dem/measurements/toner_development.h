@@ -18,7 +18,10 @@
 //    (thickness L, εr) — 1 is the physical limit of development, where
 //        TMA_bound = ε0 εr ΔV / (L |q/m|);
 //  * along the whole nip: where toner ARRIVES on the drum (not touching at the previous sample,
-//    touching now) and leaves it again, per bin of x, and the transfer rate per slab depth.
+//    touching now) and leaves it again, per bin of x, and the transfer rate per slab depth;
+//  * in the whole scene: the share of the toner mass that sits on a carrier (within the adhesion
+//    range of one), the developer's hold on its toner — toner that leaves its carrier before the
+//    nip develops as a free cloud, whatever the contrast.
 // ΔV = |V_bias − V_exposed|; for an image given as surface charges, V_exposed = σ L/(ε0 εr),
 // the potential of the charged layer on its grounded substrate.
 //
@@ -34,6 +37,7 @@
 #include "dem/wall_contact_slots.h"
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -72,6 +76,7 @@ public:
   static bool applies(const Case &c);
 
   const char *name() const override { return "toner development"; }
+  int state_version() const override { return 2; } // 2: the toner on the carriers
   double interval() const override { return settings_.sample_interval; }
   void sample(const DemSystem &system) override;
   void write(const std::string &directory) const override;
@@ -79,14 +84,21 @@ public:
   void read_state(StateIn &in) override;
   std::vector<SummaryValue> summary() const override;
 
-  // The same from hand-made records (what sample() extracts from the engine).
-  void add_sample(double time, const std::vector<DrumToner> &on_drum);
+  // The same from hand-made records (what sample() extracts from the engine); `on_carriers`:
+  // the toner mass on carriers / all toner mass (NaN: not known).
+  void add_sample(double time, const std::vector<DrumToner> &on_drum,
+                  double on_carriers = std::numeric_limits<double>::quiet_NaN());
+  // The toner mass within the adhesion range of a carrier (its touching pairs, when the
+  // contacts do not attract) over all toner mass, from the neighbour list's pairs.
+  static double toner_share_on_carriers(const DemSystem &system, const std::vector<std::uint8_t> &is_toner,
+                                        const std::vector<std::uint8_t> &is_carrier);
 
   double contrast_potential() const { return contrast_; } // ΔV [V]
   double tma_bound() const;                                // [kg/m²]
   const SampleSeries &tma() const { return tma_; }
   const SampleSeries &fog() const { return fog_; }
   const SampleSeries &neutralisation() const { return ratio_; }
+  const SampleSeries &on_carriers() const { return on_carriers_; }
 
   std::string csv() const;
   std::string transfer_profile_csv() const;
@@ -104,16 +116,16 @@ private:
   std::vector<DrumToner> before_;      // the toner on the drum at the previous sample, by id
   std::vector<double> arrived_, left_; // toner mass arriving on / leaving the drum per bin [kg]
   double previous_time_ = -1.0, first_time_ = -1.0, last_time_ = -1.0;
-  SampleSeries tma_, fog_, q_over_m_, ratio_, transfer_;
+  SampleSeries tma_, fog_, q_over_m_, ratio_, transfer_, on_carriers_;
   struct Row
   {
-    double time, tma, fog, q_over_m, ratio, transfer;
+    double time, tma, fog, q_over_m, ratio, transfer, on_carriers;
     long image_toner, dark_toner;
   };
   std::vector<Row> rows_;
   std::vector<WallContactRecord> records_;
   std::vector<DrumToner> toner_;
-  std::vector<std::uint8_t> is_toner_; // by species
+  std::vector<std::uint8_t> is_toner_, is_carrier_; // by species
 };
 
 } // namespace magbrush::dem

@@ -5,7 +5,10 @@
 // drum between two samples (transfer rate and where).
 #include "dem/measurements/toner_development.h"
 
+#include "dem/dem_system.h"
 #include "dem/run_summary.h"
+
+#include "coupling/case_parser.h"
 
 #include <gtest/gtest.h>
 
@@ -200,4 +203,67 @@ TEST(TonerDevelopment, AppliesToNipScenesWithTonerAndAField)
   c = development_case();
   c.populations.pop_back();
   EXPECT_FALSE(TonerDevelopment::applies(c));
+}
+
+// The developer's hold on its toner: the toner mass within the adhesion range of a carrier (or
+// overlapping one) over all toner mass, from the neighbour list's pairs. Toner placed by hand
+// around one carrier at known gaps: 1 nm (held: inside the 4 nm range), 10 nm (free), a 10 nm
+// overlap (held), one touching only another toner, one far away, and one held across the
+// periodic boundary (the pair's image shift counts).
+TEST(TonerDevelopment, TonerOnCarriersIsTheMassWithinTheAdhesionRangeOfOne)
+{
+  const Case c = parse_case_text(R"(
+name: retention
+scene: box
+materials:
+  carrier: {youngs_modulus: 1e3 MPa, poisson_ratio: 0.35, density: 2200 kg/m^3, friction: 0.45, damping: 0.6, hamaker: 1e-19 J}
+  toner: {youngs_modulus: 3e3 MPa, poisson_ratio: 0.35, density: 1100 kg/m^3, friction: 0.3, damping: 0.6, hamaker: 1e-19 J}
+  wall: {youngs_modulus: 5e4 MPa, poisson_ratio: 0.3, friction: 0.35, hamaker: 0 J}
+planes:
+  - {name: floor, point: [0 mm, 0 mm, 0 mm], normal: [0, 0, 1], material: wall}
+populations:
+  - {name: carrier, kind: carrier, diameter: 35 um, count: 1, insert_box: [[0 mm, 0 mm, 0 mm], [1 mm, 1 mm, 1 mm]]}
+  - {name: toner, kind: toner, diameter: 7 um, count: 1, charge_to_mass: -30 uC/g, insert_box: [[0 mm, 0 mm, 0 mm], [1 mm, 1 mm, 1 mm]]}
+dem: {gravity: [0, 0, 0], periodic_length_x: 1 mm, periodic_length_y: 1 mm}
+)",
+                                 "retention.yaml");
+  DemSystem system(c);
+  ParticleState &p = system.particles();
+  const double rc = 17.5e-6, centre = 0.5e-3;
+  p.add({centre, centre, centre}, rc, 2200.0, 0, 0.0);
+  p.add({1e-6, centre, centre}, rc, 2200.0, 0, 0.0); // a carrier at the periodic boundary
+  // A toner of radius rt at a surface gap from the carrier centred at (cx, centre, centre).
+  auto toner_at = [&](double cx, double gap, double rt, double angle) {
+    const double d = rc + rt + gap;
+    p.add({cx + d * std::cos(angle), centre + d * std::sin(angle), centre}, rt, 1100.0, 1, -1e-15);
+  };
+  toner_at(centre, 1e-9, 3.0e-6, 0.0);       // held (1 nm)
+  toner_at(centre, 10e-9, 3.5e-6, M_PI / 2); // free (10 nm > 4 nm)
+  toner_at(centre, -10e-9, 4.0e-6, M_PI);    // held (overlapping)
+  p.add({centre + 0.2e-3, centre, centre}, 3.2e-6, 1100.0, 1, -1e-15);          // free, far
+  p.add({centre + 0.2e-3 + 6.4e-6, centre, centre}, 3.2e-6, 1100.0, 1, -1e-15); // on a toner only
+  toner_at(1e-6, 2e-9, 3.7e-6, M_PI); // held through the boundary: x < 0 ...
+  p.x.back() += 1e-3;                 // ... placed at the far side of the box
+  system.initialize();
+  auto mass = [](double r) { return 1100.0 * 4.0 / 3.0 * M_PI * r * r * r; };
+  const double held = mass(3.0e-6) + mass(4.0e-6) + mass(3.7e-6);
+  const double all = held + mass(3.5e-6) + 2 * mass(3.2e-6);
+  ASSERT_GT(system.contact_table().adhesion_range(), 1e-9);
+  EXPECT_NEAR(TonerDevelopment::toner_share_on_carriers(system, {0, 1}, {1, 0}), held / all, 1e-12);
+  // Species flags the other way round: no toner, no share.
+  EXPECT_TRUE(std::isnan(TonerDevelopment::toner_share_on_carriers(system, {0, 0}, {1, 0})));
+}
+
+TEST(TonerDevelopment, TheShareOnCarriersIsSampledIntoTheSummary)
+{
+  TonerDevelopment m(development_case());
+  m.add_sample(1e-3, {}, 0.8);
+  m.add_sample(2e-3, {}, 0.6);
+  EXPECT_NEAR(m.on_carriers().mean(), 0.7, 1e-12);
+  bool found = false;
+  for (const auto &v : m.summary())
+    if (v.key == "toner_on_carriers_fraction")
+      found = std::abs(v.value - 0.7) < 1e-12;
+  EXPECT_TRUE(found);
+  EXPECT_NE(m.csv().find("toner_on_carriers_fraction"), std::string::npos);
 }

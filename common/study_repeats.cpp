@@ -14,7 +14,7 @@ constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 struct Column
 {
   std::vector<double> values, drifts, drift_errors;
-  bool missing_verdict = false; // a repeat reported the key without a value
+  bool some_without_value = false; // a repeat reported the key as NaN (no verdict)
 };
 
 double mean(const std::vector<double> &v)
@@ -47,7 +47,7 @@ SummaryRow combined_verdict(const std::string &key, const Column &c)
   if (c.values.empty())
     return r;
   if (key == "steady_state")
-    r.value = c.missing_verdict ? nan : *std::min_element(c.values.begin(), c.values.end());
+    r.value = c.some_without_value ? nan : *std::min_element(c.values.begin(), c.values.end());
   else // significant_drift, drift_resolution
     r.value = *std::max_element(c.values.begin(), c.values.end());
   return r;
@@ -70,7 +70,7 @@ std::vector<SummaryRow> mean_of_repeats(const std::vector<std::vector<SummaryRow
       }
       Column &c = columns[static_cast<std::size_t>(it - keys.begin())];
       if (std::isnan(row.value))
-        c.missing_verdict = true;
+        c.some_without_value = true;
       else
         c.values.push_back(row.value);
       if (!std::isnan(row.drift))

@@ -71,6 +71,17 @@ private:
            static_cast<long long>(c & 0x1FFFFF);
   }
 };
+} // namespace
+
+Vector3 touching_point(const Vector3 &centre, double rc, double rt, std::mt19937_64 &rng)
+{
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double cz = 2.0 * u(rng) - 1.0, ph = 2.0 * M_PI * u(rng), s = std::sqrt(1.0 - cz * cz);
+  const double reach = (rc + rt) * (1.0 + 1e-9);
+  return {centre.x + reach * s * std::cos(ph), centre.y + reach * s * std::sin(ph), centre.z + reach * cz};
+}
+
+namespace {
 // Adds the sphere (q, r) when it is clear of every particle placed so far and of the walls.
 bool place_if_clear(const Vector3 &q, double r, double density, std::size_t species, double charge,
                     const DemWalls &walls, PlacementGrid &grid, ParticleState &particles)
@@ -103,15 +114,12 @@ void attach_to_carriers(const Case &c, const DemWalls &walls, const PeriodicBox 
       carriers.push_back(k);
   if (carriers.empty())
     throw std::invalid_argument("population '" + p.name + "': attached toner needs carriers placed before it");
-  std::uniform_real_distribution<double> u(0.0, 1.0);
   // One try: toner `t` at a random point of carrier `k`'s surface, touching it.
   auto try_on = [&](std::size_t k, std::size_t t) {
-    const double rt = 0.5 * d[t], reach = (particles.radius[k] + rt) * (1.0 + 1e-9);
+    const double rt = 0.5 * d[t];
     for (int attempt = 0; attempt < 50; ++attempt)
     {
-      const double cz = 2.0 * u(rng) - 1.0, ph = 2.0 * M_PI * u(rng), sn = std::sqrt(1.0 - cz * cz);
-      Vector3 q{particles.x[k] + reach * sn * std::cos(ph), particles.y[k] + reach * sn * std::sin(ph),
-                particles.z[k] + reach * cz};
+      Vector3 q = touching_point(particles.position(k), particles.radius[k], rt, rng);
       double *coordinate[3] = {&q.x, &q.y, &q.z};
       for (int a = 0; a < 3; ++a)
         if (box.periodic(a))

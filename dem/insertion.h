@@ -23,6 +23,11 @@ namespace magbrush::dem {
 std::vector<double> draw_diameters(const Case &c, const Population &p, double carrier_mass,
                                    std::mt19937_64 &rng);
 
+// A random point (uniform over the sphere) at distance (rc + rt)(1 + 1e-9) from `centre`: a
+// sphere of radius rt there touches the sphere (centre, rc) without overlapping it. Toner
+// attached to a carrier, at insertion and by the inflow, is placed so.
+Vector3 touching_point(const Vector3 &centre, double rc, double rt, std::mt19937_64 &rng);
+
 // Fills `particles` with every population of the case, species = population index.
 void insert_populations(const Case &c, const DemWalls &walls, const PeriodicBox &box,
                         ParticleState &particles);

@@ -2,6 +2,7 @@
 #include "dem/particle_source.h"
 
 #include "dem/checkpoint_file.h"
+#include "dem/insertion.h"
 
 #include <algorithm>
 #include <cmath>
@@ -224,7 +225,6 @@ bool ParticleSource::place_carrier(double d, double theta0, double dphi, double 
 void ParticleSource::attach_toner(const Vector3 &c, double rc, double t, ParticleState &enter)
 {
   const double mc = sphere_mass(2.0 * rc, carrier_.density);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
   for (std::size_t k = 0; k < toner_.size(); ++k)
   {
     const Feed &f = toner_[k];
@@ -238,9 +238,7 @@ void ParticleSource::attach_toner(const Vector3 &c, double rc, double t, Particl
       for (int attempt = 0; attempt < toner_attempts && !placed; ++attempt)
       {
         // A random point of the carrier's surface; the toner touches it without overlap.
-        const double cz = 2.0 * u(rng_) - 1.0, ph = 2.0 * M_PI * u(rng_), s = std::sqrt(1.0 - cz * cz);
-        const double reach = (rc + 0.5 * d) * (1.0 + 1e-9);
-        Vector3 p{c.x + reach * s * std::cos(ph), c.y + reach * s * std::sin(ph), c.z + reach * cz};
+        Vector3 p = touching_point(c, rc, 0.5 * d, rng_);
         p.z -= Lz_ * std::floor(p.z / Lz_);
         if (!clear_of_everything(p, 0.5 * d))
           continue;

@@ -179,6 +179,7 @@ std::vector<ResolvedEntry> resolved_entries(const Case &c)
     e.q(at + ".wrong_sign_fraction", "populations[].wrong_sign_fraction", p.wrong_sign_fraction);
     e.b(at + ".counter_charge", "populations[].counter_charge", p.counter_charge);
     e.b(at + ".attached", "populations[].attached", p.attached);
+    e.q(at + ".carried_until_gap", "populations[].carried_until_gap", p.carried_until_gap);
     if (p.insert_box)
     {
       const auto &bx = *p.insert_box;

@@ -64,6 +64,13 @@ std::vector<KeySpec> particle_keys()
               "each carrier carrying the concentration times its own mass, as developer carries its toner "
               "(instead of at random in the insertion region).")
           .def("false"),
+      quantity("populations[].carried_until_gap", D::length,
+               "Toner on the carriers (attached, or fed by the inflow) only: the reduced toner model. Each "
+               "carrier carries its toner as a count, mass and charge (part of its own) instead of as "
+               "particles, until its surface comes this close to the drum surface; then the toner is placed "
+               "touching it at random points as particles, which may develop. 0 = the toner is always "
+               "particles. Assumes no toner leaves a carrier farther from the drum.")
+          .def("0 um").non_negative(),
       Key("populations[].insert_box", KeyType::box, "Insertion box [[xmin, ymin, zmin], [xmax, ymax, zmax]].")
           .dim(D::length),
       quantity("populations[].layer_thickness", D::length, "Insert as a layer of this thickness on the sleeve.")

@@ -128,6 +128,10 @@ struct Population
   double wrong_sign_fraction = 0.0; // share of particles charged against the sign of q/m
   bool counter_charge = false;   // carrier: carries minus the charge of all other particles
   bool attached = false;         // toner with a concentration: placed touching the carriers
+  // Toner on carriers (attached or fed by the inflow) rides them as mass and charge until the
+  // carrier's surface is this close to the drum, then becomes particles (0 = always
+  // particles; dem/carried_toner.h) [m].
+  double carried_until_gap = 0.0;
   // Where they are inserted: a box (min, max corners) in the scene frame, or, when
   // layer_thickness > 0, a layer of this thickness on the sleeve surface.
   std::optional<std::array<Vec3, 2>> insert_box;

@@ -927,6 +927,7 @@ private:
     p.wrong_sign_fraction = q(s, "wrong_sign_fraction");
     p.counter_charge = flag(s, "counter_charge");
     p.attached = flag(s, "attached");
+    p.carried_until_gap = q(s, "carried_until_gap");
     if (has(s, "insert_box"))
     {
       const auto &n = leaf(s, "insert_box").numbers;

@@ -228,6 +228,7 @@ void check_populations(const Case &c, std::vector<CaseIssue> &out)
   bool has_carrier = false;
   for (const auto &p : c.populations)
     has_carrier = has_carrier || p.kind == ParticleKind::carrier;
+  bool carried_seen = false;
   for (const auto &p : c.populations)
   {
     const std::string path = "populations." + p.name;
@@ -279,6 +280,19 @@ void check_populations(const Case &c, std::vector<CaseIssue> &out)
                                          "(each carrier carries the concentration times its own mass)"});
     if (p.attached && p.kind == ParticleKind::toner && (p.insert_box || p.layer_thickness > 0.0))
       out.push_back({path + ".attached", "attached toner sits on the carriers: give no insert_box or layer_thickness"});
+    if (p.carried_until_gap > 0.0)
+    {
+      if (p.kind != ParticleKind::toner || p.concentration <= 0.0)
+        out.push_back({path + ".carried_until_gap", "only toner given by a concentration rides the carriers"});
+      else if (!p.attached && !c.flow.inflow())
+        out.push_back({path + ".carried_until_gap", "carried toner is the toner on the carriers: set attached: true, "
+                                                    "or feed the developer with an inflow"});
+      if (!c.drum.present)
+        out.push_back({path + ".carried_until_gap", "carried toner is released near the drum, and the case has no drum"});
+      if (carried_seen)
+        out.push_back({path + ".carried_until_gap", "only one toner population may ride the carriers"});
+      carried_seen = true;
+    }
     if (!p.insert_box && p.layer_thickness <= 0.0 && !fed_from_empty && !p.attached)
       out.push_back({path, "say where the particles go: insert_box or layer_thickness"});
     if (p.layer_thickness > 0.0 && !c.sleeve)

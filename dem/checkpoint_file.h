@@ -1,7 +1,7 @@
 // The DEM checkpoint's file format: a flat binary file
 //
-//   "MBDEMCK4"                        8-byte magic (3: force-term state; 4: case identity
-//                                     and checksum)
+//   "MBDEMCK5"                        8-byte magic (3: force-term state; 4: case identity
+//                                     and checksum; 5: toner carried by the carriers)
 //   case identity                     the case hash and the resolved case inputs (key = value
 //                                     lines) of the run that wrote it (CheckpointIdentity)
 //   state                             scalars and length-prefixed arrays in the order the

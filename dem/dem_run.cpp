@@ -34,7 +34,7 @@ DemRun::DemRun(const Case &c, const RunOptions &options, std::ostream &log)
   force_terms_ = add_case_force_terms(*system_, case_);
   identity_.case_hash = case_hash(case_);
   identity_.inputs = case_inputs(case_);
-  if (case_.flow.inflow() || case_.flow.outflow())
+  if (case_.flow.inflow() || case_.flow.outflow() || carried_toner_population(case_) >= 0)
     system_->set_particle_exchange(std::make_unique<ParticleFlow>(case_, *system_));
 }
 

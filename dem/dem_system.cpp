@@ -759,7 +759,7 @@ template <typename State, typename Forces>
 auto checkpoint_arrays(State &s, Forces &f)
 {
   return std::array{&s.x, &s.y, &s.z, &s.vx, &s.vy, &s.vz, &s.wx, &s.wy, &s.wz, &s.radius, &s.mass,
-                    &s.inv_mass, &s.inv_inertia, &s.charge, &f.fx, &f.fy, &f.fz, &f.tx, &f.ty, &f.tz};
+                    &s.inv_mass, &s.inv_inertia, &s.charge, &s.carried_mass, &s.carried_charge, &f.fx, &f.fy, &f.fz, &f.tx, &f.ty, &f.tz};
 }
 } // namespace
 
@@ -778,6 +778,7 @@ void DemSystem::write_checkpoint(const std::string &path, const CheckpointIdenti
     out.put_array(*a);
   out.put_array(particles_.species);
   out.put_array(particles_.id);
+  out.put_array(particles_.carried_count);
   out.put_array(contact_count_);
   // The positions the neighbour list was built from: a restart builds the same list from
   // them (the same pairs in the same order), so that writing a checkpoint changes nothing in
@@ -831,6 +832,7 @@ void DemSystem::read_checkpoint(const std::string &path, const std::function<voi
     in.get_array(*a);
   in.get_array(particles_.species);
   in.get_array(particles_.id);
+  in.get_array(particles_.carried_count);
   in.get_array(contact_count_);
   std::vector<double> x0, y0, z0;
   in.get_array(x0);
@@ -845,7 +847,8 @@ void DemSystem::read_checkpoint(const std::string &path, const std::function<voi
   for (const auto *a : checkpoint_arrays(particles_, forces_))
     if (a->size() != n)
       in.fail("is corrupt (particle arrays of different lengths)");
-  if (particles_.species.size() != n || particles_.id.size() != n || contact_count_.size() != n ||
+  if (particles_.species.size() != n || particles_.id.size() != n || particles_.carried_count.size() != n ||
+      contact_count_.size() != n ||
       x0.size() != n || y0.size() != n || z0.size() != n)
     in.fail("is corrupt (particle arrays of different lengths)");
   // Derived set-up (contact table, time-step check, skin) as for a fresh run, then the state.

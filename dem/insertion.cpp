@@ -1,6 +1,7 @@
 // Population sampling and random sequential insertion (see insertion.h).
 #include "dem/insertion.h"
 
+#include "dem/carried_toner.h"
 #include "dem/particle_charges.h"
 
 #include <algorithm>
@@ -116,6 +117,12 @@ void attach_to_carriers(const Case &c, const DemWalls &walls, const PeriodicBox 
     throw std::invalid_argument("population '" + p.name + "': attached toner needs carriers placed before it");
   // One try: toner `t` at a random point of carrier `k`'s surface, touching it.
   auto try_on = [&](std::size_t k, std::size_t t) {
+    if (p.carried_until_gap > 0.0)
+    {
+      // Carried (dem/carried_toner.h): part of the carrier's mass and charge, no particle.
+      load_carried_toner(particles, k, 1, sphere_mass(d[t], rho), charge[t]);
+      return true;
+    }
     const double rt = 0.5 * d[t];
     for (int attempt = 0; attempt < 50; ++attempt)
     {
@@ -136,7 +143,7 @@ void attach_to_carriers(const Case &c, const DemWalls &walls, const PeriodicBox 
   double owed = 0.0;
   for (std::size_t k : carriers)
   {
-    owed += p.concentration * particles.mass[k];
+    owed += p.concentration * (particles.mass[k] - particles.carried_mass[k]); // its own mass
     while (t < d.size() && owed >= 0.5 * sphere_mass(d[t], rho) && try_on(k, t))
       owed -= sphere_mass(d[t++], rho);
   }

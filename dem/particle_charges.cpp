@@ -48,7 +48,10 @@ void assign_counter_charges(const Case &c, ParticleState &particles)
   for (std::size_t k = 0; k < particles.size(); ++k)
   {
     if (counter[static_cast<std::size_t>(particles.species[k])])
+    {
       area += particles.radius[k] * particles.radius[k];
+      others += particles.carried_charge[k]; // toner it carries (dem/carried_toner.h)
+    }
     else
       others += particles.charge[k];
   }
@@ -57,7 +60,7 @@ void assign_counter_charges(const Case &c, ParticleState &particles)
   const double per_area = -others / area;
   for (std::size_t k = 0; k < particles.size(); ++k)
     if (counter[static_cast<std::size_t>(particles.species[k])])
-      particles.charge[k] = per_area * particles.radius[k] * particles.radius[k];
+      particles.charge[k] = per_area * particles.radius[k] * particles.radius[k] + particles.carried_charge[k];
 }
 
 } // namespace magbrush::dem

@@ -1,6 +1,7 @@
 // The outflow (see particle_sink.h).
 #include "dem/particle_sink.h"
 
+#include "dem/carried_toner.h"
 #include "dem/checkpoint_file.h"
 
 #include <cmath>
@@ -12,6 +13,8 @@ ParticleSink::ParticleSink(const Case &c)
     sense_(c.sleeve && c.sleeve->omega() < 0.0 ? -1.0 : 1.0), outer_radius_(c.flow.outflow_radius),
     count_(c.populations.size(), 0), mass_(c.populations.size(), 0.0)
 {
+  const int carried = carried_toner_population(c);
+  carried_ = carried >= 0 ? static_cast<std::size_t>(carried) : 0;
 }
 
 bool ParticleSink::removes(const Vector3 &p) const
@@ -34,7 +37,12 @@ void ParticleSink::select(const ParticleState &s, std::vector<std::int32_t> &lea
       leave.push_back(static_cast<std::int32_t>(i));
       const std::size_t sp = static_cast<std::size_t>(s.species[i]);
       count_[sp] += 1;
-      mass_[sp] += s.mass[i];
+      mass_[sp] += s.mass[i] - s.carried_mass[i];
+      if (s.carried_count[i] > 0) // the toner it carries leaves as toner (dem/carried_toner.h)
+      {
+        count_[carried_] += static_cast<long>(s.carried_count[i]);
+        mass_[carried_] += s.carried_mass[i];
+      }
     }
 }
 

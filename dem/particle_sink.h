@@ -37,6 +37,7 @@ public:
 
 private:
   double angle_ = 0.0, width_ = 0.0, sense_ = 1.0, outer_radius_ = 0.0;
+  std::size_t carried_ = 0; // the population of the toner carriers carry (carried_toner.h), if any
   std::vector<long> count_;
   std::vector<double> mass_;
 };

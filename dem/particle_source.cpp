@@ -1,6 +1,7 @@
 // The inflow on the sleeve (see particle_source.h).
 #include "dem/particle_source.h"
 
+#include "dem/carried_toner.h"
 #include "dem/checkpoint_file.h"
 #include "dem/insertion.h"
 
@@ -38,6 +39,7 @@ ParticleSource::ParticleSource(const Case &c, const DemWalls &walls, const Perio
     fd.d_max = fd.d_mean + 3.0 * fd.d_std;
     fd.charge_to_mass = p.charge_to_mass;
     fd.concentration = p.concentration;
+    fd.carried = p.carried_until_gap > 0.0;
     return fd;
   };
   int carrier = -1;
@@ -198,10 +200,16 @@ void ParticleSource::append(const Feed &f, const Vector3 &p, double d, double t,
   enter.wz.back() = w;
   near_x_.push_back(p);
   near_r_.push_back(0.5 * d);
+  count_created(f, enter.mass.back());
+}
+
+// A particle of feed f and mass m created: drawn from a finite sump, counted.
+void ParticleSource::count_created(const Feed &f, double m)
+{
   if (finite_sump_ && drawing_)
-    stock_[static_cast<std::size_t>(f.species)] -= enter.mass.back();
+    stock_[static_cast<std::size_t>(f.species)] -= m;
   count_[static_cast<std::size_t>(f.species)] += 1;
-  mass_[static_cast<std::size_t>(f.species)] += enter.mass.back();
+  mass_[static_cast<std::size_t>(f.species)] += m;
 }
 
 bool ParticleSource::place_carrier(double d, double theta0, double dphi, double t, ParticleState &enter)
@@ -225,6 +233,7 @@ bool ParticleSource::place_carrier(double d, double theta0, double dphi, double 
 void ParticleSource::attach_toner(const Vector3 &c, double rc, double t, ParticleState &enter)
 {
   const double mc = sphere_mass(2.0 * rc, carrier_.density);
+  const std::size_t carrier = enter.size() - 1; // just appended
   for (std::size_t k = 0; k < toner_.size(); ++k)
   {
     const Feed &f = toner_[k];
@@ -234,6 +243,14 @@ void ParticleSource::attach_toner(const Vector3 &c, double rc, double t, Particl
       const double d = draw_diameter(f), m = sphere_mass(d, f.density);
       if (owed_toner_[k] < 0.5 * m || !in_stock(f, m))
         break;
+      if (f.carried)
+      {
+        // Carried (dem/carried_toner.h): part of the carrier's mass and charge, no particle.
+        load_carried_toner(enter, carrier, 1, m, f.charge_to_mass * m);
+        count_created(f, m);
+        owed_toner_[k] -= m;
+        continue;
+      }
       bool placed = false;
       for (int attempt = 0; attempt < toner_attempts && !placed; ++attempt)
       {

@@ -15,7 +15,9 @@
 // so the arc is free. Each new particle moves rigidly with the sleeve (v = ω ẑ × x, ω ẑ).
 // Toner populations that give a concentration TC come attached: each carrier brings toner of
 // mass TC × its own mass, touching its surface at random points (a toner that does not fit
-// is owed to the next carrier). The carriers' share of Γ is Γ / (1 + ΣTC).
+// is owed to the next carrier), or, for toner that rides its carrier (carried_until_gap),
+// as part of the carrier's mass and charge (dem/carried_toner.h). The carriers' share of Γ is
+// Γ / (1 + ΣTC).
 //
 // What is owed and not placed (a drawn diameter that did not fit, mass below one particle)
 // stays owed: over a run the mass created follows Γ R φ(t) L_z to within one particle.
@@ -101,6 +103,7 @@ private:
     int species = 0;
     double density = 0.0, d_mean = 0.0, d_std = 0.0, d_min = 0.0, d_max = 0.0, charge_to_mass = 0.0;
     double concentration = 0.0; // toner: mass per carrier mass
+    bool carried = false;       // toner: rides the carrier as its mass and charge (carried_toner.h)
   };
   Feed carrier_;
   std::vector<Feed> toner_;
@@ -140,6 +143,7 @@ private:
   void check_owed() const;
   void attach_toner(const Vector3 &centre, double rc, double t, ParticleState &enter);
   void append(const Feed &f, const Vector3 &p, double d, double t, ParticleState &enter);
+  void count_created(const Feed &f, double m);
   bool in_stock(const Feed &f, double m) const;
 };
 

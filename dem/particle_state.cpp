@@ -9,8 +9,9 @@ namespace magbrush::dem {
 void ParticleState::resize(std::size_t n)
 {
   for (auto *a : {&x, &y, &z, &vx, &vy, &vz, &wx, &wy, &wz, &radius, &mass, &inv_mass,
-                  &inv_inertia, &charge})
+                  &inv_inertia, &charge, &carried_mass, &carried_charge})
     a->resize(n, 0.0);
+  carried_count.resize(n, 0);
   species.resize(n, 0);
   id.resize(n, 0);
 }
@@ -29,6 +30,9 @@ void ParticleState::add(const Vector3 &p, double r, double density, int species_
   inv_mass.push_back(1.0 / m);
   inv_inertia.push_back(1.0 / (0.4 * m * r * r)); // solid sphere
   charge.push_back(charge_value);
+  carried_count.push_back(0);
+  carried_mass.push_back(0.0);
+  carried_charge.push_back(0.0);
   species.push_back(species_index);
   id.push_back(next_id++);
 }
@@ -49,6 +53,9 @@ void ParticleState::append_from(const ParticleState &o, std::size_t k)
   inv_mass.push_back(o.inv_mass[k]);
   inv_inertia.push_back(o.inv_inertia[k]);
   charge.push_back(o.charge[k]);
+  carried_count.push_back(o.carried_count[k]);
+  carried_mass.push_back(o.carried_mass[k]);
+  carried_charge.push_back(o.carried_charge[k]);
   species.push_back(o.species[k]);
   id.push_back(next_id++);
 }
@@ -65,8 +72,9 @@ void ParticleState::permute(const std::vector<std::int32_t> &order, std::vector<
                             std::vector<std::int32_t> &iscratch)
 {
   for (auto *a : {&x, &y, &z, &vx, &vy, &vz, &wx, &wy, &wz, &radius, &mass, &inv_mass,
-                  &inv_inertia, &charge})
+                  &inv_inertia, &charge, &carried_mass, &carried_charge})
     permute_array(*a, order, scratch);
+  permute_array(carried_count, order, iscratch);
   permute_array(species, order, iscratch);
   permute_array(id, order, iscratch);
 }

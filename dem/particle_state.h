@@ -27,7 +27,13 @@ struct ParticleState
   std::vector<double> mass;        // [kg]
   std::vector<double> inv_mass;    // [1/kg]
   std::vector<double> inv_inertia; // 1 / (2/5 m r²) [1/(kg m²)]
-  std::vector<double> charge;      // [C]
+  std::vector<double> charge;      // [C] (a carrier's includes the toner it carries)
+  // Toner carried by a carrier as part of its mass and charge instead of as particles
+  // (populations[].carried_until_gap, dem/carried_toner.h): how many toner, their mass and
+  // their charge; zero for every other particle. `mass` and `charge` above include them.
+  std::vector<std::int32_t> carried_count;
+  std::vector<double> carried_mass;   // [kg]
+  std::vector<double> carried_charge; // [C]
   std::vector<std::int32_t> species; // population index in the case
   std::vector<std::int32_t> id;      // stable particle name
   std::int32_t next_id = 0;          // the id the next added particle gets

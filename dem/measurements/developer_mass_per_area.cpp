@@ -124,6 +124,7 @@ void DeveloperMassPerArea::add_sample(double time, const ParticleState &s, const
       const auto sp = static_cast<std::size_t>(s.species[i]);
       if (sp < is_toner_.size() && is_toner_[sp])
         toner += s.mass[i];
+      toner += s.carried_mass[i]; // carried by a carrier as its own mass (dem/carried_toner.h)
     }
     const double b = angle_from(s.x[i], s.y[i], blade_angle_);
     if (b < 0.0 && b >= -settings_.front_window)

@@ -159,11 +159,16 @@ double TonerDevelopment::toner_share_on_carriers(const DemSystem &system, const 
   }
   double all = 0.0, carried = 0.0;
   for (std::size_t k = 0; k < p.size(); ++k)
+  {
     if (species_is(is_toner, k))
     {
       all += p.mass[k];
       carried += on[k] ? p.mass[k] : 0.0;
     }
+    // Toner a carrier carries as its own mass (dem/carried_toner.h) is on it by definition.
+    all += p.carried_mass[k];
+    carried += p.carried_mass[k];
+  }
   return all > 0.0 ? carried / all : std::numeric_limits<double>::quiet_NaN();
 }
 

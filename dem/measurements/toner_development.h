@@ -89,7 +89,8 @@ public:
   void add_sample(double time, const std::vector<DrumToner> &on_drum,
                   double on_carriers = std::numeric_limits<double>::quiet_NaN());
   // The toner mass within the adhesion range of a carrier (its touching pairs, when the
-  // contacts do not attract) over all toner mass, from the neighbour list's pairs.
+  // contacts do not attract) over all toner mass, from the neighbour list's pairs; toner a
+  // carrier carries as its own mass (carried_until_gap) counts as on it.
   static double toner_share_on_carriers(const DemSystem &system, const std::vector<std::uint8_t> &is_toner,
                                         const std::vector<std::uint8_t> &is_carrier);
 

@@ -39,7 +39,7 @@ public:
   explicit DrainAndRain(long every) : every_(every), rng_(7) {}
   const char *name() const override { return "drain and rain"; }
   long interval_steps() const override { return every_; }
-  void plan(const ParticleState &s, double, std::vector<std::int32_t> &leave, ParticleState &enter) override
+  void plan(ParticleState &s, double, std::vector<std::int32_t> &leave, ParticleState &enter) override
   {
     for (std::size_t i = 0; i < s.size(); ++i)
       if (s.x[i] < 0.6e-3 && s.z[i] < 0.15e-3)
@@ -265,7 +265,7 @@ class EmptyDoors : public ParticleExchange
 public:
   const char *name() const override { return "empty doors"; }
   long interval_steps() const override { return 3; }
-  void plan(const ParticleState &, double, std::vector<std::int32_t> &, ParticleState &) override { ++plans; }
+  void plan(ParticleState &, double, std::vector<std::int32_t> &, ParticleState &) override { ++plans; }
   void smallest_particles(ParticleState &out) const override { out.add({0, 0, 0}, 40e-6, 2200, 0, 0.0); }
   void write_state(CheckpointWriter &) const override {}
   void read_state(CheckpointReader &) override {}

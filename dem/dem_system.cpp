@@ -1,6 +1,7 @@
 // The DEM engine's step and state (see dem_system.h).
 #include "dem/dem_system.h"
 
+#include "dem/carried_toner.h"
 #include "dem/checkpoint_file.h"
 #include "dem/contact_law.h"
 #include "dem/insertion.h"
@@ -107,13 +108,22 @@ void DemSystem::setup_derived()
   dt_ = choose_time_step(case_.dem, stable_);
 
   const ParticleState &sized = n > 0 ? particles_ : later;
-  double mean_d = 0.0, mass = 0.0;
+  double mean_d = 0.0, mass = 0.0, sized_count = 0.0;
+  const int carried = carried_toner_population(case_);
   for (std::size_t i = 0; i < sized.size(); ++i)
   {
     mean_d += 2.0 * sized.radius[i];
     mass += sized.mass[i];
+    sized_count += 1.0;
+    if (carried >= 0 && sized.carried_count[i] > 0)
+    {
+      // Carried toner counts as the particles it becomes (the scene the skin is for).
+      const double c = static_cast<double>(sized.carried_count[i]);
+      mean_d += c * case_.populations[static_cast<std::size_t>(carried)].diameter_mean;
+      sized_count += c;
+    }
   }
-  mean_d /= static_cast<double>(sized.size());
+  mean_d /= sized_count;
   skin_ = case_.dem.verlet_skin * mean_d;
   energy_floor_ = 0.5 * mass * 1.0; // (1 m/s)²: the runaway guard ignores growth below this
   forces_.resize(n);

@@ -18,22 +18,32 @@ std::vector<double> draw_charges(const Population &p, const std::vector<double> 
   std::vector<double> q(diameters.size(), 0.0);
   if (p.counter_charge)
     return q;
-  const double mean = p.charge_to_mass;
-  std::normal_distribution<double> spread(mean, std::max(0.0, p.charge_to_mass_std));
-  std::bernoulli_distribution wrong_sign(std::clamp(p.wrong_sign_fraction, 0.0, 1.0));
+  ChargeToMassDraw charge_to_mass(p);
   for (std::size_t k = 0; k < diameters.size(); ++k)
   {
-    double qm = mean;
-    if (p.charge_to_mass_std > 0.0 && mean != 0.0)
-      do // truncated: the spread never reverses the sign (that is the wrong-sign fraction's job)
-        qm = spread(rng);
-      while (qm * mean <= 0.0);
-    if (p.wrong_sign_fraction > 0.0 && wrong_sign(rng))
-      qm = -qm;
     const double d = diameters[k];
-    q[k] = qm * (density * M_PI / 6.0 * d * d * d); // q/m times the sphere's mass
+    q[k] = charge_to_mass(rng) * (density * M_PI / 6.0 * d * d * d); // q/m times the sphere's mass
   }
   return q;
+}
+
+ChargeToMassDraw::ChargeToMassDraw(const Population &p)
+  : mean_(p.charge_to_mass), std_(p.charge_to_mass_std), wrong_(p.wrong_sign_fraction),
+    spread_(p.charge_to_mass, std::max(0.0, p.charge_to_mass_std)),
+    wrong_sign_(std::clamp(p.wrong_sign_fraction, 0.0, 1.0))
+{
+}
+
+double ChargeToMassDraw::operator()(std::mt19937_64 &rng)
+{
+  double qm = mean_;
+  if (std_ > 0.0 && mean_ != 0.0)
+    do // truncated: the spread never reverses the sign (that is the wrong-sign fraction's job)
+      qm = spread_(rng);
+    while (qm * mean_ <= 0.0);
+  if (wrong_ > 0.0 && wrong_sign_(rng))
+    qm = -qm;
+  return qm;
 }
 
 void assign_counter_charges(const Case &c, ParticleState &particles)

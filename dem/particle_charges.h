@@ -23,6 +23,21 @@ namespace magbrush::dem {
 // The random stream of the charges of a case (independent of the insertion's).
 std::mt19937_64 charge_random_stream(const Case &c);
 
+// One particle's q/m [C/kg] after population `p`: the mean, its truncated normal spread and
+// the wrong-sign fraction. Holds its distributions, so that successive draws from one object
+// are one stream (a normal distribution keeps the second of each pair it generates).
+class ChargeToMassDraw
+{
+public:
+  explicit ChargeToMassDraw(const Population &p);
+  double operator()(std::mt19937_64 &rng);
+
+private:
+  double mean_ = 0.0, std_ = 0.0, wrong_ = 0.0;
+  std::normal_distribution<double> spread_;
+  std::bernoulli_distribution wrong_sign_;
+};
+
 // Charges [C] of particles of population `p` with the given diameters [m] and density
 // [kg/m³], in the order of `diameters`. Counter-charged carriers get 0 here (see below).
 std::vector<double> draw_charges(const Population &p, const std::vector<double> &diameters, double density,

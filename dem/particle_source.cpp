@@ -4,6 +4,7 @@
 #include "dem/carried_toner.h"
 #include "dem/checkpoint_file.h"
 #include "dem/insertion.h"
+#include "dem/particle_charges.h"
 
 #include <algorithm>
 #include <cmath>
@@ -37,7 +38,7 @@ ParticleSource::ParticleSource(const Case &c, const DemWalls &walls, const Perio
     // bounds the stable time step before the particle exists.
     fd.d_min = std::max(0.05 * fd.d_mean, fd.d_mean - 3.0 * fd.d_std);
     fd.d_max = fd.d_mean + 3.0 * fd.d_std;
-    fd.charge_to_mass = p.charge_to_mass;
+    fd.population = &p;
     fd.concentration = p.concentration;
     fd.carried = p.carried_until_gap > 0.0;
     return fd;
@@ -189,10 +190,10 @@ bool ParticleSource::clear_of_everything(const Vector3 &p, double r) const
   return true;
 }
 
-void ParticleSource::append(const Feed &f, const Vector3 &p, double d, double t, ParticleState &enter)
+void ParticleSource::append(const Feed &f, const Vector3 &p, double d, double t, double charge, ParticleState &enter)
 {
   const double m = sphere_mass(d, f.density);
-  enter.add(p, 0.5 * d, f.density, f.species, f.charge_to_mass * m);
+  enter.add(p, 0.5 * d, f.density, f.species, charge);
   // Rigidly with the sleeve: v = ω ẑ × x, spin ω ẑ.
   const double w = spin_up_ > 0.0 && t < spin_up_ ? omega_ * t / spin_up_ : omega_;
   enter.vx.back() = -w * p.y;
@@ -223,8 +224,19 @@ bool ParticleSource::place_carrier(double d, double theta0, double dphi, double 
     const Vector3 p{rr * std::cos(th), rr * std::sin(th), Lz_ * u(rng_)};
     if (!clear_of_everything(p, r))
       continue;
-    append(carrier_, p, d, t, enter);
+    const std::size_t carrier = enter.size();
+    append(carrier_, p, d, t, ChargeToMassDraw(*carrier_.population)(rng_) * sphere_mass(d, carrier_.density), enter);
     attach_toner(p, r, t, enter);
+    if (carrier_.population->counter_charge)
+    {
+      // "The carrier has the opposite charge of the toner on its surface": its own charge is
+      // minus that of all the toner it brings, so that with the toner it carries (already in
+      // its charge) it holds minus the charge of the toner attached to it as particles.
+      double toner = 0.0;
+      for (std::size_t k = carrier + 1; k < enter.size(); ++k)
+        toner += enter.charge[k];
+      enter.charge[carrier] = -toner;
+    }
     return true;
   }
   return false;
@@ -237,16 +249,18 @@ void ParticleSource::attach_toner(const Vector3 &c, double rc, double t, Particl
   for (std::size_t k = 0; k < toner_.size(); ++k)
   {
     const Feed &f = toner_[k];
+    ChargeToMassDraw charge_to_mass(*f.population); // the population's q/m, spread and wrong sign
     owed_toner_[k] += f.concentration * mc;
     for (;;)
     {
       const double d = draw_diameter(f), m = sphere_mass(d, f.density);
       if (owed_toner_[k] < 0.5 * m || !in_stock(f, m))
         break;
+      const double q = charge_to_mass(rng_) * m;
       if (f.carried)
       {
         // Carried (dem/carried_toner.h): part of the carrier's mass and charge, no particle.
-        load_carried_toner(enter, carrier, 1, m, f.charge_to_mass * m);
+        load_carried_toner(enter, carrier, 1, m, q);
         count_created(f, m);
         owed_toner_[k] -= m;
         continue;
@@ -259,7 +273,7 @@ void ParticleSource::attach_toner(const Vector3 &c, double rc, double t, Particl
         p.z -= Lz_ * std::floor(p.z / Lz_);
         if (!clear_of_everything(p, 0.5 * d))
           continue;
-        append(f, p, d, t, enter);
+        append(f, p, d, t, q, enter);
         owed_toner_[k] -= m;
         placed = true;
       }

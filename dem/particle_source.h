@@ -17,7 +17,10 @@
 // mass TC × its own mass, touching its surface at random points (a toner that does not fit
 // is owed to the next carrier), or, for toner that rides its carrier (carried_until_gap),
 // as part of the carrier's mass and charge (dem/carried_toner.h). The carriers' share of Γ is
-// Γ / (1 + ΣTC).
+// Γ / (1 + ΣTC). Charges as at insertion (dem/particle_charges.h): each toner its population's
+// q/m (spread and wrong-sign fraction included) times its mass; a counter-charged carrier
+// minus the charge of the toner it brings, so that the developer fed is neutral, carrier by
+// carrier.
 //
 // What is owed and not placed (a drawn diameter that did not fit, mass below one particle)
 // stays owed: over a run the mass created follows Γ R φ(t) L_z to within one particle.
@@ -101,7 +104,8 @@ private:
   struct Feed
   {
     int species = 0;
-    double density = 0.0, d_mean = 0.0, d_std = 0.0, d_min = 0.0, d_max = 0.0, charge_to_mass = 0.0;
+    const Population *population = nullptr; // its q/m distribution, counter-charge
+    double density = 0.0, d_mean = 0.0, d_std = 0.0, d_min = 0.0, d_max = 0.0;
     double concentration = 0.0; // toner: mass per carrier mass
     bool carried = false;       // toner: rides the carrier as its mass and charge (carried_toner.h)
   };
@@ -142,7 +146,7 @@ private:
   bool fill_owed(double t, double theta0, double span, bool may_decline, ParticleState &enter);
   void check_owed() const;
   void attach_toner(const Vector3 &centre, double rc, double t, ParticleState &enter);
-  void append(const Feed &f, const Vector3 &p, double d, double t, ParticleState &enter);
+  void append(const Feed &f, const Vector3 &p, double d, double t, double charge, ParticleState &enter);
   void count_created(const Feed &f, double m);
   bool in_stock(const Feed &f, double m) const;
 };

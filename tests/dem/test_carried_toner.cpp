@@ -14,6 +14,8 @@
 //    carrier's surface; the carrier keeps exactly its own mass; charge is conserved exactly;
 //  * a restart in the middle continues bit-identically (the carried arrays and the release's
 //    random stream are in the checkpoint);
+//  * the inflow brings each carrier with minus the charge of its toner (the developer fed is
+//    neutral) and each toner with the population's q/m distribution, carried or not;
 //  * the validation refuses it where it cannot apply.
 #include "tests/dem/dem_test_scenes.h"
 #include "dem/carried_toner.h"
@@ -112,10 +114,10 @@ Case developer_conveyor()
   return c;
 }
 
-std::unique_ptr<DemSystem> make(const Case &c)
+std::unique_ptr<DemSystem> make(const Case &c, double pull = 300.0)
 {
   auto sys = std::make_unique<DemSystem>(c);
-  sys->add_force_term(std::make_unique<RadialPull>(300.0));
+  sys->add_force_term(std::make_unique<RadialPull>(pull));
   sys->set_particle_exchange(std::make_unique<ParticleFlow>(c, *sys));
   sys->initialize();
   return sys;
@@ -318,6 +320,61 @@ TEST(CarriedToner, RestartInTheMiddleContinuesBitIdentically)
   EXPECT_TRUE(bit_identical(state_by_id(*a), state_by_id(b)));
   EXPECT_TRUE(bit_identical(carried_by_id(*a), carried_by_id(b)));
   std::filesystem::remove(path);
+}
+
+TEST(CarriedToner, TheFedDeveloperIsNeutralCarrierByCarrierAndItsTonerHasTheQmDistribution)
+{
+  // The inflow's charges, toner resolved (no carrying) and carried: each carrier brings minus
+  // the charge of its toner, each toner the population's q/m (mean -30, spread 6 uC/g, 5 %
+  // wrong sign). An 8 mm slab for 0.8 ms without the pull: ~50 carriers fed, each moving on
+  // as the sleeve launched it, nothing collides (a carrier landing on the sleeve would crush
+  // the soft test toner under it), nothing comes near the drum or the outflow.
+  for (const double gap : {0.0, release_gap})
+  {
+    omp_set_num_threads(1);
+    Case c = developer_conveyor();
+    c.populations[1].carried_until_gap = gap;
+    c.dem.periodic_length = 8e-3;
+    auto sys = make(c, 0.0);
+    sys->advance(std::lround(0.8e-3 / sys->time_step()));
+    const ParticleState &s = sys->particles();
+    double total = 0.0, scale = 0.0, sum_qm = 0.0, sum_qm2 = 0.0;
+    long toner = 0, wrong = 0, carried = 0;
+    for (std::size_t k = 0; k < s.size(); ++k)
+    {
+      total += s.charge[k];
+      scale += std::abs(s.charge[k]) + std::abs(s.carried_charge[k]);
+      carried += s.carried_count[k];
+      if (s.species[k] != 1)
+        continue;
+      const double qm = s.charge[k] / s.mass[k];
+      ++toner;
+      wrong += qm > 0.0;
+      if (qm < 0.0)
+      {
+        sum_qm += qm;
+        sum_qm2 += qm * qm;
+      }
+    }
+    std::printf("release gap %.0f um: %zu particles, %ld toner (%ld wrong sign), %ld carried; net charge %.3g of %.3g C\n",
+                gap * 1e6, s.size(), toner, wrong, carried, total, scale);
+    ASSERT_GT(scale, 0.0);
+    EXPECT_LT(std::abs(total), 1e-12 * scale);
+    if (gap > 0.0)
+    {
+      EXPECT_EQ(toner, 0);
+      EXPECT_GT(carried, 300);
+      continue;
+    }
+    ASSERT_GT(toner, 300);
+    EXPECT_GT(wrong, 0);
+    EXPECT_LT(wrong, toner / 8);
+    const long right = toner - wrong;
+    const double mean = sum_qm / static_cast<double>(right);
+    const double sd = std::sqrt(sum_qm2 / static_cast<double>(right) - mean * mean);
+    EXPECT_NEAR(mean, -30e-3, 1.5e-3); // C/kg (uC/g = 1e-3 C/kg)
+    EXPECT_NEAR(sd, 6e-3, 1.5e-3);
+  }
 }
 
 namespace {

@@ -68,8 +68,9 @@ std::vector<KeySpec> particle_keys()
                "Toner on the carriers (attached, or fed by the inflow) only: the reduced toner model. Each "
                "carrier carries its toner as a count, mass and charge (part of its own) instead of as "
                "particles, until its surface comes this close to the drum surface; then the toner is placed "
-               "touching it at random points as particles, which may develop. 0 = the toner is always "
-               "particles. Assumes no toner leaves a carrier farther from the drum.")
+               "touching it at random points as particles, which may develop; a toner particle touching a "
+               "carrier farther than twice this from the drum becomes its carried toner again. 0 = the "
+               "toner is always particles. Assumes no toner leaves a carrier farther from the drum.")
           .def("0 um").non_negative(),
       Key("populations[].insert_box", KeyType::box, "Insertion box [[xmin, ymin, zmin], [xmax, ymax, zmax]].")
           .dim(D::length),

@@ -4,6 +4,7 @@
 #include "dem/checkpoint_file.h"
 #include "dem/insertion.h"
 #include "dem/particle_charges.h"
+#include "dem/placement_grid.h"
 
 #include <algorithm>
 #include <cmath>
@@ -46,7 +47,7 @@ void load_carried_toner(ParticleState &s, std::size_t k, int count, double m, do
 }
 
 CarriedTonerRelease::CarriedTonerRelease(const Case &c, const DemWalls &walls, const PeriodicBox &box)
-  : case_(c), walls_(walls), box_(box), rng_(c.dem.seed * 0xD1B54A32D192ED03ull + 0xca221ed)
+  : walls_(walls), box_(box), rng_(c.dem.seed * 0xD1B54A32D192ED03ull + 0xca221ed)
 {
   species_ = carried_toner_population(c);
   if (species_ < 0)
@@ -55,6 +56,7 @@ CarriedTonerRelease::CarriedTonerRelease(const Case &c, const DemWalls &walls, c
     throw std::invalid_argument("populations[].carried_until_gap: carried toner is released near the drum, "
                                 "and the case has no drum (or no sleeve to place it from)");
   const Population &p = c.populations[static_cast<std::size_t>(species_)];
+  population_ = p;
   density_ = c.material(p.material).density;
   d_mean_ = p.diameter_mean;
   d_std_ = std::max(0.0, p.diameter_std);
@@ -65,6 +67,8 @@ CarriedTonerRelease::CarriedTonerRelease(const Case &c, const DemWalls &walls, c
   drum_x_ = centre[0];
   drum_y_ = centre[1];
   drum_radius_ = c.drum.radius;
+  for (const Population &q : c.populations)
+    is_carrier_.push_back(q.kind == ParticleKind::carrier ? 1 : 0);
 }
 
 void CarriedTonerRelease::smallest_particles(ParticleState &out) const
@@ -151,7 +155,7 @@ void CarriedTonerRelease::release_carrier(ParticleState &state, std::size_t k, d
   const double scale = std::cbrt(state.carried_mass[k] / drawn);
   for (double &d : d_)
     d *= scale;
-  q_ = draw_charges(case_.populations[static_cast<std::size_t>(species_)], d_, density_, rng_);
+  q_ = draw_charges(population_, d_, density_, rng_);
 
   const double own_mass = state.mass[k] - state.carried_mass[k];
   gather_near(state, enter, k);
@@ -201,6 +205,49 @@ void CarriedTonerRelease::release_carrier(ParticleState &state, std::size_t k, d
   }
 }
 
+void CarriedTonerRelease::recapture(ParticleState &state, std::vector<char> &leaving,
+                                    std::vector<std::int32_t> &leave)
+{
+  // The carriers in a grid of cells one largest carrier diameter wide.
+  double d_max = 0.0;
+  for (std::size_t k = 0; k < state.size(); ++k)
+    if (is_carrier_[static_cast<std::size_t>(state.species[k])])
+      d_max = std::max(d_max, 2.0 * state.radius[k]);
+  if (d_max <= 0.0)
+    return;
+  PlacementGrid carriers(d_max, box_);
+  for (std::size_t k = 0; k < state.size(); ++k)
+    if (is_carrier_[static_cast<std::size_t>(state.species[k])] && !leaving[k])
+      carriers.add(state.position(k), k);
+  for (std::size_t t = 0; t < state.size(); ++t)
+  {
+    if (state.species[t] != species_ || leaving[t] || drum_gap(state, t) < gap_)
+      continue;
+    // The carrier it touches (the nearest surface; ties to the lower index).
+    std::size_t on = state.size();
+    double nearest = 0.02 * state.radius[t];
+    carriers.for_each_near(state, state.position(t), [&](std::size_t k, const double *d) {
+      const double g = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) - state.radius[k] - state.radius[t];
+      if (g < nearest || (g == nearest && k < on))
+      {
+        nearest = g;
+        on = k;
+      }
+    });
+    if (on == state.size() || drum_gap(state, on) <= 2.0 * gap_)
+      continue;
+    // Momentum kept: the carrier takes the toner's.
+    const double mc = state.mass[on], mt = state.mass[t], m = mc + mt;
+    state.vx[on] = (mc * state.vx[on] + mt * state.vx[t]) / m;
+    state.vy[on] = (mc * state.vy[on] + mt * state.vy[t]) / m;
+    state.vz[on] = (mc * state.vz[on] + mt * state.vz[t]) / m;
+    load_carried_toner(state, on, 1, mt, state.charge[t]);
+    leaving[t] = 1;
+    leave.push_back(static_cast<std::int32_t>(t));
+    ++recaptured_;
+  }
+}
+
 void CarriedTonerRelease::write_state(CheckpointWriter &out) const
 {
   std::ostringstream text;
@@ -208,6 +255,7 @@ void CarriedTonerRelease::write_state(CheckpointWriter &out) const
   const std::string s = text.str();
   out.put_array(std::vector<char>(s.begin(), s.end()));
   out.put(released_);
+  out.put(recaptured_);
 }
 
 void CarriedTonerRelease::read_state(CheckpointReader &in)
@@ -216,6 +264,7 @@ void CarriedTonerRelease::read_state(CheckpointReader &in)
   in.get_array(s);
   std::istringstream(std::string(s.begin(), s.end())) >> rng_;
   released_ = in.get<long>();
+  recaptured_ = in.get<long>();
 }
 
 } // namespace magbrush::dem

@@ -20,11 +20,16 @@
 // included) and subtracted from the carrier's charge, so the total charge is conserved
 // exactly (what the carried charge and the drawn charges differ by stays with the carrier).
 //
-// Deterministic: the release runs at the engine's particle exchange (serial), carriers in
-// index order, from one random stream that goes into the checkpoint.
+// Deterministic: the release and the recapture run at the engine's particle exchange
+// (serial), in index order, from one random stream that goes into the checkpoint.
+//
+// Toner that rides out of reach again goes back: a released toner touching a carrier whose
+// surface is farther than twice the release gap from the drum (the factor 2 keeps a carrier
+// at the edge from releasing and taking back at every exchange) becomes carried toner again.
 //
 // What the model assumes: toner on a carrier stays there until the drum is within the gap
-// (no toner leaves a carrier in the bulk of the brush), and released toner is not taken back.
+// (no toner leaves a carrier in the bulk of the brush), and free toner (touching no carrier)
+// stays resolved.
 #pragma once
 
 #include "dem/neighbour_list.h"
@@ -62,19 +67,27 @@ public:
   // the walls' positions).
   void release(ParticleState &state, double t, const std::vector<char> &leaving, ParticleState &enter);
 
+  // Takes back what rides out of reach again: every toner of the population (not marked in
+  // `leaving`) that touches a carrier (surface gap below 2 % of its radius) whose surface is
+  // farther than twice the release gap from the drum, the toner itself not within the
+  // release gap of the drum, leaves (appended to `leave`, marked in `leaving`) and becomes
+  // the carrier's carried toner: its mass, charge and momentum added to the carrier.
+  void recapture(ParticleState &state, std::vector<char> &leaving, std::vector<std::int32_t> &leave);
+
   // One toner at the population's smallest diameter (for the stable time step).
   void smallest_particles(ParticleState &out) const;
 
   int species() const { return species_; }
   double release_gap() const { return gap_; }
-  // Released so far: toner particles placed.
+  // Released so far: toner particles placed; taken back so far.
   long released() const { return released_; }
+  long recaptured() const { return recaptured_; }
 
   void write_state(CheckpointWriter &out) const;
   void read_state(CheckpointReader &in);
 
 private:
-  const Case &case_;
+  Population population_; // a copy: the case need not outlive the release
   const DemWalls &walls_;
   PeriodicBox box_;
   int species_ = -1;
@@ -84,12 +97,13 @@ private:
 
   // State (checkpointed).
   std::mt19937_64 rng_;
-  long released_ = 0;
+  long released_ = 0, recaptured_ = 0;
 
   // Scratch: the particles near the carrier being released (positions, radii).
   std::vector<Vector3> near_x_;
   std::vector<double> near_r_;
   std::vector<double> d_, q_;
+  std::vector<char> is_carrier_; // per population
 
   double drum_gap(const ParticleState &s, std::size_t k) const;
   void gather_near(const ParticleState &state, const ParticleState &enter, std::size_t k);

@@ -2,6 +2,7 @@
 #include "dem/insertion.h"
 
 #include "dem/carried_toner.h"
+#include "dem/placement_grid.h"
 #include "dem/particle_charges.h"
 
 #include <algorithm>
@@ -17,61 +18,6 @@ namespace magbrush::dem {
 namespace {
 double sphere_mass(double d, double rho) { return rho * M_PI / 6.0 * d * d * d; }
 
-// A hash grid of the spheres placed so far, for the overlap test.
-class PlacementGrid
-{
-public:
-  PlacementGrid(double cell, const PeriodicBox &box) : h_(cell), box_(box) {}
-
-  bool overlaps(const ParticleState &s, const Vector3 &p, double r) const
-  {
-    const long cx = cell(p.x), cy = cell(p.y), cz = cell(p.z);
-    for (long a = -1; a <= 1; ++a)
-      for (long b = -1; b <= 1; ++b)
-        for (long e = -1; e <= 1; ++e)
-        {
-          const auto it = cells_.find(key(wrap_cell(cx + a, 0), wrap_cell(cy + b, 1), wrap_cell(cz + e, 2)));
-          if (it == cells_.end())
-            continue;
-          for (std::size_t k : it->second)
-          {
-            double d[3] = {s.x[k] - p.x, s.y[k] - p.y, s.z[k] - p.z};
-            for (int q = 0; q < 3; ++q)
-              if (box_.periodic(q))
-              {
-                const double L = box_.length[static_cast<std::size_t>(q)];
-                d[q] -= L * std::round(d[q] / L);
-              }
-            const double reach = r + s.radius[k];
-            if (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < reach * reach)
-              return true;
-          }
-        }
-    return false;
-  }
-  void add(const Vector3 &p, std::size_t index)
-  {
-    cells_[key(wrap_cell(cell(p.x), 0), wrap_cell(cell(p.y), 1), wrap_cell(cell(p.z), 2))].push_back(index);
-  }
-
-private:
-  double h_;
-  PeriodicBox box_;
-  std::unordered_map<long long, std::vector<std::size_t>> cells_;
-  long cell(double v) const { return static_cast<long>(std::floor(v / h_)); }
-  long wrap_cell(long c, int d) const
-  {
-    if (!box_.periodic(d))
-      return c;
-    const long n = std::max(1L, static_cast<long>(std::floor(box_.length[static_cast<std::size_t>(d)] / h_)));
-    return ((c % n) + n) % n;
-  }
-  static long long key(long a, long b, long c)
-  {
-    return (static_cast<long long>(a & 0x1FFFFF) << 42) | (static_cast<long long>(b & 0x1FFFFF) << 21) |
-           static_cast<long long>(c & 0x1FFFFF);
-  }
-};
 } // namespace
 
 Vector3 touching_point(const Vector3 &centre, double rc, double rt, std::mt19937_64 &rng)

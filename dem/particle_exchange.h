@@ -35,11 +35,12 @@ public:
   virtual long interval_steps() const = 0;
   // At time t (step k): appends to `leave` the indices of the particles that leave (any
   // order, each once) and to `enter` the particles that enter (their id is ignored: the
-  // engine names them). Both come in empty. It may change the mass, moment of inertia and
-  // charge of present particles (a carrier releasing the toner it carried, carried_toner.h),
-  // never their number, order or kinematics, and only together with an entering particle:
-  // the force terms learn of the change through ForceTerm::particles_changed (a term that
-  // holds a particle's force keeps it until its next renewal).
+  // engine names them). Both come in empty. It may change the mass, moment of inertia, charge
+  // and velocity of present particles (a carrier releasing the toner it carried or taking it
+  // back, carried_toner.h), never their number or order, and only together with a particle
+  // entering or leaving: the force terms learn of the change through
+  // ForceTerm::particles_changed (a term that holds a particle's force keeps it until its
+  // next renewal).
   virtual void plan(ParticleState &state, double t, std::vector<std::int32_t> &leave,
                     ParticleState &enter) = 0;
   // The smallest particles the exchange may ever bring in (one or a few per population), so

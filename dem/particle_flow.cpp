@@ -48,6 +48,7 @@ void ParticleFlow::plan(ParticleState &state, double t, std::vector<std::int32_t
     for (std::int32_t i : leave)
       leaving_[static_cast<std::size_t>(i)] = 1;
     release_->release(state, t, leaving_, enter);
+    release_->recapture(state, leaving_, leave);
   }
 }
 

@@ -38,7 +38,7 @@ ParticleSource::ParticleSource(const Case &c, const DemWalls &walls, const Perio
     // bounds the stable time step before the particle exists.
     fd.d_min = std::max(0.05 * fd.d_mean, fd.d_mean - 3.0 * fd.d_std);
     fd.d_max = fd.d_mean + 3.0 * fd.d_std;
-    fd.population = &p;
+    fd.population = p;
     fd.concentration = p.concentration;
     fd.carried = p.carried_until_gap > 0.0;
     return fd;
@@ -225,9 +225,9 @@ bool ParticleSource::place_carrier(double d, double theta0, double dphi, double 
     if (!clear_of_everything(p, r))
       continue;
     const std::size_t carrier = enter.size();
-    append(carrier_, p, d, t, ChargeToMassDraw(*carrier_.population)(rng_) * sphere_mass(d, carrier_.density), enter);
+    append(carrier_, p, d, t, ChargeToMassDraw(carrier_.population)(rng_) * sphere_mass(d, carrier_.density), enter);
     attach_toner(p, r, t, enter);
-    if (carrier_.population->counter_charge)
+    if (carrier_.population.counter_charge)
     {
       // "The carrier has the opposite charge of the toner on its surface": its own charge is
       // minus that of all the toner it brings, so that with the toner it carries (already in
@@ -249,7 +249,7 @@ void ParticleSource::attach_toner(const Vector3 &c, double rc, double t, Particl
   for (std::size_t k = 0; k < toner_.size(); ++k)
   {
     const Feed &f = toner_[k];
-    ChargeToMassDraw charge_to_mass(*f.population); // the population's q/m, spread and wrong sign
+    ChargeToMassDraw charge_to_mass(f.population); // the population's q/m, spread and wrong sign
     owed_toner_[k] += f.concentration * mc;
     for (;;)
     {

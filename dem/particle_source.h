@@ -104,7 +104,7 @@ private:
   struct Feed
   {
     int species = 0;
-    const Population *population = nullptr; // its q/m distribution, counter-charge
+    Population population; // a copy (the case need not outlive the source): q/m, counter-charge
     double density = 0.0, d_mean = 0.0, d_std = 0.0, d_min = 0.0, d_max = 0.0;
     double concentration = 0.0; // toner: mass per carrier mass
     bool carried = false;       // toner: rides the carrier as its mass and charge (carried_toner.h)

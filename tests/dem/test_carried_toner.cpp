@@ -1,13 +1,16 @@
 // Toner carried by its carrier (populations[].carried_until_gap, dem/carried_toner.h): the
 // reduced toner model. Checked on the inflow/outflow conveyor of test_particle_flow.cpp (a
 // sleeve R = 2 mm at 0.2 m/s, a radial pull standing in for the magnet, developer fed at 90°
-// and removed from 165°) with a drum facing it at 135°, 0.3 mm from the sleeve (three beads), whose
-// release gap (0.25 mm) the carriers riding the sleeve pass within (from ~124° to ~146°), its
-// surface moving with the sleeve's. The drum is past where the fed carriers land (~105°): a
-// 100 µm carrier falling onto a released 17 µm toner would crush these soft test materials.
+// and removed from 185°) with a drum (R = 1 mm) facing it at 135°, 0.3 mm from the sleeve
+// (three beads), its surface moving with the sleeve's. A carrier riding the sleeve (top ~0.1 mm
+// above it) comes within the release gap (0.25 mm) of the drum from ~128° to ~142°, and
+// farther than twice the gap, where toner on it is taken back, beyond ~153°. The drum is past
+// where the fed carriers land (~105°): a 100 µm carrier falling onto a released 17 µm toner
+// would crush these soft test materials.
 //
 //  * the inflow's carriers bring their toner as mass and charge, no toner particle exists
-//    upstream of the drum, every carrier past it has released its toner;
+//    upstream of the drum, every carrier just past it has released its toner, and beyond
+//    ~153° no toner particle touches a carrier: the carriers took back what they held;
 //  * toner is conserved to the particle and to rounding in mass: created = resolved + carried
 //    + removed, each as count and mass (the outflow counts the toner a carrier takes out);
 //  * a release places each toner touching its carrier, overlapping nothing, moving with the
@@ -98,10 +101,10 @@ Case developer_conveyor()
   c.sleeve = s;
   c.materials.push_back(material("sleeve", 5e10, 0.0, 0.5));
   c.drum.present = true;
-  c.drum.radius = 3e-3;
+  c.drum.radius = 1e-3;
   c.drum.gap = drum_gap;
   c.drum.angle = 135 * deg;
-  c.drum.rpm = -0.2 / 3e-3 * 60.0 / (2.0 * M_PI); // its surface moves with the sleeve's (0.2 m/s)
+  c.drum.rpm = -0.2 / 1e-3 * 60.0 / (2.0 * M_PI); // its surface moves with the sleeve's (0.2 m/s)
   c.materials.push_back(material("drum", 5e10, 0.0, 0.35));
   c.dem.periodic_length = 1e-3;
   c.dem.seed = 5;
@@ -109,7 +112,7 @@ Case developer_conveyor()
   c.flow.inflow_angle = 90 * deg;
   c.flow.inflow_layer_height = 0.2e-3;
   c.flow.interval = 20e-6;
-  c.flow.outflow_angle = 165 * deg;
+  c.flow.outflow_angle = 185 * deg;
   c.flow.outflow_width = 60 * deg;
   return c;
 }
@@ -123,7 +126,12 @@ std::unique_ptr<DemSystem> make(const Case &c, double pull = 300.0)
   return sys;
 }
 
-double roller_angle(const ParticleState &s, std::size_t k) { return std::atan2(s.y[k], s.x[k]); }
+// The roller angle in [0, 2π) (the outflow is at 185°).
+double roller_angle(const ParticleState &s, std::size_t k)
+{
+  const double a = std::atan2(s.y[k], s.x[k]);
+  return a < 0.0 ? a + 2.0 * M_PI : a;
+}
 
 // The carried arrays and the masses and charges, by id (for the restart comparison).
 std::vector<double> carried_by_id(const DemSystem &sys)
@@ -142,15 +150,16 @@ std::vector<double> carried_by_id(const DemSystem &sys)
 
 } // namespace
 
-TEST(CarriedToner, TheConveyorReleasesAtTheDrumAndConservesTonerToTheParticle)
+TEST(CarriedToner, TheConveyorReleasesAtTheDrumTakesBackBeyondAndConservesTonerToTheParticle)
 {
   omp_set_num_threads(1);
   const Case c = developer_conveyor();
   auto sys = make(c);
-  sys->advance(std::lround(18e-3 / sys->time_step())); // 1.4 transits from the inflow to the outflow
+  sys->advance(std::lround(21e-3 / sys->time_step())); // 1.3 transits from the inflow to the outflow
   const auto &flow = *static_cast<const ParticleFlow *>(sys->particle_exchange());
   const ParticleState &s = sys->particles();
   long resolved = 0, carried = 0, upstream = 0, upstream_bare = 0, past = 0, past_carrying = 0;
+  long beyond = 0, beyond_carrying = 0, beyond_on_carriers = 0;
   double resolved_mass = 0.0, carried_mass = 0.0, upstream_toner = 0.0;
   for (std::size_t k = 0; k < s.size(); ++k)
   {
@@ -159,39 +168,65 @@ TEST(CarriedToner, TheConveyorReleasesAtTheDrumAndConservesTonerToTheParticle)
     {
       ++resolved;
       resolved_mass += s.mass[k];
-      upstream_toner += a < 115 * deg;
+      upstream_toner += a < 120 * deg;
+      if (a > 160 * deg)
+        for (std::size_t j = 0; j < s.size(); ++j)
+          if (s.species[j] == 0)
+          {
+            double dz = s.z[k] - s.z[j];
+            dz -= 1e-3 * std::round(dz / 1e-3);
+            const double g = std::sqrt(std::pow(s.x[k] - s.x[j], 2) + std::pow(s.y[k] - s.y[j], 2) + dz * dz) -
+                             s.radius[k] - s.radius[j];
+            if (g < 0.02 * s.radius[k])
+            {
+              ++beyond_on_carriers;
+              break;
+            }
+          }
       continue;
     }
     carried += s.carried_count[k];
     carried_mass += s.carried_mass[k];
-    if (a < 115 * deg)
+    if (a < 120 * deg)
     {
       ++upstream;
       upstream_bare += s.carried_count[k] == 0;
     }
-    if (a > 150 * deg)
+    if (a > 144 * deg && a < 150 * deg)
     {
       ++past;
       past_carrying += s.carried_count[k] > 0;
     }
+    if (a > 160 * deg)
+    {
+      ++beyond;
+      beyond_carrying += s.carried_count[k] > 0;
+    }
   }
+  const auto *release = flow.release();
   const long created = flow.source()->created_count()[1], removed = flow.sink()->removed_count()[1];
   const double created_mass = flow.source()->created_mass()[1], removed_mass = flow.sink()->removed_mass()[1];
-  std::printf("toner created %ld (%.6g kg) = resolved %ld + carried %ld + removed %ld; released %ld; carriers "
-              "upstream %ld (bare %ld), past the drum %ld (still carrying %ld)\n",
-              created, created_mass, resolved, carried, removed, flow.release()->released(), upstream, upstream_bare,
-              past, past_carrying);
+  std::printf("toner created %ld (%.6g kg) = resolved %ld + carried %ld + removed %ld; released %ld, taken back %ld; "
+              "carriers upstream %ld (bare %ld), just past the drum %ld (still carrying %ld), beyond 160 deg %ld "
+              "(carrying again %ld; toner particles on carriers there %ld)\n",
+              created, created_mass, resolved, carried, removed, release->released(), release->recaptured(), upstream,
+              upstream_bare, past, past_carrying, beyond, beyond_carrying, beyond_on_carriers);
   ASSERT_GT(created, 800);
-  EXPECT_GT(flow.release()->released(), 300);
-  EXPECT_GT(removed, 100); // released toner, and what carriers carried past the drum, left
+  EXPECT_GT(release->released(), 300);
+  EXPECT_GT(release->recaptured(), 50);
+  EXPECT_GT(removed, 100); // what carriers carried out, and free toner
   EXPECT_EQ(created, resolved + carried + removed);
   EXPECT_NEAR(resolved_mass + carried_mass + removed_mass, created_mass, 1e-12 * created_mass);
-  // Where: upstream of the drum the carriers carry and no toner is a particle; past it, none carries.
+  // Where: upstream of the drum the carriers carry and no toner is a particle; just past it,
+  // none carries; beyond, what stayed on a carrier is carried again.
   EXPECT_GT(upstream, 30);
   EXPECT_EQ(upstream_bare, 0);
   EXPECT_EQ(upstream_toner, 0.0);
-  EXPECT_GT(past, 10);
+  EXPECT_GT(past, 5);
   EXPECT_EQ(past_carrying, 0);
+  EXPECT_GT(beyond, 10);
+  EXPECT_GT(beyond_carrying, 0);
+  EXPECT_EQ(beyond_on_carriers, 0);
 }
 
 TEST(CarriedToner, AReleasePlacesTheTonerOnItsCarrierAndConservesMassAndCharge)
@@ -202,7 +237,8 @@ TEST(CarriedToner, AReleasePlacesTheTonerOnItsCarrierAndConservesMassAndCharge)
   c.populations[0].count = 40;
   c.populations[0].insert_box = std::array<Vec3, 2>{Vec3{-0.4e-3, 2.05e-3, 0.0}, Vec3{0.4e-3, 2.17e-3, 1e-3}};
   c.populations[1].attached = true;
-  c.drum.angle = 90 * deg; // straight above the box (its surface at y = 2.3 mm): every carrier within 0.17 mm
+  c.drum.angle = 90 * deg; // straight above the box (its surface at y = 2.3 mm): every carrier within 0.25 mm
+  c.populations[1].carried_until_gap = 0.4e-3;
   DemSystem sys(c);
   sys.insert_particles();
   ParticleState s = sys.particles();

@@ -121,6 +121,27 @@ inline void give_random_velocities(ParticleState &p, unsigned long seed)
   }
 }
 
+// A sleeve's magnet stood in for by a pull of `g` [m/s²] towards the roller axis (z) on every
+// particle: beads ride a conveyor sleeve by friction without the magnetics' cost.
+class RadialPull : public ForceTerm
+{
+public:
+  explicit RadialPull(double g) : g_(g) {}
+  const char *name() const override { return "radial pull"; }
+  void add_forces(const ParticleState &s, ForceBuffers &f, double) override
+  {
+    for (std::size_t i = 0; i < s.size(); ++i)
+    {
+      const double r = std::hypot(s.x[i], s.y[i]);
+      f.fx[i] -= g_ * s.mass[i] * s.x[i] / r;
+      f.fy[i] -= g_ * s.mass[i] * s.y[i] / r;
+    }
+  }
+
+private:
+  double g_;
+};
+
 // The id and every dynamic quantity of each particle, in ascending id: id, x, y, z, v, ω,
 // force, torque (state_values_per_particle numbers each, the force at state_force_offset).
 constexpr std::size_t state_values_per_particle = 16;

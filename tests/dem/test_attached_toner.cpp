@@ -8,6 +8,7 @@
 #include "coupling/case_parser.h"
 
 #include "tests/case_error.h"
+#include "tests/dem/box_developer.h"
 
 #include <gtest/gtest.h>
 
@@ -20,25 +21,6 @@
 using namespace magbrush;
 
 namespace {
-std::string developer(const std::string &toner_where)
-{
-  return R"(
-name: developer
-scene: box
-materials:
-  carrier: {youngs_modulus: 1e3 MPa, poisson_ratio: 0.35, density: 2200 kg/m^3, friction: 0.45, damping: 0.6}
-  toner: {youngs_modulus: 3e3 MPa, poisson_ratio: 0.35, density: 1100 kg/m^3, friction: 0.3, damping: 0.6}
-  wall: {youngs_modulus: 5e4 MPa, poisson_ratio: 0.3, friction: 0.35, damping: 0.6}
-planes:
-  - {name: floor, point: [0 mm, 0 mm, 0 mm], normal: [0, 0, 1], material: wall}
-populations:
-  - {name: carrier, kind: carrier, diameter: 35 um, diameter_std: 3.5 um, count: 150, counter_charge: true, insert_box: [[0 mm, 0 mm, 0 mm], [1 mm, 1 mm, 0.3 mm]]}
-  - {name: toner, kind: toner, diameter: 7 um, diameter_std: 1 um, concentration: 5 %, charge_to_mass: -30 uC/g, )" +
-         toner_where + R"(}
-dem: {gravity: [0, 0, 0], periodic_length_x: 1 mm, periodic_length_y: 1 mm}
-)";
-}
-
 dem::ParticleState inserted(const std::string &yaml)
 {
   const Case c = parse_case_text(yaml, "developer.yaml");
@@ -104,7 +86,7 @@ Layout layout_of(const dem::ParticleState &s)
 
 TEST(AttachedToner, EveryTonerTouchesACarrierAndEachCarriesTheConcentration)
 {
-  const Layout l = layout_of(inserted(developer("attached: true")));
+  const Layout l = layout_of(inserted(magbrush::testing::box_developer("attached: true")));
   ASSERT_GT(l.toner, 1000u); // 150 carriers × ~17 toner
   EXPECT_EQ(l.touching, l.toner);
   EXPECT_GT(l.min_gap, -1e-9) << "particles overlap";
@@ -124,23 +106,24 @@ TEST(AttachedToner, EveryTonerTouchesACarrierAndEachCarriesTheConcentration)
 
 TEST(AttachedToner, TonerPlacedInTheBoxMostlyTouchesNothing)
 {
-  const Layout l = layout_of(inserted(developer("insert_box: [[0 mm, 0 mm, 0 mm], [1 mm, 1 mm, 0.3 mm]]")));
+  const Layout l =
+      layout_of(inserted(magbrush::testing::box_developer("insert_box: [[0 mm, 0 mm, 0 mm], [1 mm, 1 mm, 0.3 mm]]")));
   EXPECT_LT(l.touching, l.toner / 10);
 }
 
 TEST(AttachedToner, OnlyTonerGivenByAConcentrationIsAttachedAndItTakesNoRegion)
 {
   auto error_of = [](const std::string &yaml) { return magbrush::testing::case_error_of(yaml, "developer.yaml"); };
-  std::string by_count = developer("attached: true");
+  std::string by_count = magbrush::testing::box_developer("attached: true");
   by_count.replace(by_count.find("concentration: 5 %"), 18, "count: 100");
   const std::string count = error_of(by_count);
   EXPECT_NE(count.find("populations.toner.attached"), std::string::npos) << count;
   EXPECT_NE(count.find("concentration"), std::string::npos) << count;
 
-  const std::string region = error_of(developer("attached: true, insert_box: [[0 mm, 0 mm, 0 mm], [1 mm, 1 mm, 1 mm]]"));
+  const std::string region = error_of(magbrush::testing::box_developer("attached: true, insert_box: [[0 mm, 0 mm, 0 mm], [1 mm, 1 mm, 1 mm]]"));
   EXPECT_NE(region.find("give no insert_box"), std::string::npos) << region;
 
-  std::string carrier = developer("attached: true");
+  std::string carrier = magbrush::testing::box_developer("attached: true");
   carrier.replace(carrier.find("counter_charge: true"), 20, "attached: true");
   const std::string on_carrier = error_of(carrier);
   EXPECT_NE(on_carrier.find("populations.carrier.attached"), std::string::npos) << on_carrier;

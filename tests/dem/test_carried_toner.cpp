@@ -24,6 +24,7 @@
 #include "dem/carried_toner.h"
 #include "dem/particle_flow.h"
 #include "tests/case_error.h"
+#include "tests/dem/box_developer.h"
 #include "tests/test_temp_dir.h"
 
 #include <gtest/gtest.h>
@@ -43,25 +44,6 @@ namespace {
 
 constexpr double deg = M_PI / 180.0;
 constexpr double sleeve_radius = 2e-3, drum_gap = 0.3e-3, release_gap = 0.25e-3;
-
-class RadialPull : public ForceTerm
-{
-public:
-  explicit RadialPull(double g) : g_(g) {}
-  const char *name() const override { return "radial pull"; }
-  void add_forces(const ParticleState &s, ForceBuffers &f, double) override
-  {
-    for (std::size_t i = 0; i < s.size(); ++i)
-    {
-      const double r = std::hypot(s.x[i], s.y[i]);
-      f.fx[i] -= g_ * s.mass[i] * s.x[i] / r;
-      f.fy[i] -= g_ * s.mass[i] * s.y[i] / r;
-    }
-  }
-
-private:
-  double g_;
-};
 
 Material material(const std::string &name, double E, double rho, double friction)
 {
@@ -414,42 +396,26 @@ TEST(CarriedToner, TheFedDeveloperIsNeutralCarrierByCarrierAndItsTonerHasTheQmDi
 }
 
 namespace {
-std::string box_developer(const std::string &toner_keys)
-{
-  return R"(
-name: developer
-scene: box
-materials:
-  carrier: {youngs_modulus: 1e3 MPa, poisson_ratio: 0.35, density: 2200 kg/m^3, friction: 0.45, damping: 0.6}
-  toner: {youngs_modulus: 3e3 MPa, poisson_ratio: 0.35, density: 1100 kg/m^3, friction: 0.3, damping: 0.6}
-  wall: {youngs_modulus: 5e4 MPa, poisson_ratio: 0.3, friction: 0.35, damping: 0.6}
-planes:
-  - {name: floor, point: [0 mm, 0 mm, 0 mm], normal: [0, 0, 1], material: wall}
-populations:
-  - {name: carrier, kind: carrier, diameter: 35 um, count: 150, insert_box: [[0 mm, 0 mm, 0 mm], [1 mm, 1 mm, 0.3 mm]]}
-  - {name: toner, kind: toner, diameter: 7 um, charge_to_mass: -30 uC/g, )" +
-         toner_keys + R"(}
-dem: {gravity: [0, 0, 0], periodic_length_x: 1 mm, periodic_length_y: 1 mm}
-)";
-}
 std::string error_of(const std::string &yaml) { return magbrush::testing::case_error_of(yaml, "developer.yaml"); }
 } // namespace
 
 TEST(CarriedToner, TheValidationRefusesItWhereItCannotApply)
 {
+  using magbrush::testing::box_developer;
   // No drum to release at.
-  const std::string no_drum = error_of(box_developer("concentration: 5 %, attached: true, carried_until_gap: 10 um"));
+  const std::string no_drum = error_of(box_developer("attached: true, carried_until_gap: 10 um"));
   EXPECT_NE(no_drum.find("populations.toner.carried_until_gap"), std::string::npos) << no_drum;
   EXPECT_NE(no_drum.find("no drum"), std::string::npos) << no_drum;
   // Toner by count: nothing rides a carrier.
-  const std::string by_count = error_of(box_developer("count: 100, insert_box: [[0 mm, 0 mm, 0 mm], [1 mm, 1 mm, 0.3 mm]], "
-                                                      "carried_until_gap: 10 um"));
+  std::string count = box_developer("insert_box: [[0 mm, 0 mm, 0 mm], [1 mm, 1 mm, 0.3 mm]], carried_until_gap: 10 um");
+  count.replace(count.find("concentration: 5 %"), 18, "count: 100");
+  const std::string by_count = error_of(count);
   EXPECT_NE(by_count.find("only toner given by a concentration"), std::string::npos) << by_count;
   // In a box, neither attached nor fed.
-  const std::string loose = error_of(box_developer("concentration: 5 %, insert_box: [[0 mm, 0 mm, 0 mm], [1 mm, 1 mm, "
-                                                   "0.3 mm]], carried_until_gap: 10 um"));
+  const std::string loose =
+      error_of(box_developer("insert_box: [[0 mm, 0 mm, 0 mm], [1 mm, 1 mm, 0.3 mm]], carried_until_gap: 10 um"));
   EXPECT_NE(loose.find("set attached: true"), std::string::npos) << loose;
   // A negative gap.
-  const std::string negative = error_of(box_developer("concentration: 5 %, attached: true, carried_until_gap: -1 um"));
+  const std::string negative = error_of(box_developer("attached: true, carried_until_gap: -1 um"));
   EXPECT_NE(negative.find("carried_until_gap"), std::string::npos) << negative;
 }

@@ -38,26 +38,6 @@ namespace {
 constexpr double deg = M_PI / 180.0;
 constexpr double omega = 100.0, sleeve_radius = 2e-3, areal_mass = 0.05;
 
-// The magnet's stand-in: a pull of `g` towards the roller axis on every particle.
-class RadialPull : public ForceTerm
-{
-public:
-  explicit RadialPull(double g) : g_(g) {}
-  const char *name() const override { return "radial pull"; }
-  void add_forces(const ParticleState &s, ForceBuffers &f, double) override
-  {
-    for (std::size_t i = 0; i < s.size(); ++i)
-    {
-      const double r = std::hypot(s.x[i], s.y[i]);
-      f.fx[i] -= g_ * s.mass[i] * s.x[i] / r;
-      f.fy[i] -= g_ * s.mass[i] * s.y[i] / r;
-    }
-  }
-
-private:
-  double g_;
-};
-
 Case conveyor_case(double slab, double E = 1e7)
 {
   Material m = elastic_material("carrier", E, 0.3, 2200);

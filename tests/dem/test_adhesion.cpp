@@ -432,7 +432,8 @@ TEST(Adhesion, TheKweonCaseGivesEveryPairItsHamakerConstant)
 {
   // The development case sets Hamaker constants for the toner and every material it meets,
   // with 50 nm asperities: its contact table builds, and the toner's pull-off forces are
-  // nN, not the µN of smooth 7 µm spheres.
+  // nN, not the µN of smooth 7 µm spheres. Its toner-carrier pair is set apart (35 nN, tens of
+  // nN as measured): the carried toner model it uses assumes toner stays on its carrier.
   const Case c = load_case(std::string(MAGBRUSH_SOURCE_DIR) + "/cases/kweon_development.yaml");
   std::vector<std::string> species;
   for (const auto &p : c.populations)
@@ -456,6 +457,6 @@ TEST(Adhesion, TheKweonCaseGivesEveryPairItsHamakerConstant)
                 walls.material(w).c_str(), F, a.hamaker);
     EXPECT_LT(F, 1e-7);
   }
-  EXPECT_GT(F_tc, 1e-9);
+  EXPECT_GT(F_tc, 1e-8);
   EXPECT_LT(F_tc, 1e-7);
 }

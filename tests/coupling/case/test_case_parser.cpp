@@ -242,6 +242,22 @@ TEST(CaseFiles, KweonDevelopmentHasTheBiasRangeAndChargedToner)
   ASSERT_EQ(c.populations.size(), 2u);
   EXPECT_EQ(c.populations[1].kind, ParticleKind::toner);
   EXPECT_NEAR(c.populations[1].charge_to_mass, -30e-3, 1e-15);
+  // Its toner rides the carriers until near the drum, fed with them (the reduced toner model).
+  EXPECT_GT(c.populations[1].carried_until_gap, 0.0);
+  EXPECT_TRUE(c.populations[1].attached);
+  ASSERT_TRUE(c.flow.inflow() && c.sleeve && c.drum.present);
+  // The window is the nip's: the feed upstream of the development pole facing the drum, and
+  // the removal downstream of the measuring window: the drum point measure_to past the gap
+  // centre must still be before the outflow, seen from the roller axis, or the developed toner
+  // is removed before it is measured.
+  const double x = c.development.measure_to;
+  const double radial = c.sleeve->radius + c.drum.gap + x * x / (2.0 * c.drum.radius);
+  const double measured_at = c.drum.angle + std::atan2(x, radial);
+  EXPECT_LT(c.flow.inflow_angle + c.flow.inflow_prefill_arc, c.drum.angle);
+  EXPECT_LT(measured_at, c.flow.outflow_angle);
+  EXPECT_GT(c.development.measure_from, 0.0);
+  EXPECT_GT(c.development.average_from, 0.0);
+  EXPECT_GT(c.dem.duration, c.development.average_from);
 }
 
 TEST(CaseParser, DefaultsAgreeWithTheContractStruct)

@@ -1,6 +1,7 @@
 // Toner carried by its carrier, and its release near the drum (see carried_toner.h).
 #include "dem/carried_toner.h"
 
+#include "common/random_engine_state.h"
 #include "dem/checkpoint_file.h"
 #include "dem/insertion.h"
 #include "dem/particle_charges.h"
@@ -8,7 +9,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -250,19 +250,14 @@ void CarriedTonerRelease::recapture(ParticleState &state, std::vector<char> &lea
 
 void CarriedTonerRelease::write_state(CheckpointWriter &out) const
 {
-  std::ostringstream text;
-  text << rng_;
-  const std::string s = text.str();
-  out.put_array(std::vector<char>(s.begin(), s.end()));
+  put_random_engine(out, rng_);
   out.put(released_);
   out.put(recaptured_);
 }
 
 void CarriedTonerRelease::read_state(CheckpointReader &in)
 {
-  std::vector<char> s;
-  in.get_array(s);
-  std::istringstream(std::string(s.begin(), s.end())) >> rng_;
+  get_random_engine(in, rng_);
   released_ = in.get<long>();
   recaptured_ = in.get<long>();
 }

@@ -1,6 +1,7 @@
 // The inflow on the sleeve (see particle_source.h).
 #include "dem/particle_source.h"
 
+#include "common/random_engine_state.h"
 #include "dem/carried_toner.h"
 #include "dem/checkpoint_file.h"
 #include "dem/insertion.h"
@@ -8,7 +9,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -192,7 +192,6 @@ bool ParticleSource::clear_of_everything(const Vector3 &p, double r) const
 
 void ParticleSource::append(const Feed &f, const Vector3 &p, double d, double t, double charge, ParticleState &enter)
 {
-  const double m = sphere_mass(d, f.density);
   enter.add(p, 0.5 * d, f.density, f.species, charge);
   // Rigidly with the sleeve: v = ω ẑ × x, spin ω ẑ.
   const double w = spin_up_ > 0.0 && t < spin_up_ ? omega_ * t / spin_up_ : omega_;
@@ -392,10 +391,7 @@ void ParticleSource::check_owed() const
 
 void ParticleSource::write_state(CheckpointWriter &out) const
 {
-  std::ostringstream text;
-  text << rng_;
-  const std::string s = text.str();
-  out.put_array(std::vector<char>(s.begin(), s.end()));
+  put_random_engine(out, rng_);
   out.put(t_last_);
   out.put(owed_carrier_);
   out.put(pending_d_);
@@ -409,9 +405,7 @@ void ParticleSource::write_state(CheckpointWriter &out) const
 
 void ParticleSource::read_state(CheckpointReader &in)
 {
-  std::vector<char> s;
-  in.get_array(s);
-  std::istringstream(std::string(s.begin(), s.end())) >> rng_;
+  get_random_engine(in, rng_);
   t_last_ = in.get<double>();
   owed_carrier_ = in.get<double>();
   pending_d_ = in.get<double>();

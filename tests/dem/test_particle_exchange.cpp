@@ -6,6 +6,7 @@
 // a checkpoint in the middle continues bit-identically (the exchange's random stream and
 // counters are in the checkpoint).
 #include "tests/dem/dem_test_scenes.h"
+#include "common/random_engine_state.h"
 #include "dem/checkpoint_file.h"
 #include "dem/force_terms/gravity.h"
 #include "tests/test_temp_dir.h"
@@ -19,7 +20,6 @@
 #include <filesystem>
 #include <map>
 #include <random>
-#include <sstream>
 
 using namespace magbrush;
 using namespace magbrush::dem;
@@ -71,17 +71,12 @@ public:
   void smallest_particles(ParticleState &out) const override { out.add({0, 0, 0}, 40e-6, 2200, 0, 0.0); }
   void write_state(CheckpointWriter &out) const override
   {
-    std::ostringstream text;
-    text << rng_;
-    const std::string t = text.str();
-    out.put_array(std::vector<char>(t.begin(), t.end()));
+    put_random_engine(out, rng_);
     out.put(created_);
   }
   void read_state(CheckpointReader &in) override
   {
-    std::vector<char> t;
-    in.get_array(t);
-    std::istringstream(std::string(t.begin(), t.end())) >> rng_;
+    get_random_engine(in, rng_);
     created_ = in.get<long>();
   }
   long created() const { return created_; }

@@ -298,6 +298,7 @@ std::vector<ResolvedEntry> resolved_entries(const Case &c)
   e.q("inflow.layer_height", "inflow.layer_height", flow.inflow_layer_height);
   e.s("inflow.supply", "inflow.supply", flow.inflow_supply);
   e.q("inflow.prefill_arc", "inflow.prefill_arc", flow.inflow_prefill_arc);
+  e.s("inflow.prefill_where_no_room", "inflow.prefill_where_no_room", flow.inflow_prefill_no_room);
   e.q("inflow.sump_mass", "inflow.sump_mass", flow.inflow_sump_mass);
   e.q("inflow.interval", "inflow.interval", flow.interval);
   e.q("outflow.angle", "outflow.angle", flow.outflow_angle);

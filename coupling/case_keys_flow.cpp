@@ -36,6 +36,12 @@ std::vector<KeySpec> flow_keys()
                "a transit time bringing the first developer to the nip or the blade (0 = the sleeve starts bare). "
                "These particles are part of the initial state; at rest when the scene settles first.")
           .def("0 deg").non_negative().max(2.0 * pi),
+      choice("inflow.prefill_where_no_room", {"refuse", "thin"},
+             "Where the prefilled layer finds no room (a drum nearer the sleeve than inflow.layer_height, at the "
+             "layer's mass per area): refuse: the run stops with the angle where it does not fit; thin: what fits "
+             "is placed there, and downstream the layer keeps only the fraction that passed its narrowest place, "
+             "as a layer squeezed through a gap does (a nip filled from the start, instead of after a transit).")
+          .def("refuse"),
       quantity("inflow.sump_mass", D::linear_mass,
                "With supply: sump, the developer in the sump per length along the roller axis (0 = unlimited). "
                "The inflow draws on it (carriers and toner, each from its own stock) and everything the outflow "

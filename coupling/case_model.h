@@ -336,6 +336,10 @@ struct FlowSettings
   // offered, and what finds no room in the entry arc stays in the sump (the pick-up is measured).
   std::string inflow_supply = "fixed";
   double inflow_prefill_arc = 0.0;   // the sleeve carries the layer over this arc downstream of the entry at the start [rad]
+  // Where the prefilled layer finds no room (a drum nearer the sleeve than the layer): "refuse"
+  // (an error naming the angle) or "thin" (what fits is placed, and the layer downstream keeps
+  // only the fraction that passed the narrowest place, as a layer squeezed through a gap).
+  std::string inflow_prefill_no_room = "refuse";
   // A finite sump (supply "sump" only): the developer in it per length along the roller axis
   // [kg/m] (0 = unlimited). The inflow draws on it, the outflow returns to it.
   double inflow_sump_mass = 0.0;

@@ -1027,6 +1027,7 @@ private:
     f.inflow_layer_height = q(in, "layer_height");
     f.inflow_supply = str(in, "supply");
     f.inflow_prefill_arc = q(in, "prefill_arc");
+    f.inflow_prefill_no_room = str(in, "prefill_where_no_room");
     f.inflow_sump_mass = q(in, "sump_mass");
     f.interval = q(in, "interval");
     f.outflow_angle = q(out, "angle");

@@ -367,6 +367,8 @@ void check_flow(const Case &c, std::vector<CaseIssue> &out)
   if (f.inflow_sump_mass > 0.0 && f.inflow_supply != "sump")
     out.push_back({"inflow.sump_mass", "a finite sump needs inflow.supply: sump (a fixed supply feeds exactly "
                                        "inflow.areal_mass and has no stock to run out of)"});
+  if (f.inflow_prefill_no_room != "refuse" && f.inflow_prefill_arc <= 0.0)
+    out.push_back({"inflow.prefill_where_no_room", "applies to the prefilled layer: set inflow.prefill_arc"});
   if (f.inflow_prefill_arc > 0.0 && !f.inflow())
     out.push_back({"inflow.prefill_arc", "the prefill is the inflow's layer: set inflow.areal_mass"});
 }

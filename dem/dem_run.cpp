@@ -221,6 +221,16 @@ void DemRun::log_setup() const
                       flow->source()->prefilled_count(), flow->source()->prefilled_mass(),
                       f.inflow_prefill_arc * 180.0 / M_PI);
         log_ << line;
+        const ParticleSource &source = *flow->source();
+        if (source.prefill_thinned_mass() > 0.0)
+        {
+          std::snprintf(line, sizeof line,
+                        "  prefill thinned where the layer finds no room: %.4g kg of carriers not placed; past its "
+                        "narrowest place (%.4g deg) the layer holds %.3g of the fed mass per area\n",
+                        source.prefill_thinned_mass(), source.prefill_narrowest_angle() * 180.0 / M_PI,
+                        source.prefill_passed_fraction());
+          log_ << line;
+        }
       }
     }
     if (flow->sink())

@@ -70,6 +70,7 @@ ParticleSource::ParticleSource(const Case &c, const DemWalls &walls, const Perio
   areal_mass_ = f.inflow_areal_mass;
   sump_ = f.inflow_supply == "sump";
   prefill_arc_ = f.inflow_prefill_arc;
+  prefill_thins_ = f.inflow_prefill_no_room == "thin";
   prefill_at_rest_ = c.dem.settle_time > 0.0;
   carrier_share_ = 1.0 / (1.0 + tc);
   // Random insertion jams near 30-40 % solid; refuse a layer that would need more.
@@ -336,6 +337,13 @@ bool ParticleSource::fill_owed(double t, double theta0, double span, bool may_de
 // does not fit there: a wall in the way leaves most of a piece unplaced at once, while random
 // placement near its packing limit only falls behind by a fraction of a carrier per piece,
 // which the pieces downstream take up.
+//
+// Where it does not fit, the layer is refused (inflow.prefill_where_no_room: refuse) or thinned
+// (thin): a piece's shortfall beyond two carriers is dropped (counted in prefill_thinned_mass;
+// a smaller one, the random placement's lag, moves on as before), and from there on every
+// piece is given only the fraction of the layer's mass that the narrowest piece so far took,
+// since a layer that passes a gap carries on downstream what the gap let through, not what the
+// sleeve brought to it.
 void ParticleSource::prefill(const ParticleState &present, ParticleState &add)
 {
   if (prefill_arc_ <= 0.0)
@@ -349,13 +357,34 @@ void ParticleSource::prefill(const ParticleState &present, ParticleState &add)
   const double span = sense * prefill_arc_ / pieces;
   const double per_piece = carrier_share_ * areal_mass_ * R_ * std::abs(span) * Lz_;
   const double backlog = std::max(per_piece, 10.0 * sphere_mass(carrier_.d_mean, carrier_.density));
+  // Thin: a piece that leaves more than two carriers unplaced has no room for the layer (random
+  // placement near its packing limit falls behind by a fraction of one).
+  const double shortfall = 2.0 * sphere_mass(carrier_.d_mean, carrier_.density);
+  double passed = 1.0; // the fraction of the layer the narrowest piece so far took (thin)
   for (int k = 0; k < pieces; ++k)
   {
     const double theta0 = theta_in_ + k * span;
-    owed_carrier_ += per_piece;
+    const double given = passed * per_piece;
+    prefill_withheld_mass_ += per_piece - given;
+    const double owed_before = owed_carrier_ + given;
+    owed_carrier_ += given;
     gather_near(present, theta0, span);
     add_near(add, theta0, span);
     fill_owed(0.0, theta0, span, /*may_decline=*/false, add); // the layer is given, not offered
+    if (owed_carrier_ > shortfall && prefill_thins_)
+    {
+      // What this piece took is what passes on (pending_d_: a drawn carrier that did not fit
+      // is drawn anew downstream).
+      const double took = (owed_before - owed_carrier_) / per_piece;
+      if (took < passed)
+      {
+        passed = took;
+        prefill_narrowest_ = theta0 + 0.5 * span;
+      }
+      prefill_thinned_mass_ += owed_carrier_;
+      owed_carrier_ = 0.0;
+      pending_d_ = 0.0;
+    }
     if (owed_carrier_ > backlog)
     {
       throw std::invalid_argument(
@@ -365,6 +394,7 @@ void ParticleSource::prefill(const ParticleState &present, ParticleState &add)
     }
   }
   // What is left (below half a particle) is not carried over into the run's inflow.
+  prefill_passed_ = passed;
   owed_carrier_ = 0.0;
   pending_d_ = 0.0;
   std::fill(owed_toner_.begin(), owed_toner_.end(), 0.0);

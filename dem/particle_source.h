@@ -39,6 +39,8 @@
 // With inflow.prefill_arc the sleeve already carries the layer at the start: the same areal
 // mass, placed the same way over the arc θ_in … θ_in ± prefill_arc (downstream), so that the
 // run does not spend a transit time bringing the first developer to where it is measured.
+// Where a drum leaves the layer no room, the prefill is refused, or thinned to what fits there
+// and downstream of it (inflow.prefill_where_no_room), so that it can fill a nip.
 // Those particles are part of the initial state (not counted as created), at rest when the
 // scene settles first (dem.settle_time) and moving with the sleeve otherwise.
 #pragma once
@@ -76,6 +78,15 @@ public:
   // Prefilled at the start: number and mass of carriers and toner together.
   long prefilled_count() const { return prefilled_count_; }
   double prefilled_mass() const { return prefilled_mass_; }
+  // A thinned prefill (inflow.prefill_where_no_room: thin): the carrier mass of the layer that
+  // found no room [kg], and the fraction of the layer that passed its narrowest place (1: it
+  // fitted everywhere).
+  double prefill_thinned_mass() const { return prefill_thinned_mass_; }
+  double prefill_passed_fraction() const { return prefill_passed_; }
+  double prefill_narrowest_angle() const { return prefill_narrowest_; } // [rad] (roller angle)
+  // ... and the carrier mass the pieces past the narrowest place were not given [kg] (the
+  // layer that did not pass): prefilled carriers + thinned + withheld = the layer's carriers.
+  double prefill_withheld_mass() const { return prefill_withheld_mass_; }
 
   // One particle per fed population at its smallest diameter (for the stable time step).
   void smallest_particles(ParticleState &out) const;
@@ -117,6 +128,9 @@ private:
   double areal_mass_ = 0.0, carrier_share_ = 1.0;
   bool sump_ = false; // inflow.supply: sump
   double prefill_arc_ = 0.0;
+  bool prefill_thins_ = false; // inflow.prefill_where_no_room: thin
+  double prefill_thinned_mass_ = 0.0, prefill_passed_ = 1.0, prefill_narrowest_ = 0.0;
+  double prefill_withheld_mass_ = 0.0;
   bool finite_sump_ = false;
   bool drawing_ = false; // creating the run's inflow (not the prefill): draws on a finite sump
   bool prefill_at_rest_ = false;

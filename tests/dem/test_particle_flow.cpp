@@ -453,6 +453,68 @@ TEST(DemParticleFlow, APrefillWithNoRoomIsRefusedNamingTheKey)
   }
 }
 
+// inflow.prefill_where_no_room: thin. A roof of beads from 130 µm above the sleeve, 100° to 125°
+// (a cubic lattice whose holes no drawn bead passes), leaves room for about one layer of beads
+// under it; the layer of 0.12 kg/m² (27 % solid in the 0.2 mm its centres may use) does not fit
+// there. Thinned: the first piece (90° to 97°, before the roof) carries the whole layer, the arc
+// under the roof what fits, the arc after it no more than what passed (the layer squeezed
+// through a gap), and the layer's mass is placed, thinned or withheld, to within a bead.
+// Refused by default (the test above).
+TEST(DemParticleFlow, APrefillThinnedWhereItFindsNoRoomCarriesOnWhatPassed)
+{
+  const double slab = 1e-3, arc = 50 * deg, gamma = 0.12;
+  Case c = conveyor_case(slab);
+  c.flow.inflow_areal_mass = gamma;
+  c.flow.inflow_prefill_arc = arc;
+  c.flow.inflow_prefill_no_room = "thin";
+  DemSystem sys(c);
+  ParticleSource source(c, sys.walls(), sys.box());
+  ParticleState roof;
+  const double r_roof = sleeve_radius + 180e-6;
+  for (double th = 100 * deg; th < 125 * deg; th += 95e-6 / r_roof)
+    for (double z = 0.0; z < slab - 1e-9; z += slab / 10)
+      roof.add({r_roof * std::cos(th), r_roof * std::sin(th), z}, 50e-6, 2200, 0, 0.0);
+  ParticleState add;
+  ASSERT_NO_THROW(source.prefill(roof, add));
+  // Mass per degree of the layer placed before, under and after the roof.
+  auto mass_between = [&](double a, double b) {
+    double m = 0.0;
+    for (std::size_t i = 0; i < add.size(); ++i)
+    {
+      const double th = std::atan2(add.y[i], add.x[i]);
+      if (th >= a * deg && th < b * deg)
+        m += add.mass[i];
+    }
+    return m / (b - a);
+  };
+  const double layer = gamma * sleeve_radius * deg * slab; // per degree
+  const double before = mass_between(90, 97), under = mass_between(105, 124), after = mass_between(127, 140);
+  const double bead_max = 2200 * M_PI / 6.0 * std::pow(130e-6, 3);
+  std::printf("per degree, of the layer's %.4g kg: %.4g before the roof, %.4g under it, %.4g after it; passed "
+              "%.3f at %.1f deg; thinned %.4g kg\n",
+              layer, before, under, after, source.prefill_passed_fraction(),
+              source.prefill_narrowest_angle() / deg, source.prefill_thinned_mass());
+  EXPECT_NEAR(before, layer, 0.1 * layer);
+  EXPECT_LT(under, 0.8 * layer);
+  EXPECT_GT(under, 0.2 * layer);
+  EXPECT_LE(after, under * 1.1);
+  EXPECT_GT(after, 0.1 * layer);
+  EXPECT_LT(source.prefill_passed_fraction(), 0.8);
+  EXPECT_GE(source.prefill_narrowest_angle(), 100 * deg);
+  EXPECT_LE(source.prefill_narrowest_angle(), 125 * deg);
+  EXPECT_EQ(source.prefilled_count(), static_cast<long>(add.size()));
+  // The layer's mass over the whole arc is placed, thinned (no room) or withheld (not given to
+  // the pieces past the narrowest place), to within the last piece's remainder (a bead).
+  double placed = 0.0;
+  for (std::size_t i = 0; i < add.size(); ++i)
+    placed += add.mass[i];
+  EXPECT_DOUBLE_EQ(source.prefilled_mass(), placed);
+  EXPECT_GT(source.prefill_thinned_mass(), 0.0);
+  EXPECT_GT(source.prefill_withheld_mass(), 0.0);
+  EXPECT_NEAR(placed + source.prefill_thinned_mass() + source.prefill_withheld_mass(),
+              gamma * sleeve_radius * arc * slab, bead_max);
+}
+
 // A finite, closed sump (inflow.sump_mass): it holds ~100 beads' worth at the start; the sleeve
 // draws ~17 beads per ms, so it runs dry after ~6 ms; what the outflow removes (from ~10 ms on,
 // when the first beads arrive there) returns to it and is fed again. At every row of the flow

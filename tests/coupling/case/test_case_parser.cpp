@@ -253,7 +253,11 @@ TEST(CaseFiles, KweonDevelopmentHasTheBiasRangeAndChargedToner)
   const double x = c.development.measure_to;
   const double radial = c.sleeve->radius + c.drum.gap + x * x / (2.0 * c.drum.radius);
   const double measured_at = c.drum.angle + std::atan2(x, radial);
-  EXPECT_LT(c.flow.inflow_angle + c.flow.inflow_prefill_arc, c.drum.angle);
+  EXPECT_LT(c.flow.inflow_angle, c.drum.angle);
+  // The nip is filled from the start: the prefill reaches the outflow, thinned past the gap
+  // (the feed layer does not fit under the drum).
+  EXPECT_GE(c.flow.inflow_angle + c.flow.inflow_prefill_arc, c.flow.outflow_angle - 1e-9);
+  EXPECT_EQ(c.flow.inflow_prefill_no_room, "thin");
   EXPECT_LT(measured_at, c.flow.outflow_angle);
   EXPECT_GT(c.development.measure_from, 0.0);
   EXPECT_GT(c.development.average_from, 0.0);

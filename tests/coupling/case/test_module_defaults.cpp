@@ -332,6 +332,7 @@ TEST(ModuleDefaults, MeasurementAndOutputSettingsOfADefaultCaseAreTheStructDefau
   EXPECT_SAME(c.flow, flow, inflow_prefill_arc);
   EXPECT_SAME(c.flow, flow, inflow_sump_mass);
   EXPECT_SAME_EXACT(c.flow, flow, inflow_supply);
+  EXPECT_SAME_EXACT(c.flow, flow, inflow_prefill_no_room);
   EXPECT_SAME(c.flow, flow, interval);
   EXPECT_SAME(c.flow, flow, outflow_angle);
   EXPECT_SAME(c.flow, flow, outflow_width);

@@ -35,6 +35,19 @@ public:
   virtual void add_forces_of(const ParticleState & /*state*/, ForceBuffers & /*forces*/, double /*t*/,
                              const std::vector<std::uint32_t> & /*which*/)
   {}
+  // Optional, for a term held as a whole (force_terms/held_forces.h) that can renew what a few
+  // moved particles change without evaluating everybody (Coulomb: the rows the moved charges
+  // stand in). `held` holds this term's forces alone; `moved` lists the particles that moved
+  // the hold distance since their last evaluation or renewal (ascending). The term updates in
+  // place the held forces of every particle whose force those moves change, as if those
+  // particles alone had been evaluated again where they are now, and returns true; or it
+  // returns false, touching nothing held, when it cannot this step (then everybody is
+  // evaluated). The same bits on any number of threads.
+  virtual bool renew_moved(const ParticleState & /*state*/, ForceBuffers & /*held*/, double /*t*/,
+                           const std::vector<std::uint32_t> & /*moved*/)
+  {
+    return false;
+  }
   // Optional, for terms that are a plain loop over the particles (gravity, drag): they may
   // run inside the engine's OpenMP team instead of in a parallel region of their own, which
   // saves a fork and a join per step (~45 µs with sleeping idle threads, measured). Such a

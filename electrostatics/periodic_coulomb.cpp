@@ -119,7 +119,7 @@ void PeriodicCoulomb::set_image_surface(const GroundedSurface &surface, int term
 void PeriodicCoulomb::place_sources(const double *x, const double *y, const double *z, const double *q,
                                     const double *floor)
 {
-  const std::size_t n = n_, m = static_cast<std::size_t>(images_per_charge_);
+  const std::size_t n = n_;
   for (std::size_t i = 0; i < n; ++i)
   {
     sx_[i] = x[i];
@@ -127,25 +127,31 @@ void PeriodicCoulomb::place_sources(const double *x, const double *y, const doub
     sz_[i] = z[i];
     sq_[i] = q[i];
   }
-  if (m == 0)
+  if (images_per_charge_ == 0)
     return;
   for (std::size_t i = 0; i < n; ++i)
+    place_images_of(i, x, y, z, q, floor);
+}
+
+// The pair images of charge i below the tangent plane at its foot point on the surface.
+void PeriodicCoulomb::place_images_of(std::size_t i, const double *x, const double *y, const double *z,
+                                      const double *q, const double *floor)
+{
+  const std::size_t n = n_, m = static_cast<std::size_t>(images_per_charge_);
+  double normal[3];
+  double h = surface_.height(x[i], y[i], z[i], normal);
+  if (floor)
+    h = std::max(h, floor[i]);
+  h = std::max(h, 0.0);
+  const double foot[3] = {x[i] - h * normal[0], y[i] - h * normal[1], z[i] - h * normal[2]};
+  surface_.layer.pair_images(h, image_terms_, image_charge_, image_depth_);
+  for (std::size_t k = 0; k < m; ++k)
   {
-    double normal[3];
-    double h = surface_.height(x[i], y[i], z[i], normal);
-    if (floor)
-      h = std::max(h, floor[i]);
-    h = std::max(h, 0.0);
-    const double foot[3] = {x[i] - h * normal[0], y[i] - h * normal[1], z[i] - h * normal[2]};
-    surface_.layer.pair_images(h, image_terms_, image_charge_, image_depth_);
-    for (std::size_t k = 0; k < m; ++k)
-    {
-      const std::size_t s = n + i * m + k;
-      sx_[s] = foot[0] - image_depth_[k] * normal[0];
-      sy_[s] = foot[1] - image_depth_[k] * normal[1];
-      sz_[s] = foot[2] - image_depth_[k] * normal[2];
-      sq_[s] = q[i] * image_charge_[k];
-    }
+    const std::size_t s = n + i * m + k;
+    sx_[s] = foot[0] - image_depth_[k] * normal[0];
+    sy_[s] = foot[1] - image_depth_[k] * normal[1];
+    sz_[s] = foot[2] - image_depth_[k] * normal[2];
+    sq_[s] = q[i] * image_charge_[k];
   }
 }
 
@@ -236,6 +242,7 @@ void PeriodicCoulomb::rebuild(std::size_t n, const double *x, const double *y, c
   far_->build(total, sx_.data(), sy_.data(), sz_.data(), settings_.cell_size);
   const double t1 = omp_get_wtime();
   build_rows(own_image_near_);
+  columns_built_ = false;
   const double t2 = omp_get_wtime();
   scratch_E_.resize(3 * total);
   scratch_phi_.resize(total);
@@ -268,6 +275,86 @@ void PeriodicCoulomb::field(const double *x, const double *y, const double *z, c
     if (phi)
       phi[i] = far_phi_[i] + coulomb_constant * near.phi;
   }
+}
+
+void PeriodicCoulomb::build_columns()
+{
+  // A counting sort of the row entries by source: the entries of each source in row order.
+  const std::size_t sources = sx_.size(), entries = row_source_.size();
+  column_begin_.assign(sources + 1, 0);
+  for (const std::uint32_t s : row_source_)
+    ++column_begin_[s + 1];
+  for (std::size_t s = 0; s < sources; ++s)
+    column_begin_[s + 1] += column_begin_[s];
+  column_entry_.resize(entries);
+  entry_target_.resize(entries);
+  row_fill_.assign(column_begin_.begin(), column_begin_.end() - 1);
+  for (std::size_t i = 0; i < n_; ++i)
+    for (std::uint32_t e = row_begin_[i]; e < row_begin_[i + 1]; ++e)
+    {
+      column_entry_[row_fill_[row_source_[e]]++] = e;
+      entry_target_[e] = static_cast<std::uint32_t>(i);
+    }
+  moving_.assign(n_, 0);
+  columns_built_ = true;
+}
+
+void PeriodicCoulomb::renew(const std::vector<std::uint32_t> &moved, const double *x, const double *y, const double *z,
+                            const double *q, const double *floor, std::vector<std::uint32_t> &touched,
+                            std::vector<double> &dE, std::vector<double> &E_moved)
+{
+  if (!columns_built_)
+    build_columns();
+  const std::size_t n = n_, m = static_cast<std::size_t>(images_per_charge_);
+  touched.clear();
+  dE.resize(3 * n);
+  for (const std::uint32_t k : moved)
+    moving_[k] = 1;
+  // Each entry of a moved source in another charge's row: its field from the source where it
+  // was, then where it is now. (A target that moves too gets its whole row afresh below.)
+  auto entries_of = [&](std::size_t s, double sign) {
+    for (std::uint32_t c = column_begin_[s]; c < column_begin_[s + 1]; ++c)
+    {
+      const std::uint32_t e = column_entry_[c], i = entry_target_[e];
+      if (moving_[i])
+        continue;
+      double ex = 0.0, ey = 0.0, ez = 0.0, phi = 0.0;
+      add_coulomb(sx_[i] - sx_[s] - row_shift_[3 * e], sy_[i] - sy_[s] - row_shift_[3 * e + 1],
+                  sz_[i] - sz_[s] - row_shift_[3 * e + 2], sq_[s], ex, ey, ez, phi);
+      if (sign > 0.0)
+        touched.push_back(i);
+      dE[3 * i] += sign * coulomb_constant * ex;
+      dE[3 * i + 1] += sign * coulomb_constant * ey;
+      dE[3 * i + 2] += sign * coulomb_constant * ez;
+    }
+  };
+  for (const std::uint32_t k : moved)
+  {
+    entries_of(k, -1.0);
+    for (std::size_t j = 0; j < m; ++j)
+      entries_of(n + k * m + j, -1.0);
+    sx_[k] = x[k];
+    sy_[k] = y[k];
+    sz_[k] = z[k];
+    sq_[k] = q[k];
+    if (m > 0)
+      place_images_of(k, x, y, z, q, floor);
+    entries_of(k, 1.0);
+    for (std::size_t j = 0; j < m; ++j)
+      entries_of(n + k * m + j, 1.0);
+  }
+  E_moved.resize(3 * moved.size());
+  for (std::size_t a = 0; a < moved.size(); ++a)
+  {
+    const std::uint32_t k = moved[a], first = row_begin_[k];
+    const RowSum near = near_row_sum(sx_[k], sy_[k], sz_[k], row_source_.data() + first, row_shift_.data() + 3 * first,
+                                     row_begin_[k + 1] - first, sx_.data(), sy_.data(), sz_.data(), sq_.data());
+    E_moved[3 * a] = far_E_[3 * k] + coulomb_constant * near.ex;
+    E_moved[3 * a + 1] = far_E_[3 * k + 1] + coulomb_constant * near.ey;
+    E_moved[3 * a + 2] = far_E_[3 * k + 2] + coulomb_constant * near.ez;
+  }
+  for (const std::uint32_t k : moved)
+    moving_[k] = 0;
 }
 
 } // namespace magbrush::electrostatics

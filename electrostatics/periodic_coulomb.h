@@ -67,6 +67,29 @@ public:
   void field(const double *x, const double *y, const double *z, const double *q, const double *floor,
              double *E, double *phi);
 
+  // Renewal of a few moved charges, for a field held between evaluations (the DEM term holds
+  // it until something moved a hold distance: dem/force_terms/coulomb.h). The sources stand
+  // where the last field() or renew() placed them; the charges `moved` (ascending) now stand
+  // at x, y, z (the others' entries there are not read). Their images are placed again, and
+  //  * for every other charge whose near row holds one of their sources, the change of those
+  //    entries' field is ADDED to dE (3 per charge): `touched` lists those charges, ascending
+  //    within each moved charge's rows (a charge may appear more than once);
+  //  * the moved charges' own fields are computed afresh into E_moved (3 per moved charge):
+  //    the held far field plus their near rows at the sources' present places.
+  // So after it the held field of every charge is the field of the sources where they were
+  // last placed, as if the whole had been evaluated then, each pair off by the moves of its
+  // two charges since they were last placed. The far field is not touched (its own refresh).
+  // Serial, in a fixed order: the same bits on any number of threads.
+  void renew(const std::vector<std::uint32_t> &moved, const double *x, const double *y, const double *z,
+             const double *q, const double *floor, std::vector<std::uint32_t> &touched, std::vector<double> &dE,
+             std::vector<double> &E_moved);
+  // Places the sources at these positions without evaluating anything (a restarted run puts
+  // them back where the interrupted one had last placed them).
+  void place(const double *x, const double *y, const double *z, const double *q, const double *floor)
+  {
+    place_sources(x, y, z, q, floor);
+  }
+
   // The held far field (3 per charge, [V/m]) and far potential, for checkpoints.
   std::vector<double> &held_far_field() { return far_E_; }
   std::vector<double> &held_far_potential() { return far_phi_; }
@@ -98,11 +121,19 @@ private:
   std::vector<double> row_shift_;
   std::vector<std::uint32_t> row_fill_;
   std::vector<char> own_image_near_; // per image: is it its owner's near pair (not in the far field)
+  // The near rows transposed, built at the first renew() after a rebuild: for each source,
+  // the row entries that hold it, and each entry's target.
+  bool columns_built_ = false;
+  std::vector<std::uint32_t> column_begin_, column_entry_, entry_target_;
+  std::vector<char> moving_; // per real charge: in the renewal under way
   // Held far field of the real charges (kernel sum × 1/(4πε0)), own images removed.
   std::vector<double> far_E_, far_phi_, scratch_phi_, scratch_E_;
   Times times_;
 
   void place_sources(const double *x, const double *y, const double *z, const double *q, const double *floor);
+  void place_images_of(std::size_t i, const double *x, const double *y, const double *z, const double *q,
+                       const double *floor);
+  void build_columns();
   void build_rows(std::vector<char> &own_image_near);
   void remove_own_far_images(const std::vector<char> &own_image_near);
 };

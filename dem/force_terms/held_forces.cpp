@@ -10,8 +10,9 @@
 namespace magbrush::dem {
 
 HeldForces::HeldForces(std::unique_ptr<ForceTerm> inner, double hold_distance, const std::array<double, 3> &box,
-                       std::function<double(double)> source_travel)
-  : inner_(std::move(inner)), hold_distance_(hold_distance), box_(box), source_travel_(std::move(source_travel))
+                       std::function<double(double)> source_travel, double renew_share)
+  : inner_(std::move(inner)), hold_distance_(hold_distance), box_(box), source_travel_(std::move(source_travel)),
+    renew_share_(renew_share)
 {
   if (!inner_)
     throw std::invalid_argument("held forces: no force term given");
@@ -32,11 +33,16 @@ double HeldForces::squared_move(const ParticleState &state, std::size_t i) const
   return d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
 }
 
-bool HeldForces::must_evaluate(const ParticleState &state, double t) const
+bool HeldForces::stale_as_a_whole(const ParticleState &state, double t) const
 {
   if (!valid_ || held_.fx.size() != state.size())
     return true;
-  if (source_travel_ && std::abs(source_travel_(t) - source_travel_(evaluated_at_)) >= hold_distance_)
+  return source_travel_ && std::abs(source_travel_(t) - source_travel_(evaluated_at_)) >= hold_distance_;
+}
+
+bool HeldForces::must_evaluate(const ParticleState &state, double t) const
+{
+  if (stale_as_a_whole(state, t))
     return true;
   // The largest squared displacement since the last evaluation (a max is the same on any
   // number of threads).
@@ -61,6 +67,44 @@ void HeldForces::evaluate(const ParticleState &state, double t)
   evaluated_at_ = t;
   valid_ = true;
   evaluations_ += 1;
+}
+
+void HeldForces::hold_as_a_whole(const ParticleState &state, double t)
+{
+  if (renew_share_ <= 0.0)
+  {
+    if (must_evaluate(state, t))
+      evaluate(state, t);
+    return;
+  }
+  if (stale_as_a_whole(state, t))
+  {
+    evaluate(state, t);
+    return;
+  }
+  // Who moved d since their last evaluation or renewal, in index order (serial: the list is
+  // the same on any number of threads). Few: the term renews them alone, if it can.
+  const std::size_t n = state.size(), most = static_cast<std::size_t>(renew_share_ * static_cast<double>(n));
+  const double d2 = hold_distance_ * hold_distance_;
+  which_.clear();
+  for (std::size_t i = 0; i < n && which_.size() <= most; ++i)
+    if (squared_move(state, i) >= d2)
+      which_.push_back(static_cast<std::uint32_t>(i));
+  if (which_.empty())
+    return;
+  if (which_.size() > most || !inner_->renew_moved(state, held_, t, which_))
+  {
+    evaluate(state, t);
+    return;
+  }
+  for (const std::uint32_t i : which_)
+  {
+    x0_[i] = state.x[i];
+    y0_[i] = state.y[i];
+    z0_[i] = state.z[i];
+  }
+  renewals_ += 1;
+  renewed_ += static_cast<long>(which_.size());
 }
 
 void HeldForces::evaluate_moved_particles(const ParticleState &state, double t)
@@ -108,8 +152,7 @@ void HeldForces::add_forces(const ParticleState &state, ForceBuffers &forces, do
   else
   {
     ++calls_;
-    if (must_evaluate(state, t))
-      evaluate(state, t);
+    hold_as_a_whole(state, t);
   }
   const long n = static_cast<long>(state.size());
 #pragma omp parallel for schedule(static) if (n > 4096)
@@ -206,19 +249,26 @@ std::string HeldForces::cost_note() const
   if (per_particle_)
     std::snprintf(line, sizeof line, "evaluated at %.2g %% of %ld particle-steps, each held until it moved %.3g nm",
                   share, calls_, hold_distance_ * 1e9);
-  else
+  else if (renew_share_ <= 0.0)
     std::snprintf(line, sizeof line, "evaluated at %ld of %ld steps (%.2g %%), held until something moved %.3g nm",
                   evaluations_, calls_, share, hold_distance_ * 1e9);
+  else
+    std::snprintf(line, sizeof line,
+                  "evaluated at %ld of %ld steps (%.2g %%), held until something moved %.3g nm; the moved alone "
+                  "renewed at %ld steps since the start of this run (%.3g particles each)",
+                  evaluations_, calls_, share, hold_distance_ * 1e9, renewals_,
+                  renewals_ > 0 ? static_cast<double>(renewed_) / static_cast<double>(renewals_) : 0.0);
   const std::string inner = inner_->cost_note();
   return inner.empty() ? std::string(line) : std::string(line) + "; " + inner;
 }
 
 std::unique_ptr<ForceTerm> held_for(std::unique_ptr<ForceTerm> term, double hold_distance,
-                                    const std::array<double, 3> &box, std::function<double(double)> source_travel)
+                                    const std::array<double, 3> &box, std::function<double(double)> source_travel,
+                                    double renew_share)
 {
   if (hold_distance <= 0.0)
     return term;
-  return std::make_unique<HeldForces>(std::move(term), hold_distance, box, std::move(source_travel));
+  return std::make_unique<HeldForces>(std::move(term), hold_distance, box, std::move(source_travel), renew_share);
 }
 
 } // namespace magbrush::dem

@@ -21,7 +21,10 @@
 // particle is evaluated again when IT (or the source) has moved d since its own last
 // evaluation, so a few fast toner do not make the resting thousands pay. Any other term (Coulomb
 // between the charges) is held as a WHOLE: evaluated for everybody when the fastest particle has
-// moved d.
+// moved d. A whole term that can renew what a few moved particles change
+// (ForceTerm::renew_moved: Coulomb) is asked to do that instead when at most `renew_share` of
+// the particles moved d (each is then renewed when IT moved d since its last renewal, like a
+// per-particle term, and everybody when more moved); the bound on each pair is unchanged.
 //
 // The held forces (and torques) are the inner term's, so held at distance 0 they are its
 // forces at every step, bit for bit. Particles re-sorted: the held forces and the reference
@@ -42,8 +45,10 @@ class HeldForces : public ForceTerm
 {
 public:
   // `box`: the periodic lengths (0 = not periodic along that axis).
+  // `renew_share`: a whole term renews the moved particles alone (ForceTerm::renew_moved) when
+  // they are at most this share of all (0: never; everybody whenever one moved d).
   HeldForces(std::unique_ptr<ForceTerm> inner, double hold_distance, const std::array<double, 3> &box,
-             std::function<double(double)> source_travel = {});
+             std::function<double(double)> source_travel = {}, double renew_share = 0.0);
 
   const char *name() const override { return inner_->name(); }
   void add_forces(const ParticleState &state, ForceBuffers &forces, double t) override;
@@ -59,12 +64,16 @@ public:
   // (per particle: particle-steps).
   long evaluations() const { return evaluations_; }
   long calls() const { return calls_; }
+  // Whole: steps on which the moved particles alone were renewed, and how many in all.
+  long renewals() const { return renewals_; }
+  long renewed() const { return renewed_; }
 
 private:
   std::unique_ptr<ForceTerm> inner_;
   double hold_distance_;
   std::array<double, 3> box_;
   std::function<double(double)> source_travel_;
+  double renew_share_ = 0.0;
 
   bool per_particle_;
   bool valid_ = false;     // whole: the held forces belong to the particles present
@@ -76,9 +85,12 @@ private:
   std::vector<std::uint32_t> which_; // per particle: those evaluated this step
   std::vector<double> scratch_;
   long evaluations_ = 0, calls_ = 0;
+  long renewals_ = 0, renewed_ = 0; // since this run (re)started: not in the checkpoint
 
   double squared_move(const ParticleState &state, std::size_t i) const;
   bool must_evaluate(const ParticleState &state, double t) const;
+  bool stale_as_a_whole(const ParticleState &state, double t) const;
+  void hold_as_a_whole(const ParticleState &state, double t);
   void evaluate(const ParticleState &state, double t);
   void evaluate_moved_particles(const ParticleState &state, double t);
 };
@@ -86,6 +98,6 @@ private:
 // `term` held for `hold_distance` (> 0), or `term` itself (0: evaluated at every step).
 std::unique_ptr<ForceTerm> held_for(std::unique_ptr<ForceTerm> term, double hold_distance,
                                     const std::array<double, 3> &box,
-                                    std::function<double(double)> source_travel = {});
+                                    std::function<double(double)> source_travel = {}, double renew_share = 0.0);
 
 } // namespace magbrush::dem

@@ -2,16 +2,19 @@
 // conductors' images (dem/force_terms/conductor_images.h) — Newton's third law over a neutral
 // periodic system, the same bits on 1 and 2 threads, a restart from a checkpoint bit for bit,
 // the image force on a charge near the drum and the sleeve, and a uniform sheet of charge on
-// the photoconductor dropping the potential by σ(h + L/εr)/ε0 through the pair images.
+// the photoconductor dropping the potential by σ(h + L/εr)/ε0 through the pair images, and the
+// renewal of a few moved charges alone giving what a whole evaluation of that moment gives.
 #include "dem/checkpoint_file.h"
 #include "dem/force_terms/conductor_images.h"
 #include "dem/force_terms/coulomb.h"
+#include "dem/force_terms/held_forces.h"
 #include "electrostatics/coulomb_constants.h"
 #include "tests/test_temp_dir.h"
 
 #include <gtest/gtest.h>
 #include <omp.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -317,4 +320,115 @@ TEST(CoulombTerm, AnExchangeOfAsManyParticlesAsLeftSelectsTheChargesAgain)
     EXPECT_EQ(r.fy[i], g.fy[i]) << i;
     EXPECT_EQ(r.fz[i], g.fz[i]) << i;
   }
+}
+
+TEST(PeriodicCoulomb, RenewingAFewMovedChargesGivesWhatAFieldOfTheirNewPlacesGives)
+{
+  // Two rounds of moving a few charges (with their pair images in a layered drum plane): after
+  // renew(), the moved charges' fields are a field() at the new places bit for bit, the others'
+  // held fields plus the changes renew() gave them agree with it to round-off, and no moved
+  // charge is among those touched.
+  const std::array<double, 3> box = {0.0, 0.0, 1e-3};
+  auto s = brush(1500, 200, 1e-3, 0.4e-3, 1e-3, 11);
+  for (std::size_t i = 0; i < s.size(); ++i)
+    s.y[i] += 30e-6; // above the drum plane at y = 0
+  GroundedSurface drum;
+  drum.layer = LayeredImages(3.0, 20e-6);
+  CoulombSettings set;
+  PeriodicCoulomb c(set, box);
+  c.set_image_surface(drum, 2);
+  const std::size_t n = s.size();
+  c.rebuild(n, s.x.data(), s.y.data(), s.z.data(), s.charge.data(), s.radius.data());
+  std::vector<double> held(3 * n), fresh(3 * n), dE, E_moved;
+  c.field(s.x.data(), s.y.data(), s.z.data(), s.charge.data(), s.radius.data(), held.data(), nullptr);
+  std::vector<std::uint32_t> touched;
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-1e-6, 1e-6);
+  for (int round = 0; round < 2; ++round)
+  {
+    std::vector<std::uint32_t> moved;
+    for (std::uint32_t k = static_cast<std::uint32_t>(round); k < n; k += 57)
+    {
+      moved.push_back(k);
+      s.x[k] += u(rng);
+      s.y[k] += u(rng);
+      s.z[k] += u(rng);
+    }
+    c.renew(moved, s.x.data(), s.y.data(), s.z.data(), s.charge.data(), s.radius.data(), touched, dE, E_moved);
+    for (const std::uint32_t k : touched)
+    {
+      EXPECT_TRUE(std::find(moved.begin(), moved.end(), k) == moved.end());
+      for (int d = 0; d < 3; ++d)
+      {
+        held[3 * k + d] += dE[3 * k + d];
+        dE[3 * k + d] = 0.0;
+      }
+    }
+    for (std::size_t a = 0; a < moved.size(); ++a)
+      for (int d = 0; d < 3; ++d)
+        held[3 * moved[a] + d] = E_moved[3 * a + d];
+    EXPECT_GT(touched.size(), moved.size());
+    c.field(s.x.data(), s.y.data(), s.z.data(), s.charge.data(), s.radius.data(), fresh.data(), nullptr);
+    double largest = 0.0, worst = 0.0;
+    for (std::size_t i = 0; i < 3 * n; ++i)
+      largest = std::max(largest, std::abs(fresh[i]));
+    for (std::size_t i = 0; i < 3 * n; ++i)
+      worst = std::max(worst, std::abs(held[i] - fresh[i]));
+    for (const std::uint32_t k : moved)
+      for (int d = 0; d < 3; ++d)
+        EXPECT_EQ(held[3 * k + d], fresh[3 * k + d]);
+    std::printf("round %d: %zu moved, %zu entries touched; held vs field(): %.1e of the largest field\n", round,
+                moved.size(), touched.size(), worst / largest);
+    EXPECT_LT(worst, 1e-12 * largest);
+  }
+}
+
+TEST(CoulombTerm, HeldWithTheMovedRenewedAloneIsAWholeEvaluationOfTheirNewPlaces)
+{
+  // The chain the engine runs: HeldForces around the Coulomb term, renewing alone the few
+  // charges that moved the hold distance. Held forces after the move = the term evaluated
+  // (with the same held far field and cells) with the moved charges where they are and the
+  // others where they were, to round-off; the others' own small moves are not yet seen.
+  const std::array<double, 3> box = {0.0, 0.0, 1e-3};
+  auto s = brush(1500, 200, 1e-3, 0.4e-3, 1e-3, 12);
+  const double d = 20e-9;
+  dem::HeldForces held(std::make_unique<CoulombTerm>(settings(4, 25e-6, 1e-3), box), d, box, {}, 0.05);
+  CoulombTerm whole(settings(4, 25e-6, 1e-3), box);
+  forces_of(held, s, 0.0);
+  forces_of(whole, s, 0.0);
+  auto mixed = s;
+  std::vector<std::uint32_t> moved;
+  for (std::size_t i = 0; i < s.size(); ++i)
+  {
+    const bool fast = i % 40 == 3;
+    const double step = fast ? 3.0 * d : 0.3 * d;
+    s.x[i] += step * std::cos(static_cast<double>(i));
+    s.y[i] += step * std::sin(static_cast<double>(i));
+    if (fast)
+    {
+      mixed.x[i] = s.x[i];
+      mixed.y[i] = s.y[i];
+      moved.push_back(static_cast<std::uint32_t>(i));
+    }
+  }
+  const auto fh = forces_of(held, s, 1e-8), fw = forces_of(whole, mixed, 1e-8);
+  EXPECT_EQ(held.renewals(), 1);
+  EXPECT_EQ(held.renewed(), static_cast<long>(moved.size()));
+  EXPECT_EQ(held.evaluations(), 1);
+  double largest = 0.0, worst = 0.0;
+  for (std::size_t i = 0; i < s.size(); ++i)
+  {
+    largest = std::max({largest, std::abs(fw.fx[i]), std::abs(fw.fy[i]), std::abs(fw.fz[i])});
+    worst = std::max({worst, std::abs(fh.fx[i] - fw.fx[i]), std::abs(fh.fy[i] - fw.fy[i]),
+                      std::abs(fh.fz[i] - fw.fz[i])});
+  }
+  std::printf("%zu of %zu renewed alone: held vs whole evaluation %.1e of the largest force\n", moved.size(),
+              s.size(), worst / largest);
+  EXPECT_LT(worst, 1e-12 * largest);
+  // More than the share moved: everybody is evaluated.
+  for (std::size_t i = 0; i < s.size(); ++i)
+    s.x[i] += 2.0 * d;
+  forces_of(held, s, 2e-8);
+  EXPECT_EQ(held.evaluations(), 2);
+  EXPECT_EQ(held.renewals(), 1);
 }

@@ -174,10 +174,13 @@ void DemRun::log_setup() const
   log_ << "  contact law: Hertz + Voigt damping, Mindlin tangential + Coulomb, rolling friction (Kawamoto A2-A7)\n"
        << s.contact_table().describe();
   const auto &st = s.stable_time_step_info();
+  // A restart keeps the checkpoint's step (time = step count x step), whatever the case says now.
+  const char *origin = !options_.restart_file.empty() ? "the checkpoint's"
+                       : case_.dem.time_step > 0      ? "user"
+                                                      : "automatic";
   std::snprintf(line, sizeof line,
                 "  time step %.4g s (%s; stable limit %.4g s set by the %s; Rayleigh %.4g s, Hertz t_c/10 %.4g s)\n",
-                s.time_step(), case_.dem.time_step > 0 ? "user" : "automatic", st.limit, st.limiting.c_str(),
-                st.rayleigh, st.hertz);
+                s.time_step(), origin, st.limit, st.limiting.c_str(), st.rayleigh, st.hertz);
   log_ << line;
   std::snprintf(line, sizeof line, "  Verlet skin %.3g m\n", s.skin());
   log_ << line;

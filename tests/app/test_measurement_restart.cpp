@@ -79,6 +79,8 @@ TEST_P(MeasurementRestart, RestartedRunWritesTheUninterruptedRunsFilesByteForByt
                                               " --output " + continued.string());
   ASSERT_EQ(b.code, 0) << b.output;
   EXPECT_NE(b.output.find("the measurements continue from the checkpoint"), std::string::npos) << b.output;
+  // The restarted run keeps the checkpoint's step and says so.
+  EXPECT_NE(b.output.find("(the checkpoint's; stable limit"), std::string::npos) << b.output;
   for (const char *file : scene.files)
   {
     ASSERT_TRUE(fs::exists(whole / file)) << file << " was not written by the whole run";

@@ -70,8 +70,7 @@ public:
   std::string cost_note() const override;
 
   long evaluations() const { return evaluations_; } // far-field evaluations (rebuilds) so far
-  long renewals() const { return renewals_; }       // renew_moved() calls that renewed charges
-  long renewed_charges() const { return renewed_charges_; }
+
   std::size_t charges() const { return index_.size(); }
 
 private:
@@ -82,7 +81,6 @@ private:
   bool must_select_ = true, must_rebuild_ = true;
   double built_at_ = 0.0;
   long evaluations_ = 0;
-  long renewals_ = 0, renewed_charges_ = 0; // renew_moved() since this run (re)started
   // Compact charged particles: engine index, charge, radius (image floor), unwrapped
   // positions now and at the last rebuild, field.
   std::vector<std::uint32_t> index_;

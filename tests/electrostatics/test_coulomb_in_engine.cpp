@@ -47,6 +47,18 @@ void fill(dem::DemSystem &system)
         p.add({a * (i + 0.5 + u(rng)), a * (j + 0.5 + u(rng)), a * (l + 0.5 + u(rng))}, 4e-6, 1000.0, 0,
               k % 2 ? 3e-15 : -3e-15);
 }
+
+// `b` (a system of case c) with the particles `fill_it` places and the case's force terms,
+// restored from `checkpoint` and advanced by `steps`.
+void restore_and_advance(dem::DemSystem &b, const Case &c, void (*fill_it)(dem::DemSystem &),
+                         const std::string &checkpoint, long steps)
+{
+  fill_it(b);
+  dem::add_case_force_terms(b, c);
+  b.initialize();
+  b.read_checkpoint(checkpoint);
+  b.advance(steps);
+}
 } // namespace
 
 TEST(CoulombInEngine, RegistryChoosesTheTermsAndRestartIsBitForBit)
@@ -76,11 +88,7 @@ TEST(CoulombInEngine, RegistryChoosesTheTermsAndRestartIsBitForBit)
   a.advance(20);
 
   dem::DemSystem b(c);
-  fill(b);
-  dem::add_case_force_terms(b, c);
-  b.initialize();
-  b.read_checkpoint(path);
-  b.advance(20);
+  restore_and_advance(b, c, fill, path, 20);
   const auto &pa = a.particles(), &pb = b.particles();
   ASSERT_EQ(pa.size(), pb.size());
   EXPECT_EQ(std::memcmp(pa.x.data(), pb.x.data(), pa.size() * sizeof(double)), 0);
@@ -139,11 +147,7 @@ TEST(CoulombInEngine, TheFewRenewedAloneRestartBitForBitOnOneAndTwoThreads)
     a.write_checkpoint(path);
     a.advance(40);
     dem::DemSystem b(c);
-    fill_with_fast_few(b);
-    dem::add_case_force_terms(b, c);
-    b.initialize();
-    b.read_checkpoint(path);
-    b.advance(40);
+    restore_and_advance(b, c, fill_with_fast_few, path, 40);
     const auto &pa = a.particles(), &pb = b.particles();
     ASSERT_EQ(pa.size(), pb.size());
     EXPECT_EQ(std::memcmp(pa.x.data(), pb.x.data(), pa.size() * sizeof(double)), 0);

@@ -316,6 +316,12 @@ TEST(ModuleDefaults, MeasurementAndOutputSettingsOfADefaultCaseAreTheStructDefau
   EXPECT_SAME(c.nip, nip, chain_bin_angle);
   EXPECT_SAME(c.nip, nip, chain_half_angle);
 
+  const DevelopmentSettings development;
+  EXPECT_SAME(c.development, development, measure_from);
+  EXPECT_SAME(c.development, development, measure_to);
+  EXPECT_SAME(c.development, development, sample_interval);
+  EXPECT_SAME(c.development, development, average_from);
+
   const CompressionSettings compression;
   EXPECT_SAME_EXACT(c.compression, compression, plate);
   EXPECT_SAME_EXACT(c.compression, compression, stage);

@@ -2,6 +2,7 @@
 
 #include "dem/checkpoint_file.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
@@ -21,16 +22,24 @@ HeldForces::HeldForces(std::unique_ptr<ForceTerm> inner, double hold_distance, c
   per_particle_ = inner_->acts_on_each_particle_alone();
 }
 
-double HeldForces::squared_move(const ParticleState &state, std::size_t i) const
+void HeldForces::squared_moves(const ParticleState &state, std::size_t begin, std::size_t end, double *out) const
 {
-  // Minimum image along the periodic axes: crossing the box is no move.
-  // A move is far below half the box, so one wrap is the only case (no division in this
-  // per-particle, per-step check).
-  double d[3] = {state.x[i] - x0_[i], state.y[i] - y0_[i], state.z[i] - z0_[i]};
-  for (int a = 0; a < 3; ++a)
-    if (box_[a] > 0.0 && std::abs(d[a]) > 0.5 * box_[a])
-      d[a] -= std::copysign(box_[a], d[a]);
-  return d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+  // Minimum image along the periodic axes: crossing the box is no move. A move is far below
+  // half the box, so one wrap is the only case. Written without calls or branches (a wrap is
+  // a select, an axis that is not periodic has half = 0 and wraps by 0) so that the compiler
+  // vectorises it: this check runs for every particle at every step, once per held term.
+  const double *x = state.x.data(), *y = state.y.data(), *z = state.z.data();
+  const double *x0 = x0_.data(), *y0 = y0_.data(), *z0 = z0_.data();
+  const double bx = box_[0], by = box_[1], bz = box_[2];
+  const double hx = 0.5 * bx, hy = 0.5 * by, hz = 0.5 * bz;
+  for (std::size_t i = begin; i < end; ++i)
+  {
+    double dx = x[i] - x0[i], dy = y[i] - y0[i], dz = z[i] - z0[i];
+    dx -= (dx > hx ? bx : 0.0) - (dx < -hx ? bx : 0.0);
+    dy -= (dy > hy ? by : 0.0) - (dy < -hy ? by : 0.0);
+    dz -= (dz > hz ? bz : 0.0) - (dz < -hz ? bz : 0.0);
+    out[i - begin] = dx * dx + dy * dy + dz * dz;
+  }
 }
 
 bool HeldForces::stale_as_a_whole(const ParticleState &state, double t) const
@@ -46,13 +55,17 @@ bool HeldForces::must_evaluate(const ParticleState &state, double t) const
     return true;
   // The largest squared displacement since the last evaluation (a max is the same on any
   // number of threads).
-  const long n = static_cast<long>(state.size());
+  const long blocks = static_cast<long>((state.size() + move_block - 1) / move_block);
   double largest = 0.0;
-#pragma omp parallel for schedule(static) reduction(max : largest) if (n > 4096)
-  for (long i = 0; i < n; ++i)
+#pragma omp parallel for schedule(static) reduction(max : largest) if (blocks > 16)
+  for (long b = 0; b < blocks; ++b)
   {
-    const double d2 = squared_move(state, static_cast<std::size_t>(i));
-    largest = d2 > largest ? d2 : largest;
+    double d2[move_block];
+    const std::size_t begin = static_cast<std::size_t>(b) * move_block,
+                      end = std::min(state.size(), begin + move_block);
+    squared_moves(state, begin, end, d2);
+    for (std::size_t k = 0; k < end - begin; ++k)
+      largest = d2[k] > largest ? d2[k] : largest;
   }
   return largest >= hold_distance_ * hold_distance_;
 }
@@ -83,13 +96,20 @@ void HeldForces::hold_as_a_whole(const ParticleState &state, double t)
     return;
   }
   // Who moved d since their last evaluation or renewal, in index order (serial: the list is
-  // the same on any number of threads). Few: the term renews them alone, if it can.
+  // the same on any number of threads). Few: the term renews them alone, if it can. The scan
+  // stops at the block where they became too many.
   const std::size_t n = state.size(), most = static_cast<std::size_t>(renew_share_ * static_cast<double>(n));
-  const double d2 = hold_distance_ * hold_distance_;
+  const double hold2 = hold_distance_ * hold_distance_;
   which_.clear();
-  for (std::size_t i = 0; i < n && which_.size() <= most; ++i)
-    if (squared_move(state, i) >= d2)
-      which_.push_back(static_cast<std::uint32_t>(i));
+  double d2[move_block];
+  for (std::size_t begin = 0; begin < n && which_.size() <= most; begin += move_block)
+  {
+    const std::size_t end = std::min(n, begin + move_block);
+    squared_moves(state, begin, end, d2);
+    for (std::size_t i = begin; i < end; ++i)
+      if (d2[i - begin] >= hold2)
+        which_.push_back(static_cast<std::uint32_t>(i));
+  }
   if (which_.empty())
     return;
   if (which_.size() > most || !inner_->renew_moved(state, held_, t, which_))
@@ -121,11 +141,17 @@ void HeldForces::evaluate_moved_particles(const ParticleState &state, double t)
   }
   // Who moved (or whose source did), in index order: the list, and so the bits, are the same on
   // any number of threads.
-  const double u = source_travel_ ? source_travel_(t) : 0.0, d2 = hold_distance_ * hold_distance_;
+  const double u = source_travel_ ? source_travel_(t) : 0.0, hold2 = hold_distance_ * hold_distance_;
   which_.clear();
-  for (std::size_t i = 0; i < n; ++i)
-    if (stale_[i] || std::abs(u - u0_[i]) >= hold_distance_ || squared_move(state, i) >= d2)
-      which_.push_back(static_cast<std::uint32_t>(i));
+  double d2[move_block];
+  for (std::size_t begin = 0; begin < n; begin += move_block)
+  {
+    const std::size_t end = std::min(n, begin + move_block);
+    squared_moves(state, begin, end, d2);
+    for (std::size_t i = begin; i < end; ++i)
+      if (stale_[i] || std::abs(u - u0_[i]) >= hold_distance_ || d2[i - begin] >= hold2)
+        which_.push_back(static_cast<std::uint32_t>(i));
+  }
   if (which_.empty())
     return;
   for (const std::uint32_t i : which_)

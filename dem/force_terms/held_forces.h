@@ -87,7 +87,10 @@ private:
   long evaluations_ = 0, calls_ = 0;
   long renewals_ = 0, renewed_ = 0; // since this run (re)started: not in the checkpoint
 
-  double squared_move(const ParticleState &state, std::size_t i) const;
+  // The squared moves since the last evaluation of particles [begin, end) into out[0 ..),
+  // scanned in blocks of move_block (a buffer on the stack: nothing allocated per step).
+  static constexpr std::size_t move_block = 256;
+  void squared_moves(const ParticleState &state, std::size_t begin, std::size_t end, double *out) const;
   bool must_evaluate(const ParticleState &state, double t) const;
   bool stale_as_a_whole(const ParticleState &state, double t) const;
   void hold_as_a_whole(const ParticleState &state, double t);

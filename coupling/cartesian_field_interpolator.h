@@ -32,10 +32,10 @@ public:
     double out[6];
     if (!patch(x, out))
     {
-      E = {0.0, 0.0, 0.0};
+      E = {{0.0, 0.0, 0.0}};
       return false;
     }
-    E = {-out[1] / dx_, -out[2] / dy_, 0.0};
+    E = {{-out[1] / dx_, -out[2] / dy_, 0.0}};
     return true;
   }
   Vec3 field(const Vec3 &x) const

@@ -91,10 +91,10 @@ public:
     double phi, gx, gy;
     if (!gradient(x, w, phi, gx, gy))
     {
-      E = {0.0, 0.0, 0.0};
+      E = {{0.0, 0.0, 0.0}};
       return false;
     }
-    E = {-gx, -gy, 0.0};
+    E = {{-gx, -gy, 0.0}};
     return true;
   }
   // Φ [V] inside the window, NaN outside.

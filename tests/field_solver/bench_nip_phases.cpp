@@ -35,7 +35,7 @@ std::vector<Vec3> gap_points(const NipPhaseSetup &s, double d_drum)
   std::vector<Vec3> p;
   for (double y = -0.35e-3; y <= 0.35e-3 + 1e-12; y += 0.05e-3)
     for (double x = s.sleeve_surface_x(y); x <= s.drum_surface_x(y) - d_drum; x += 5e-6)
-      p.push_back({x, y, 0.0});
+      p.push_back({{x, y, 0.0}});
   return p;
 }
 

@@ -79,7 +79,7 @@ struct NipPhaseSetup
     g.bias = empty_grid();
     g.bias.phi = solve(bias, 0.0, 0.0);
     g.image_period = image.period;
-    g.drum_center = {Rs + gap + Rd, 0.0};
+    g.drum_center = {{Rs + gap + Rd, 0.0}};
     g.drum_radius = Rd;
     for (int k = 0; k < K; ++k)
       g.image.push_back(solve(0.0, 1.0, k * image.period / K));

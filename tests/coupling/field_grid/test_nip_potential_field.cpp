@@ -132,8 +132,10 @@ TEST(NipPotentialField, SurfaceTravelIsTheIntegralOfTheDrumSpeed)
   {
     integral += 0.5 * dt * (speed(t) + speed(t + dt));
     if ((k + 1) % 500 == 0)
+    {
       EXPECT_NEAR(NipPotentialField::surface_travel(d, t + dt), integral, 1e-12 * d.radius)
         << "t = " << t + dt;
+    }
   }
   EXPECT_EQ(NipPotentialField::surface_travel(d, -1e-3), 0.0);
   d.spin_up_time = 0.0;

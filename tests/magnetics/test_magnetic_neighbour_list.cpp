@@ -226,7 +226,9 @@ TEST(MagneticNeighbourList, AppendedBeadsJoinTheRowsInPairOrderInPlaceOrLaidOutA
     (kept ? in_place : afresh) += 1;
     ASSERT_EQ(rows_of(list), expected_rows(list, x.size())) << "batch " << batch;
     if (kept) // no earlier row moved
+    {
       EXPECT_TRUE(std::equal(begin_before.begin(), begin_before.end(), list.incident_begin().begin()));
+    }
     EXPECT_EQ(list.particle_count(), x.size());
   }
   EXPECT_GE(in_place, 5);

@@ -50,6 +50,9 @@ const cli::CommandSpec &report_command_line()
   flux_profile.png        the computed sleeve flux (over output.measured_flux_file's scan if given)
   brush_snapshot.png      the brush in the nip at the last snapshot, beads coloured by speed
   time_series.png         kinetic energy, contacts, wall loads, bead budget
+  toner_development.png   TMA and fog against time, the averaging window with its mean, its
+                          halves (the steady-state test) and the neutralisation bound, when the
+                          run measures toner development
   index.md, index.html    the key numbers (slip at the gap centre against the relative surface
                           speed, peak normal pressure against B^2/2mu0, tangential/normal,
                           touching density, beads in/out, run times per stage and force term)

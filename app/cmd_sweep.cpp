@@ -76,7 +76,8 @@ then compares the nip profiles of all points:
                        looked at, the drift between the halves of the averaging window with its
                        standard error (<key>_drift, <key>_drift_stderr), steady_state (1: every tested mean drifts < 2 %;
                        where a measurement reports a state, e.g. the beads in the nip window: the
-                       state drifts < 2 % and no other mean drifts beyond 2 % and its noise),
+                       state drifts < 2 % and no other mean drifts beyond 2 % and its noise, or
+                       beyond 2 % with too few samples to know its noise),
                        significant_drift (1: a drift beyond two of its standard errors, a
                        trend; 0: noise) and drift_resolution, the run time of the point, and with --measured the measured value, the
                        relative error and a within-tolerance flag

@@ -69,7 +69,9 @@ void SteadyStateVerdict::add(const SummaryValue &v, double tolerance)
     trending += !within && beyond_noise;
     return;
   }
-  observables_beyond += !within && beyond_noise;
+  // Beyond the tolerance and beyond its noise, or beyond the tolerance with no error to tell it
+  // from noise (too few samples for blocks): either way not shown steady.
+  observables_beyond += !within && (beyond_noise || !has_error);
   if (!has_error)
     return;
   ++with_error;

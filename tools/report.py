@@ -413,6 +413,75 @@ def series_plot(plt, series, nip_series, out):
     return "time_series.png"
 
 
+def averaging_start(path):
+    """The averaging window's start [s] that toner_development.csv states in its first line
+    (0 when it states none: files of earlier versions, which held only the window's rows)."""
+    with open(path) as f:
+        m = re.search(r"from t = (\S+) s", f.readline())
+    return float(m.group(1)) if m else 0.0
+
+
+def window_halves(t, values, t_from):
+    """The samples (t, value) from t_from on, without NaN, and the means of their two halves by
+    count (the steady-state test compares those; with fewer than 4 samples: no halves)."""
+    window = [(ti, v) for ti, v in zip(t, values) if ti >= t_from and v == v]
+    half = len(window) // 2
+    if half < 2:
+        return window, []
+    return window, [(part[0][0], part[-1][0], sum(v for _, v in part) / len(part))
+                    for part in (window[:half], window[half:])]
+
+
+def development_plot(plt, dem_dir, run_summary, out):
+    """TMA and fog against time (toner_development.csv), the averaging window shaded, its mean
+    with the standard error, the means of its two halves (the steady-state test compares them)
+    and the neutralisation bound. None when the run measured no toner development."""
+    path = os.path.join(dem_dir, "toner_development.csv")
+    dev = read_csv(path)
+    if not dev or not dev.get("time_s"):
+        return None
+    t_from = averaging_start(path)
+    rows = {r["key"]: r for r in run_summary}
+
+    def number(key, column="value"):
+        try:
+            return float(rows[key][column])
+        except (KeyError, ValueError):
+            return float("nan")
+
+    t = [v * 1e3 for v in dev["time_s"]]
+    fig, ax = plt.subplots(figsize=(8, 4))
+    ax.plot(t, dev["tma_kg_per_m2"], lw=0.9, label="TMA (image strips)")
+    ax.plot(t, dev["fog_kg_per_m2"], lw=0.9, color="tab:gray", label="fog (dark strips)")
+    ax.axvspan(t_from * 1e3, t[-1], color="tab:blue", alpha=0.08, label="averaging window")
+    mean, se = number("tma_kg_per_m2"), number("tma_kg_per_m2", "standard_error")
+    window, halves = window_halves(t, dev["tma_kg_per_m2"], t_from * 1e3)
+    if mean == mean and window:
+        ax.hlines(mean, window[0][0], window[-1][0], color="tab:blue", lw=2,
+                  label=f"mean {mean:.3g} ± {se:.2g} kg/m²")
+        for begin, end, value in halves:
+            ax.hlines(value, begin, end, color="tab:orange", lw=1.5, ls="--")
+        if halves:
+            ax.plot([], [], color="tab:orange", ls="--",
+                    label=f"halves (drift {100 * number('tma_kg_per_m2', 'drift'):+.1f} %)")
+    bound = number("tma_kg_per_m2_bound")
+    top = max((v for v in dev["tma_kg_per_m2"] if v == v), default=0.0)
+    if bound == bound and top > 0 and bound < 5 * top:
+        ax.axhline(bound, color="tab:red", ls=":", label="neutralisation bound")
+    elif bound == bound:
+        ax.set_title(f"neutralisation bound {bound:.3g} kg/m² (off the scale)", fontsize=9)
+    steady = number("steady_state")
+    verdict = "steady" if steady == 1 else "not steady" if steady == 0 else "steady state not tested"
+    ax.text(0.01, 0.97, f"run: {verdict}", transform=ax.transAxes, va="top", fontsize=9)
+    ax.set_xlabel("time [ms]")
+    ax.set_ylabel("toner mass per area [kg/m²]")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, loc="lower right")
+    save(fig, os.path.join(out, "toner_development.png"))
+    plt.close(fig)
+    return "toner_development.png"
+
+
 # ------------------------------------------------------------------------------------------
 # Key numbers and the index
 
@@ -611,6 +680,9 @@ def main():
     phases = read_phase_times(log)
     dem_done = read_log_line(log, "done:")
     run_summary = read_run_summary(os.path.join(args.dem_dir, "summary.csv"))
+    development = development_plot(plt, args.dem_dir, run_summary, args.out)
+    if development:
+        images.append(development)
     flow = read_csv(os.path.join(args.dem_dir, "flow_report.csv"))
     rows = key_numbers(summary, nip_series, series, flux, run_summary, flow)
     build_index(args, images, rows, run_times, phases, snapshot_time, dem_done)

@@ -109,8 +109,8 @@ double TonerDevelopment::tma_bound() const
 
 void TonerDevelopment::sample(const DemSystem &system)
 {
-  if (system.time() < settings_.average_from)
-    return;
+  // Sampled from the start, so that the file shows the approach to the steady state; the means
+  // and the transfer profile take only the samples from average_from on (add_sample).
   std::size_t drum = system.walls().size();
   for (std::size_t w = 0; w < system.walls().size(); ++w)
     if (system.walls().name(w) == "drum")
@@ -176,9 +176,16 @@ void TonerDevelopment::add_sample(double time, const std::vector<DrumToner> &on_
 {
   std::vector<DrumToner> now = on_drum_now;
   std::sort(now.begin(), now.end(), [](const DrumToner &a, const DrumToner &b) { return a.id < b.id; });
-  if (first_time_ < 0.0)
-    first_time_ = time;
-  last_time_ = time;
+  // Every sample is a row of the file; the means take those from average_from on, and the
+  // transfer between two samples counts when both are.
+  const bool averaged = time >= settings_.average_from;
+  const bool interval_averaged = averaged && previous_time_ >= settings_.average_from;
+  if (averaged)
+  {
+    if (first_time_ < 0.0)
+      first_time_ = time;
+    last_time_ = time;
+  }
 
   // Transfer: merge the id-sorted lists of this and the previous sample.
   double arrived_mass = 0.0;
@@ -194,13 +201,13 @@ void TonerDevelopment::add_sample(double time, const std::vector<DrumToner> &on_
       if (j == before_.size() || (i < now.size() && now[i].id < before_[j].id))
       {
         arrived_mass += now[i].mass;
-        if (const int b = bin(now[i]); b >= 0)
+        if (const int b = bin(now[i]); b >= 0 && interval_averaged)
           arrived_[static_cast<std::size_t>(b)] += now[i].mass;
         ++i;
       }
       else if (i == now.size() || before_[j].id < now[i].id)
       {
-        if (const int b = bin(before_[j]); b >= 0)
+        if (const int b = bin(before_[j]); b >= 0 && interval_averaged)
           left_[static_cast<std::size_t>(b)] += before_[j].mass;
         ++j;
       }
@@ -233,24 +240,39 @@ void TonerDevelopment::add_sample(double time, const std::vector<DrumToner> &on_
       m_dark += t.mass, ++n_dark;
   }
   Row row{time, nan, nan, nan, nan, nan, on_carriers, n_image, n_dark};
-  if (!std::isnan(on_carriers))
-    on_carriers_.add(on_carriers);
   if (image_area > 0.0)
   {
     row.tma = m_image / image_area;
-    tma_.add(row.tma);
     if (eps_layer_over_l_ > 0.0 && contrast_ > 0.0)
-      ratio_.add(row.ratio = std::abs(q_image / image_area) / (eps_layer_over_l_ * contrast_));
+      row.ratio = std::abs(q_image / image_area) / (eps_layer_over_l_ * contrast_);
   }
   if (dark_area > 0.0)
-    fog_.add(row.fog = m_dark / dark_area);
+    row.fog = m_dark / dark_area;
   if (m_image > 0.0)
-    q_over_m_.add(row.q_over_m = q_image / m_image);
+    row.q_over_m = q_image / m_image;
   if (previous_time_ >= 0.0 && time > previous_time_)
-    transfer_.add(row.transfer = arrived_mass / ((time - previous_time_) * depth));
+    row.transfer = arrived_mass / ((time - previous_time_) * depth);
+  if (averaged)
+    add_to_means(row, interval_averaged);
   rows_.push_back(row);
   previous_time_ = time;
   before_ = std::move(now);
+}
+
+void TonerDevelopment::add_to_means(const Row &row, bool with_transfer)
+{
+  if (!std::isnan(row.on_carriers))
+    on_carriers_.add(row.on_carriers);
+  if (!std::isnan(row.tma))
+    tma_.add(row.tma);
+  if (!std::isnan(row.ratio))
+    ratio_.add(row.ratio);
+  if (!std::isnan(row.fog))
+    fog_.add(row.fog);
+  if (!std::isnan(row.q_over_m))
+    q_over_m_.add(row.q_over_m);
+  if (with_transfer && !std::isnan(row.transfer))
+    transfer_.add(row.transfer);
 }
 
 std::vector<SummaryValue> TonerDevelopment::summary() const
@@ -287,7 +309,9 @@ std::string TonerDevelopment::csv() const
 {
   std::ostringstream o;
   o << "# toner on the drum between x = " << settings_.measure_from * 1e3 << " and " << settings_.measure_to * 1e3
-    << " mm after the nip (magbrush toner development); NaN: no area or no toner\n";
+    << " mm after the nip (magbrush toner development); NaN: no area or no toner; the means average the rows "
+       "from t = "
+    << settings_.average_from << " s\n";
   o << "time_s,tma_kg_per_m2,fog_kg_per_m2,developed_q_over_m_C_per_kg,neutralisation_ratio,"
        "transfer_rate_kg_per_s_m,toner_on_carriers_fraction,image_toner,dark_toner\n";
   char line[256];

@@ -123,7 +123,10 @@ private:
     double time, tma, fog, q_over_m, ratio, transfer, on_carriers;
     long image_toner, dark_toner;
   };
-  std::vector<Row> rows_;
+  std::vector<Row> rows_; // every sample since the start
+  // A row from average_from on into the means (its transfer when the interval before it is
+  // inside the averaging window too).
+  void add_to_means(const Row &row, bool with_transfer);
   std::vector<WallContactRecord> records_;
   std::vector<DrumToner> toner_;
   std::vector<std::uint8_t> is_toner_, is_carrier_; // by species

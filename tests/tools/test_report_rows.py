@@ -36,6 +36,30 @@ class SumpRow(unittest.TestCase):
         self.assertTrue(report.sump_row(f)[3].startswith("NOT conserved"))
 
 
+class DevelopmentWindow(unittest.TestCase):
+    """The toner development plot's window: where averaging starts and the halves it compares."""
+
+    def test_the_file_states_where_averaging_starts(self):
+        import tempfile
+        with tempfile.NamedTemporaryFile("w", suffix=".csv", delete=False) as f:
+            f.write("# toner on the drum ...; the means average the rows from t = 0.02 s\ntime_s,tma_kg_per_m2\n")
+        try:
+            self.assertEqual(report.averaging_start(f.name), 0.02)
+            with open(f.name, "w") as g:
+                g.write("# toner on the drum ... (an earlier version)\ntime_s,tma_kg_per_m2\n")
+            self.assertEqual(report.averaging_start(f.name), 0.0)
+        finally:
+            os.unlink(f.name)
+
+    def test_halves_are_the_window_split_by_count_without_nan(self):
+        t = [0, 1, 2, 3, 4, 5, 6, 7]
+        v = [9.0, 9.0, 1.0, math.nan, 2.0, 3.0, 4.0, 6.0]
+        window, halves = report.window_halves(t, v, 2)
+        self.assertEqual([ti for ti, _ in window], [2, 4, 5, 6, 7])
+        self.assertEqual(halves, [(2, 4, 1.5), (5, 7, (3.0 + 4.0 + 6.0) / 3)])
+        self.assertEqual(report.window_halves(t, v, 6)[1], [])  # two samples: no halves
+
+
 def summary(drift_nf, se_nf, resolution, significant, reached):
     """dem/summary.csv rows as report.py reads them (one tested mean)."""
     return [{"key": "normal_force_per_length_N_m", "value": "0.53", "drift": repr(drift_nf),

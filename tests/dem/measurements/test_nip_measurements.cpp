@@ -380,6 +380,11 @@ TEST(NipTimeSeries, BeadsInTheWindowAreTheStateOfTheSteadyStateVerdict)
   EXPECT_EQ(verdict(s[0], force(-0.04, 0.025)).verdict(), 1.0);
   EXPECT_EQ(verdict(s[0], force(-0.06, 0.01)).verdict(), 0.0);
   EXPECT_EQ(verdict(f[0], force(-0.04, 0.025)).verdict(), 0.0); // still filling
+  // A drift beyond the tolerance whose error is unknown (too few samples for blocks) is not
+  // taken for noise; one within the tolerance passes without an error.
+  const double unknown = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(verdict(s[0], force(1.8, unknown)).verdict(), 0.0);
+  EXPECT_EQ(verdict(s[0], force(0.01, unknown)).verdict(), 1.0);
   const std::string rows = verdict(f[0], force(0.0, 0.01)).rows(0.02);
   EXPECT_NE(rows.find("steady_state,0,"), std::string::npos) << rows;
   EXPECT_NE(rows.find("significant_drift,1,"), std::string::npos) << rows; // the filling is a trend

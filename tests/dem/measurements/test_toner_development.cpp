@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -192,6 +193,43 @@ TEST(TonerDevelopment, ArrivalsAreCountedWhereAndWhenTheyHappen)
   for (const char *key : {"tma_kg_per_m2,", "tma_kg_per_m2_bound,", "fog_kg_per_m2,", "developed_q_over_m_C_per_kg,",
                           "neutralisation_ratio,", "toner_transfer_rate_kg_per_s_m,", "steady_state,"})
     EXPECT_NE(csv.find(key), std::string::npos) << key;
+}
+
+TEST(TonerDevelopment, SamplesBeforeTheAveragingWindowAreRowsButNotMeans)
+{
+  // The same three samples as above, with the averaging window opening at the second: all three
+  // are rows of the file (the approach to the steady state), the means and the transfer profile
+  // take only what lies inside the window, i.e. the interval from the second to the third sample.
+  Case c = development_case();
+  c.development.average_from = 5e-6;
+  TonerDevelopment m(c);
+  const NipFrame f = NipFrame::from_case(c);
+  auto at_x = [&](double x) {
+    const double psi = std::asin(x / f.drum_radius);
+    return std::pair{f.cx + f.drum_radius * (-f.nx * std::cos(psi) + f.tx * std::sin(psi)),
+                     f.cy + f.drum_radius * (-f.ny * std::cos(psi) + f.ty * std::sin(psi))};
+  };
+  const auto [x1, y1] = at_x(0.2e-3);
+  const auto [x2, y2] = at_x(-0.5e-3);
+  m.add_sample(0.0, {{1, x1, y1, 3e-13, -1e-14}});
+  m.add_sample(5e-6, {{2, x2, y2, 4e-13, -1.2e-14}, {1, x1, y1, 3e-13, -1e-14}});
+  m.add_sample(10e-6, {{1, x1, y1, 3e-13, -1e-14}});
+  const std::string csv = m.csv();
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 2 + 3) << csv; // comment, header, three rows
+  EXPECT_NE(csv.find("\n0,"), std::string::npos) << csv;            // the sample before the window
+  // The arrival happened before the window (between 0 and 5 us): the window's one interval saw
+  // nothing arrive, so the rate's mean is 0 and the profile is empty over the 5 us span.
+  const auto summary = m.summary();
+  const auto rate = std::find_if(summary.begin(), summary.end(),
+                                 [](const SummaryValue &v) { return v.key == "toner_transfer_rate_kg_per_s_m"; });
+  ASSERT_NE(rate, summary.end());
+  EXPECT_EQ(rate->value, 0.0);
+  EXPECT_EQ(m.tma().size(), 2u);
+  const std::string profile = m.transfer_profile_csv();
+  const double per = 1.0 / (5e-6 * 0.2e-3 * 0.25e-3);
+  char left[128];
+  std::snprintf(left, sizeof left, "-0.5,0,%.6g\n", 4e-13 * per); // it left inside the window
+  EXPECT_NE(profile.find(left), std::string::npos) << profile;
 }
 
 TEST(TonerDevelopment, AppliesToNipScenesWithTonerAndAField)

@@ -157,13 +157,13 @@ TEST(TonerDevelopment, HandPlacedTonerGivesExactTmaFogChargeAndBound)
   EXPECT_NEAR(m.tma_bound(), sigma_limit / 0.03, 1e-9 * sigma_limit / 0.03);
 }
 
-TEST(TonerDevelopment, ArrivalsAreCountedWhereAndWhenTheyHappen)
+namespace {
+
+// Three samples 5 µs apart: toner 1 on the drum at x = 0.2 mm throughout; toner 2 arrives at
+// x ≈ −0.5 mm (in the nip, upstream of the centre) by the second and has left by the third.
+void arrive_and_leave(TonerDevelopment &m, const Case &c)
 {
-  const Case c = development_case();
-  TonerDevelopment m(c);
   const NipFrame f = NipFrame::from_case(c);
-  // Sample 1: toner 1 on the drum. Sample 2 (5 µs later): toner 1 and toner 2, which arrived at
-  // x ≈ −0.5 mm (in the nip, upstream of the centre). Sample 3: toner 2 has left again.
   auto at_x = [&](double x) {
     const double psi = std::asin(x / f.drum_radius);
     return std::pair{f.cx + f.drum_radius * (-f.nx * std::cos(psi) + f.tx * std::sin(psi)),
@@ -174,6 +174,15 @@ TEST(TonerDevelopment, ArrivalsAreCountedWhereAndWhenTheyHappen)
   m.add_sample(0.0, {{1, x1, y1, 3e-13, -1e-14}});
   m.add_sample(5e-6, {{2, x2, y2, 4e-13, -1.2e-14}, {1, x1, y1, 3e-13, -1e-14}});
   m.add_sample(10e-6, {{1, x1, y1, 3e-13, -1e-14}});
+}
+
+} // namespace
+
+TEST(TonerDevelopment, ArrivalsAreCountedWhereAndWhenTheyHappen)
+{
+  const Case c = development_case();
+  TonerDevelopment m(c);
+  arrive_and_leave(m, c);
   const std::string profile = m.transfer_profile_csv();
   // Over the 10 µs span and a 0.2 mm depth, in the 0.25 mm bin at −0.5 mm: 4e-13 kg arrived
   // and left.
@@ -203,17 +212,7 @@ TEST(TonerDevelopment, SamplesBeforeTheAveragingWindowAreRowsButNotMeans)
   Case c = development_case();
   c.development.average_from = 5e-6;
   TonerDevelopment m(c);
-  const NipFrame f = NipFrame::from_case(c);
-  auto at_x = [&](double x) {
-    const double psi = std::asin(x / f.drum_radius);
-    return std::pair{f.cx + f.drum_radius * (-f.nx * std::cos(psi) + f.tx * std::sin(psi)),
-                     f.cy + f.drum_radius * (-f.ny * std::cos(psi) + f.ty * std::sin(psi))};
-  };
-  const auto [x1, y1] = at_x(0.2e-3);
-  const auto [x2, y2] = at_x(-0.5e-3);
-  m.add_sample(0.0, {{1, x1, y1, 3e-13, -1e-14}});
-  m.add_sample(5e-6, {{2, x2, y2, 4e-13, -1.2e-14}, {1, x1, y1, 3e-13, -1e-14}});
-  m.add_sample(10e-6, {{1, x1, y1, 3e-13, -1e-14}});
+  arrive_and_leave(m, c);
   const std::string csv = m.csv();
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 2 + 3) << csv; // comment, header, three rows
   EXPECT_NE(csv.find("\n0,"), std::string::npos) << csv;            // the sample before the window

@@ -1,4 +1,4 @@
-// `magbrush dem CASE [--set key=value ...] [--restart FILE] [--threads N] [--output DIR]`:
+// `magbrush dem CASE [--set key=value ...] [--restart FILE | --resume] [--threads N] [--output DIR]`:
 // runs the OpenMP particle engine bin/magbrush-dem on a case. The driver never links the
 // engine; it checks the arguments against the engine's own declaration
 // (dem/dem_command_line.h) and starts the sibling executable with them.

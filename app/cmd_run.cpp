@@ -60,7 +60,9 @@ bool contains(const std::vector<std::string> &v, const std::string &s)
 class TeeOutput
 {
 public:
-  explicit TeeOutput(const std::string &log_path) : log_(log_path)
+  // append: keep what the log holds (a resumed run adds its part after the earlier runs').
+  TeeOutput(const std::string &log_path, bool append)
+      : log_(log_path, append ? std::ios::out | std::ios::app : std::ios::out)
   {
     std::cout.flush();
     std::cerr.flush();
@@ -272,7 +274,9 @@ int run_stages(const cli::ParsedArguments &args)
     {
       const fs::path dem_dir = fs::path(resolved->output.directory) / "dem";
       fs::create_directories(dem_dir);
-      TeeOutput tee((dem_dir / "dem.log").string());
+      // A resumed DEM continues its log: the earlier runs' lines stay above its own.
+      const bool resuming = args.has("--resume") && fs::exists(dem_dir / "checkpoint.bin");
+      TeeOutput tee((dem_dir / "dem.log").string(), resuming);
       rc = stage->run(a);
     }
     else

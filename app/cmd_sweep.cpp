@@ -32,6 +32,7 @@
 #include "common/study_repeats.h"
 #include "common/study_table.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -119,6 +120,11 @@ run_time_s):
                        the sbatch line; edit the resource lines first.
   --point INDEX / --merge   the two steps by hand (a point's run time and status are kept in
                        its folder, <point>/sweep_point.csv).
+  --resume             a point stopped before its end (a time limit, by hand, a crash) continues
+                       from its own dem/checkpoint.bin, its files then covering the whole run;
+                       one without a checkpoint starts afresh, a finished one only rewrites its
+                       files. Its run time adds the time spent before (to the last line of its
+                       DEM log when it was stopped). A merge lists the points still "running".
 )";
     s.positionals = {{"CASE", "the case file"}};
     s.options = {{"--vary", {}, "key=v1,v2", "the values of one key to run (repeatable: every combination)", true},
@@ -493,6 +499,31 @@ std::pair<std::string, std::string> read_point_result(const fs::path &dir)
   return {"nan", "missing"};
 }
 
+// The time a point has already spent, for a resumed point's run time: what its folder
+// recorded, and for a run stopped before its end (still "running": killed by a time limit or
+// by hand) also the time from its start (when it wrote sweep_point.csv) to the last line of
+// its DEM log. 0 when the point has not run.
+double time_spent_before(const fs::path &dir)
+{
+  const auto [run_time_cell, status] = read_point_result(dir);
+  if (status == "missing")
+    return 0.0;
+  const double recorded = std::atof(run_time_cell.c_str());
+  const double earlier = std::isfinite(recorded) ? recorded : 0.0;
+  const fs::path log = dir / "dem" / "dem.log";
+  if (status != "running" || !fs::exists(log))
+    return earlier;
+  const auto stopped = fs::last_write_time(log) - fs::last_write_time(dir / point_result_name);
+  return earlier + std::max(0.0, std::chrono::duration<double>(stopped).count());
+}
+
+std::string seconds_cell(double seconds)
+{
+  char cell[64];
+  std::snprintf(cell, sizeof cell, "%.1f", seconds);
+  return cell;
+}
+
 // Runs point n's pipeline in its folder and keeps its result there; returns the pipeline's
 // exit code. `threads` > 0: the DEM's --threads when the user gave none (an MPI rank's share).
 // A point that throws counts as failed rather than ending the process: on an MPI rank an
@@ -501,13 +532,17 @@ int run_point(const SweepPlan &plan, std::size_t n, const cli::ParsedArguments &
 {
   const auto started = std::chrono::steady_clock::now();
   int rc = 1;
+  double earlier = 0.0; // seconds spent on this point before (--resume)
   fs::path dir = plan.sweep_dir / ("p" + std::to_string(n));
   try
   {
     const PointSetup point = set_up_point(plan, n);
     dir = point.dir;
     fs::create_directories(point.dir);
-    fs::remove(point.dir / point_result_name); // a result of an earlier run must not stand for this one
+    // A result of an earlier run must not stand for this one: the point says it is running
+    // (and keeps saying so if it is stopped), with the time it had already spent when resumed.
+    earlier = args.has("--resume") ? time_spent_before(point.dir) : 0.0;
+    write_point_result(point.dir, seconds_cell(earlier), "running", rank);
     std::cout << "\n##### magbrush sweep: point " << n + 1 << "/" << plan.points.size() << ": " << point.label
               << " (" << (point.point_case.populations.empty() ? 0 : point.point_case.populations[0].count)
               << " beads) #####" << std::endl;
@@ -531,13 +566,11 @@ int run_point(const SweepPlan &plan, std::size_t n, const cli::ParsedArguments &
     std::cerr << "magbrush sweep: point " << n << " failed: " << e.what() << "\n";
     rc = 1;
   }
-  const double run_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  char cell[64];
-  std::snprintf(cell, sizeof cell, "%.1f", run_time);
+  const double run_time = earlier + std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   try
   {
     fs::create_directories(dir);
-    write_point_result(dir, cell, rc == 0 ? "ok" : "failed", rank);
+    write_point_result(dir, seconds_cell(run_time), rc == 0 ? "ok" : "failed", rank);
   }
   catch (const std::exception &e)
   {
@@ -611,13 +644,15 @@ int merge_points(const SweepPlan &plan)
   std::ostringstream profiles;
   profiles << "# magbrush sweep profiles of " << plan.case_path << " (columns after 'point' as in nip_profile.csv)\n";
   bool profile_header = false;
-  std::vector<std::string> failed, missing;
+  std::vector<std::string> failed, missing, unfinished;
   for (std::size_t n = 0; n < plan.points.size(); ++n)
   {
     const PointSetup point = set_up_point(plan, n);
     const auto [run_time_cell, status] = read_point_result(point.dir);
     if (status == "missing")
       missing.push_back(std::to_string(n) + " (" + point.label + ")");
+    else if (status == "running")
+      unfinished.push_back(std::to_string(n) + " (" + point.label + ")");
     else if (status != "ok")
       failed.push_back(std::to_string(n) + " (" + point.label + ")");
     // Gather the point's key numbers (whatever its measurements report) and profile.
@@ -717,10 +752,14 @@ int merge_points(const SweepPlan &plan)
     std::cerr << "magbrush sweep: " << missing.size() << " of " << plan.points.size()
               << " points have not run (no " << point_result_name << " in their folders): " << listed(missing)
               << "; run them with --point INDEX, then merge again\n";
+  if (!unfinished.empty())
+    std::cerr << "magbrush sweep: " << unfinished.size() << " of " << plan.points.size()
+              << " points have not finished (running, or stopped before their end): " << listed(unfinished)
+              << "; --resume continues them from their checkpoints, then merge again\n";
   if (!failed.empty())
     std::cerr << "magbrush sweep: " << failed.size() << " of " << plan.points.size()
               << " points failed (their rows say so; see their logs in the point folders): " << listed(failed) << "\n";
-  return missing.empty() && failed.empty() ? 0 : 1;
+  return missing.empty() && unfinished.empty() && failed.empty() ? 0 : 1;
 }
 
 // The sweep's own words as given, for the Slurm scripts: the case and any file by absolute
@@ -789,6 +828,9 @@ int sweep(const cli::ParsedArguments &args)
     throw cli::UsageError(std::string(one_point ? "--point" : merge_only ? "--merge" : "--emit") +
                           " is one process's step: run it without mpirun (mpirun -np K magbrush sweep ... "
                           "deals the points to the ranks by itself)");
+  if (args.has("--restart") && !one_point)
+    throw cli::UsageError("--restart names one checkpoint, of one point: give it with --point INDEX, or let every "
+                          "point continue from its own with --resume");
   const SweepPlan plan = plan_sweep(args);
   if (emit)
     return emit_slurm(plan, args);

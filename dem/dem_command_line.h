@@ -14,7 +14,7 @@ inline cli::CommandSpec engine_command_line(const std::string &program)
 {
   cli::CommandSpec spec;
   spec.program = program;
-  spec.usage = program + " CASE [--set key=value ...] [--restart FILE [--restart-anyway]] [--threads N] [--output DIR]";
+  spec.usage = program + " CASE [--set key=value ...] [--restart FILE [--restart-anyway] | --resume] [--threads N] [--output DIR]";
   spec.description =
       "Runs the particles of a case with the discrete-element engine (bin/magbrush-dem): inserts\n"
       "the populations, lets them settle (dem.settle_time), then runs to dem.duration. Outputs in\n"
@@ -26,6 +26,9 @@ inline cli::CommandSpec engine_command_line(const std::string &program)
       {"--restart", {}, "FILE", "continue from a checkpoint, bit-identically to an uninterrupted run"},
       {"--restart-anyway", {}, {},
        "restart even when the checkpoint's case differs from this one beyond run control\n(particle counts, materials, walls, settings: refused otherwise, with the keys)"},
+      {"--resume", {}, {},
+       "continue from the output folder's own checkpoint.bin when there is one (a run stopped by a\n"
+       "time limit, by hand or by a crash: the files then cover the whole run), else start afresh"},
       {"--threads", {}, "N", "OpenMP threads (default: dem.threads, then all cores); results do not\ndepend on it"},
       {"--output", {}, "DIR", "write the outputs here instead of <output.directory>/dem",
        /*repeatable=*/false, /*choices=*/{}, /*for_pipeline=*/false}};

@@ -1,6 +1,6 @@
 // magbrush-dem — the OpenMP discrete-element engine (run through `magbrush dem`).
 //
-//   magbrush-dem CASE [--set key=value ...] [--restart FILE] [--threads N] [--output DIR]
+//   magbrush-dem CASE [--set key=value ...] [--restart FILE | --resume] [--threads N] [--output DIR]
 #include "dem/dem_command_line.h"
 #include "dem/dem_run.h"
 #include "dem/measurements/measurement_registry.h"
@@ -31,6 +31,10 @@ int run_engine(const magbrush::cli::ParsedArguments &args)
   magbrush::dem::RunOptions options;
   options.restart_file = args.value("--restart");
   options.restart_anyway = args.has("--restart-anyway");
+  options.resume = args.has("--resume");
+  if (options.resume && !options.restart_file.empty())
+    throw magbrush::cli::UsageError("--resume continues from the output folder's own checkpoint; --restart names "
+                                    "another one: give one of them");
   options.output_dir = args.value("--output");
   if (args.has("--threads"))
     options.threads = static_cast<int>(args.whole_number("--threads", 0, 1, 1024));

@@ -30,6 +30,8 @@ DemRun::DemRun(const Case &c, const RunOptions &options, std::ostream &log)
     omp_set_num_threads(threads);
   out_dir_ = options_.output_dir.empty() ? (fs::path(case_.output.directory) / "dem").string() : options_.output_dir;
   fs::create_directories(out_dir_);
+  if (options_.resume)
+    take_own_checkpoint();
   system_ = std::make_unique<DemSystem>(case_);
   force_terms_ = add_case_force_terms(*system_, case_);
   identity_.case_hash = case_hash(case_);
@@ -292,6 +294,22 @@ void DemRun::write_measurements() const
   }
   write_run_summary(out_dir_, measurements_, case_.statistics);
 }
+// --resume: the folder's own checkpoint becomes the restart file. It is read whole before the
+// run writes its first checkpoint over it (the writer renames a finished file into place).
+void DemRun::take_own_checkpoint()
+{
+  if (!options_.restart_file.empty())
+    throw std::invalid_argument("resume continues from the output folder's own checkpoint: give it without a "
+                                "restart file (--restart names another one)");
+  const fs::path own = fs::path(out_dir_) / "checkpoint.bin";
+  if (fs::exists(own))
+  {
+    options_.restart_file = own.string();
+    log_ << "resume: continuing from this folder's checkpoint '" << own.string() << "'\n";
+  }
+  else
+    log_ << "resume: no checkpoint in '" << out_dir_ << "' yet: the run starts from the beginning\n";
+}
 
 void DemRun::run()
 {
@@ -411,9 +429,12 @@ void DemRun::run()
     log_timings(omp_get_wtime() - t_wall0);
     throw;
   }
-  if (out_every == 0 || s.step_count() % out_every != 0)
+  // The last step's snapshot and row, unless its interval has just written them, or nothing
+  // ran (a finished run restarted: they are in its files already).
+  const bool advanced = s.step_count() > start_step;
+  if (advanced && (out_every == 0 || s.step_count() % out_every != 0))
     snapshots.write(s);
-  if (s.step_count() % series_every != 0)
+  if (advanced && s.step_count() % series_every != 0)
     series.record(s);
   write_checkpoint();
   write_measurements();

@@ -32,6 +32,9 @@ namespace magbrush::dem {
 struct RunOptions
 {
   std::string restart_file;  // continue from this checkpoint ("" = fresh run)
+  // Continue from the output folder's own checkpoint.bin when there is one (a run stopped by
+  // a time limit, by hand or by a crash), else start afresh. Not with restart_file.
+  bool resume = false;
   bool restart_anyway = false; // restart even when the checkpoint's case differs beyond run control
   std::string output_dir;    // "" = <case.output.directory>/dem
   int threads = 0;           // 0 = case.dem.threads, then the OpenMP default
@@ -82,6 +85,7 @@ private:
   void write_checkpoint();
   void log_setup() const;
   void log_timings(double wall) const;
+  void take_own_checkpoint();
   void write_measurements() const;
 };
 

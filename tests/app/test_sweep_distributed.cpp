@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -200,6 +201,66 @@ TEST_F(DistributedSweep, SlurmArrayStepsRunOneByOneGiveTheSerialTable)
   EXPECT_NE(outside.output.find("--point expects a point of this sweep, 0 to 1 (2 points), found '2'"),
             std::string::npos)
     << outside.output;
+}
+
+// A point stopped before its end continues with --resume from its own checkpoint, in its own
+// folder, to the serial sweep's result bit for bit; its run time adds the time it had spent.
+// The stop is the state a killed point leaves: its DEM ended at a checkpoint (here: a shorter
+// duration, which is run control: 150 steps, a row of the time series, so that its end adds no
+// row the uninterrupted run lacks), its sweep_point.csv still says "running", and its DEM log
+// was last written some time after the point started (100 s here, set on the files' clocks).
+TEST_F(DistributedSweep, AStoppedPointResumesFromItsCheckpointToTheSerialResult)
+{
+  ASSERT_EQ(serial_.status, 0) << serial_.output;
+  const fs::path out = dir_ / "resume";
+  const fs::path point = out / "sweep_diameter" / point_folders[0];
+  const Result first = run(dir_ / "first.log", with({magbrush}, with(sweep_words(dir_, out),
+                                                                      {"--point", "0", "--set", "dem.duration=9.934us"})));
+  ASSERT_EQ(first.status, 0) << first.output;
+  ASSERT_TRUE(fs::exists(point / "dem" / "checkpoint.bin")) << first.output;
+  std::ofstream(point / "sweep_point.csv") << "# stopped\nrun_time_s,status,rank\n5.0,running,0\n";
+  const auto started = fs::last_write_time(point / "sweep_point.csv");
+  fs::last_write_time(point / "dem" / "dem.log", started + std::chrono::seconds(100));
+
+  // The merge of a stopped point says so and fails.
+  const Result early = run(dir_ / "early_merge.log", with({magbrush}, with(sweep_words(dir_, out), {"--merge"})));
+  EXPECT_NE(early.status, 0);
+  EXPECT_NE(early.output.find("have not finished (running, or stopped before their end): 0 (p0_diameter-100um)"),
+            std::string::npos)
+    << early.output;
+
+  const Result resumed = run(dir_ / "resumed.log", with({magbrush}, with(sweep_words(dir_, out), {"--point", "0", "--resume"})));
+  ASSERT_EQ(resumed.status, 0) << resumed.output;
+  EXPECT_NE(resumed.output.find("resume: continuing from this folder's checkpoint"), std::string::npos)
+    << resumed.output;
+  const double run_time = std::stod(magbrush::testing::read_csv_rows(point / "sweep_point.csv").at(1).at(0));
+  EXPECT_GE(run_time, 105.0);
+  EXPECT_LT(run_time, 105.0 + 120.0);
+  // The DEM log keeps the first run's lines above the resumed run's.
+  const std::string log = text_of(point / "dem" / "dem.log");
+  EXPECT_LT(log.find("restarted from"), std::string::npos);
+  EXPECT_LT(log.find("magbrush-dem"), log.find("restarted from")) << log;
+
+  // A point without a checkpoint starts afresh under --resume.
+  const Result fresh = run(dir_ / "fresh.log", with({magbrush}, with(sweep_words(dir_, out), {"--point", "1", "--resume"})));
+  ASSERT_EQ(fresh.status, 0) << fresh.output;
+  EXPECT_NE(fresh.output.find("resume: no checkpoint in"), std::string::npos) << fresh.output;
+  const Result merged = run(dir_ / "merge_resumed.log", with({magbrush}, with(sweep_words(dir_, out), {"--merge"})));
+  ASSERT_EQ(merged.status, 0) << merged.output;
+  expect_same_table_but_run_time(dir_ / "serial", out);
+
+  // A finished point resumed only rewrites its files: the same time series.
+  const std::string series = text_of(point / "dem" / "time_series.csv");
+  const Result again = run(dir_ / "again.log", with({magbrush}, with(sweep_words(dir_, out), {"--point", "0", "--resume"})));
+  ASSERT_EQ(again.status, 0) << again.output;
+  EXPECT_EQ(text_of(point / "dem" / "time_series.csv"), series);
+
+  // One checkpoint for every point is refused, with the way to say what is meant.
+  const Result one_for_all = run(dir_ / "restart_all.log",
+                                 with({magbrush}, with(sweep_words(dir_, out), {"--restart", (point / "dem" / "checkpoint.bin").string()})));
+  EXPECT_NE(one_for_all.status, 0);
+  EXPECT_NE(one_for_all.output.find("--restart names one checkpoint, of one point"), std::string::npos)
+    << one_for_all.output;
 }
 
 } // namespace

@@ -28,7 +28,7 @@ struct CaseDifference
 };
 
 // Run-control keys: dem.duration, the output, sample and checkpoint intervals, threads,
-// the output directory and formats, and every key of the measurement-only sections (nip.*,
+// the output directory and formats, the stored fields' folder (a sweep keeps them per digest), and every key of the measurement-only sections (nip.*,
 // dma.*, development.*, flow_report.*, statistics.*: windows, sampling, averaging).
 bool is_run_control_key(const std::string &key);
 // Keys that say what a measurement samples and how it judges it (the measurement-only sections

@@ -93,6 +93,10 @@ then compares the nip profiles of all points:
   sweep_<key>.png      each key with a standard error against the (first) varied value, with
                        its physical bound (<key>_bound), the measured points and, per point,
                        the key's own steady-state verdict, the run's and the run time
+  sweep_tma_threshold.csv   a TMA study against electric.bias: the straight line through its
+                       points (weighted by their standard errors), its slope and the bias where
+                       it reaches zero (the development threshold) with their standard errors,
+                       chi2/dof, and the bias where the contrast vanishes; drawn in the TMA plot
   sweep_slip.png, sweep_pressure.png, sweep_density.png   (Kawamoto Fig. 17-19, 22-27)
 Values carry units as in the case file (--vary populations.carrier.diameter=42um,50um,60um).
 Varying a population's diameter also scales its count by (d0/d)^3 and its diameter_std by

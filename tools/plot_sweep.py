@@ -10,7 +10,9 @@ standard error, a physical bound (<key>_bound) or a measured comparison (or the 
 --key): the mean with its standard-error bars against the first varied value (in SI), the bound
 as a dashed line, the measured points with their relative error and the within-tolerance flag,
 the steady-state verdict of the key itself (where the runs tested it: its drift between the
-halves of the window), of the whole run, and the run time of each point. For nip scenes it also reads
+halves of the window), of the whole run, and the run time of each point. A TMA study against
+the bias also gets its straight line down to the development threshold, drawn in and kept in
+sweep_tma_threshold.csv (tools/development_threshold.py). For nip scenes it also reads
 sweep_profiles.csv and writes sweep_slip.png, sweep_pressure.png, sweep_density.png (Kawamoto
 Fig. 17-19 and 22-27: one curve per point).
 Exit status 3 when matplotlib is missing, 2 for unreadable inputs.
@@ -19,6 +21,8 @@ import argparse
 import csv
 import os
 import sys
+
+import development_threshold
 
 
 def read(path):
@@ -59,6 +63,26 @@ def verdicts(col, r, key):
            else "undecided (noise)")
     spread = f" ± {100 * error:.1f}" if error == error else ""
     return f"{key} {own} (drift {100 * drift:+.1f}{spread} %); run {verdict}, {run} s"
+
+
+def draw_threshold(ax, directory, header, rows, xs):
+    """A TMA study against the bias: the straight line through its points down to its
+    development threshold (tools/development_threshold.py), kept in sweep_tma_threshold.csv."""
+    result = development_threshold.study_threshold(header, rows)
+    if result is None:
+        return
+    path = os.path.join(directory, "sweep_tma_threshold.csv")
+    development_threshold.write_csv(path, result)
+    print(f"  threshold   {path}: {development_threshold.describe(result)}")
+    x0 = result["threshold"]
+    if x0 != x0:
+        return
+    ends = [min(xs + [x0]), max(xs + [x0])]
+    ax.plot(ends, [result["intercept"] + result["slope"] * x for x in ends], ":", color="C1",
+            label=development_threshold.describe(result))
+    if result["contrast_zero"] == result["contrast_zero"]:
+        ax.axvline(result["contrast_zero"], color="0.6", lw=0.8, ls="-.",
+                   label=f"zero contrast (the bound vanishes): {result['contrast_zero']:.0f} V")
 
 
 def plot_keys(plt, directory, header, rows, requested):
@@ -111,6 +135,8 @@ def plot_keys(plt, directory, header, rows, requested):
             ax.plot(xs, bound, "k--", lw=1.2, label="physical bound")
             if log:
                 ax.plot([], [], " ", label="log scale: the values lie below 5 % of the bound")
+        if key == "tma_kg_per_m2":
+            draw_threshold(ax, directory, header, rows, xs)
         measured = "measured_" + key
         if measured in col:
             mys = [number(r[col[measured]]) for r in rows]

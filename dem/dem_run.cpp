@@ -285,12 +285,13 @@ void DemRun::log_timings(double wall) const
   row("total", wall);
 }
 
-void DemRun::write_measurements() const
+void DemRun::write_measurements(bool so_far) const
 {
   for (const auto &m : measurements_)
   {
     m->write(out_dir_);
-    log_ << "measurement '" << m->name() << "' written to " << out_dir_ << "\n";
+    if (!so_far)
+      log_ << "measurement '" << m->name() << "' written to " << out_dir_ << "\n";
   }
   write_run_summary(out_dir_, measurements_, case_.statistics);
 }
@@ -394,6 +395,9 @@ void DemRun::run()
       if ((ckpt_every > 0 && k % ckpt_every == 0) || wall_due)
       {
         write_checkpoint();
+        // The measurements' files so far: a long run can be watched while it runs (magbrush
+        // report), and one stopped later (a time limit, a crash) leaves them to this point.
+        write_measurements(/*so_far=*/true);
         last_checkpoint_wall = omp_get_wtime();
       }
       const double now = omp_get_wtime();

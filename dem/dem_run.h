@@ -10,7 +10,8 @@
 // Checkpoints are written every dem.checkpoint_interval of simulated time, every
 // dem.checkpoint_wall_interval of wall time and at the end; each replaces checkpoint.bin
 // atomically and the one before it is kept as checkpoint.previous.bin. A checkpoint holds the
-// measurements' accumulated state too, so a restarted run writes the files of the whole run.
+// measurements' accumulated state too, so a restarted run writes the files of the whole run;
+// their files are written at every checkpoint as well, so a stopped run leaves them to there.
 // A restart checks that the checkpoint was written by this case (restart_check.h).
 #pragma once
 
@@ -86,7 +87,8 @@ private:
   void log_setup() const;
   void log_timings(double wall) const;
   void take_own_checkpoint();
-  void write_measurements() const;
+  // Every measurement's files and the run's summary; so_far: at a checkpoint (not logged).
+  void write_measurements(bool so_far = false) const;
 };
 
 } // namespace magbrush::dem

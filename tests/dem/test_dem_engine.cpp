@@ -553,11 +553,13 @@ public:
   void write(const std::string &dir) const override
   {
     std::ofstream(dir + "/samples.txt") << times.size() << "\n";
+    written.push_back(times.size());
   }
   void write_state(StateOut &out) const override { out.put_array(times); }
   void read_state(StateIn &in) override { in.get_array(times); }
   int state_version() const override { return version; }
   std::vector<double> times;
+  mutable std::vector<std::size_t> written; // the samples held at each write
   int version = 1;
 
 private:
@@ -596,6 +598,28 @@ TEST(DemEngine, MeasurementsAreSampledAtTheirIntervalAndWritten)
   int n = 0;
   in >> n;
   EXPECT_EQ(n, 10);
+  std::filesystem::remove_all(dir);
+}
+
+// The measurements' files are written at every checkpoint as well as at the end, so that a run
+// stopped later leaves them to its last checkpoint (and a long one can be watched).
+TEST(DemEngine, MeasurementsAreWrittenAtEveryCheckpointAndAtTheEnd)
+{
+  Case c = one_bead_case();
+  c.dem.duration = 100e-6;
+  c.dem.checkpoint_interval = 30e-6;
+  const std::string dir = (magbrush::testing::test_temp_dir("dem_measurement_checkpoints") / "out").string();
+  RunOptions o;
+  o.output_dir = dir;
+  o.threads = 1;
+  std::ostringstream log;
+  DemRun run(c, o, log);
+  auto counter = std::make_unique<SampleCounter>(10e-6);
+  const SampleCounter &seen = *counter;
+  run.add_measurement(std::move(counter));
+  run.run();
+  EXPECT_EQ(seen.written, (std::vector<std::size_t>{3, 6, 9, 10})) << log.str(); // 30, 60, 90 µs; the end
+  EXPECT_TRUE(std::filesystem::exists(dir + "/summary.csv"));
   std::filesystem::remove_all(dir);
 }
 

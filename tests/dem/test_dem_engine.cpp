@@ -577,10 +577,14 @@ Case one_bead_case()
 }
 } // namespace
 
-TEST(DemEngine, MeasurementsAreSampledAtTheirIntervalAndWritten)
+// A measurement is sampled at its own interval, and its files are written at every checkpoint
+// as well as at the end, so that a run stopped later leaves them to its last checkpoint (and a
+// long one can be watched).
+TEST(DemEngine, MeasurementsAreSampledAtTheirIntervalAndWrittenAtEveryCheckpoint)
 {
   Case c = one_bead_case();
   c.dem.duration = 100e-6;
+  c.dem.checkpoint_interval = 30e-6;
   const std::string dir = (magbrush::testing::test_temp_dir("dem_measurement") / "out").string();
   RunOptions o;
   o.output_dir = dir;
@@ -598,26 +602,6 @@ TEST(DemEngine, MeasurementsAreSampledAtTheirIntervalAndWritten)
   int n = 0;
   in >> n;
   EXPECT_EQ(n, 10);
-  std::filesystem::remove_all(dir);
-}
-
-// The measurements' files are written at every checkpoint as well as at the end, so that a run
-// stopped later leaves them to its last checkpoint (and a long one can be watched).
-TEST(DemEngine, MeasurementsAreWrittenAtEveryCheckpointAndAtTheEnd)
-{
-  Case c = one_bead_case();
-  c.dem.duration = 100e-6;
-  c.dem.checkpoint_interval = 30e-6;
-  const std::string dir = (magbrush::testing::test_temp_dir("dem_measurement_checkpoints") / "out").string();
-  RunOptions o;
-  o.output_dir = dir;
-  o.threads = 1;
-  std::ostringstream log;
-  DemRun run(c, o, log);
-  auto counter = std::make_unique<SampleCounter>(10e-6);
-  const SampleCounter &seen = *counter;
-  run.add_measurement(std::move(counter));
-  run.run();
   EXPECT_EQ(seen.written, (std::vector<std::size_t>{3, 6, 9, 10})) << log.str(); // 30, 60, 90 µs; the end
   EXPECT_TRUE(std::filesystem::exists(dir + "/summary.csv"));
   std::filesystem::remove_all(dir);

@@ -832,9 +832,6 @@ int sweep(const cli::ParsedArguments &args)
     throw cli::UsageError(std::string(one_point ? "--point" : merge_only ? "--merge" : "--emit") +
                           " is one process's step: run it without mpirun (mpirun -np K magbrush sweep ... "
                           "deals the points to the ranks by itself)");
-  if (args.has("--restart") && !one_point)
-    throw cli::UsageError("--restart names one checkpoint, of one point: give it with --point INDEX, or let every "
-                          "point continue from its own with --resume");
   const SweepPlan plan = plan_sweep(args);
   if (emit)
     return emit_slurm(plan, args);

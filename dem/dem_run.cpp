@@ -295,6 +295,7 @@ void DemRun::write_measurements(bool so_far) const
   }
   write_run_summary(out_dir_, measurements_, case_.statistics);
 }
+
 // --resume: the folder's own checkpoint becomes the restart file. It is read whole before the
 // run writes its first checkpoint over it (the writer renames a finished file into place).
 void DemRun::take_own_checkpoint()

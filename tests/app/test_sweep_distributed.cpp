@@ -254,13 +254,6 @@ TEST_F(DistributedSweep, AStoppedPointResumesFromItsCheckpointToTheSerialResult)
   const Result again = run(dir_ / "again.log", with({magbrush}, with(sweep_words(dir_, out), {"--point", "0", "--resume"})));
   ASSERT_EQ(again.status, 0) << again.output;
   EXPECT_EQ(text_of(point / "dem" / "time_series.csv"), series);
-
-  // One checkpoint for every point is refused, with the way to say what is meant.
-  const Result one_for_all = run(dir_ / "restart_all.log",
-                                 with({magbrush}, with(sweep_words(dir_, out), {"--restart", (point / "dem" / "checkpoint.bin").string()})));
-  EXPECT_NE(one_for_all.status, 0);
-  EXPECT_NE(one_for_all.output.find("--restart names one checkpoint, of one point"), std::string::npos)
-    << one_for_all.output;
 }
 
 } // namespace

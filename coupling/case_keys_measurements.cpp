@@ -32,6 +32,16 @@ std::vector<KeySpec> measurement_keys()
           .def("2 us").positive(),
       quantity("development.average_from", D::time, "Sample from this time on (after the transient).")
           .def("0 s").non_negative(),
+      choice("development.average_over", {"samples", "image_periods"},
+             "samples: the means average the measuring window's samples (a scene whose image does not pass "
+             "through the window: a development cell); image_periods: each drum element is counted once as it "
+             "crosses measure_to, with the toner it carries then, and the means are over whole periods of the "
+             "latent image (its blocks for the standard error and the steady-state test): a moving image's TMA "
+             "repeats with its period in any fixed window.")
+          .def("samples"),
+      integer("development.phase_bins", "Bins per latent-image period of the developed profile "
+                                        "(toner_developed_profile.csv; image_periods only).")
+          .def("40").min(1).max(100000),
 
       section("dma", "The developer on the sleeve after the doctor blade (a roller scene with a doctor blade): "
                      "developer mass per area (DMA) in a window past the blade and from the flux through it, the "

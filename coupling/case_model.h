@@ -293,6 +293,11 @@ struct DevelopmentSettings
   double measure_to = 4e-3;       // [m]
   double sample_interval = 2e-6;  // [s]
   double average_from = 0.0;      // [s]
+  // "samples": the means average the window's samples; "image_periods": over whole periods of
+  // the latent image, each drum element counted once as it crosses measure_to
+  // (dem/measurements/developed_line.h).
+  std::string average_over = "samples";
+  int phase_bins = 40; // bins of the developed profile per image period
 };
 
 // The developer on the sleeve after the doctor blade (dem/measurements/developer_mass_per_area.h):

@@ -778,6 +778,8 @@ private:
     c.development.measure_to = q(dv, "measure_to");
     c.development.sample_interval = q(dv, "sample_interval");
     c.development.average_from = q(dv, "average_from");
+    c.development.average_over = str(dv, "average_over");
+    c.development.phase_bins = static_cast<int>(integer(dv, "phase_bins"));
     const Scope dm = top.child("dma");
     c.dma.after_blade = q(dm, "after_blade");
     c.dma.window = q(dm, "window");

@@ -379,6 +379,9 @@ void check_measurements(const Case &c, std::vector<CaseIssue> &out)
   if (c.development.measure_to <= c.development.measure_from)
     out.push_back({"development.measure_to", "the measuring window ends at " + L(c.development.measure_to) +
                                                  ", not downstream of its start " + L(c.development.measure_from)});
+  if (c.development.average_over == "image_periods" && !(c.electric.image.period > 0.0))
+    out.push_back({"development.average_over", "image_periods needs a latent image with a period "
+                                               "(electric.image.period > 0)"});
 }
 
 } // namespace

@@ -100,4 +100,27 @@ SummaryValue summarise(const SampleSeries &series, std::size_t blocks, bool stea
   return v;
 }
 
+SummaryValue summarise_blocks(const std::vector<double> &blocks, bool steady_test, std::string key,
+                              std::string unit, std::string meaning)
+{
+  SummaryValue v;
+  v.key = std::move(key);
+  v.unit = std::move(unit);
+  v.meaning = std::move(meaning);
+  const std::size_t n = blocks.size();
+  v.value = mean_of(blocks.begin(), blocks.end());
+  if (n >= 2)
+    v.standard_error = std::sqrt(squared_error_of_mean(blocks));
+  if (steady_test && n >= 2 && v.value != 0.0)
+  {
+    const std::vector<double> older(blocks.begin(), blocks.begin() + static_cast<std::ptrdiff_t>(n / 2));
+    const std::vector<double> newer(blocks.begin() + static_cast<std::ptrdiff_t>(n / 2), blocks.end());
+    v.drift = (mean_of(newer.begin(), newer.end()) - mean_of(older.begin(), older.end())) / std::abs(v.value);
+    if (older.size() >= 2 && newer.size() >= 2)
+      v.drift_standard_error =
+        std::sqrt(squared_error_of_mean(older) + squared_error_of_mean(newer)) / std::abs(v.value);
+  }
+  return v;
+}
+
 } // namespace magbrush::dem

@@ -62,4 +62,13 @@ private:
 SummaryValue summarise(const SampleSeries &series, std::size_t blocks, bool steady_test, std::string key,
                        std::string unit, std::string meaning);
 
+// The same for values that are already independent blocks (the developed image's whole
+// periods, toner_development.h): the mean of the blocks, its standard error from their scatter
+// (NaN with fewer than two), the drift between the means of the older and the newer half (the
+// newer half takes the middle block of an odd count; NaN with fewer than two blocks) and the
+// drift's standard error from each half's scatter about its own mean (NaN with fewer than two
+// blocks in a half).
+SummaryValue summarise_blocks(const std::vector<double> &blocks, bool steady_test, std::string key,
+                              std::string unit, std::string meaning);
+
 } // namespace magbrush::dem

@@ -19,15 +19,6 @@ namespace {
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 constexpr double epsilon0 = 8.8541878128e-12; // [F/m]
 
-double wrapped(double a) { return std::remainder(a, 2.0 * M_PI); } // into [−π, π]
-
-// Cumulative exposed share of the strip pattern at u = s/period + duty/2 (per period).
-double exposed_cumulative(double u, double duty)
-{
-  const double whole = std::floor(u);
-  return whole * duty + std::min(u - whole, duty);
-}
-
 // The development contrast ΔV = |V_bias − V_exposed| of the case's latent image.
 double contrast_of(const Case &c)
 {
@@ -40,35 +31,6 @@ double contrast_of(const Case &c)
   return std::abs(c.electric.bias - exposed);
 }
 } // namespace
-
-// ---------------------------------------------------------------------------------------
-DrumImage::DrumImage(const LatentImage &image, const NipFrame &frame)
-  : period_(image.period), duty_(image.duty), frame_(frame),
-    nip_angle_(std::atan2(frame.sy - frame.cy, frame.sx - frame.cx))
-{
-}
-
-double DrumImage::drum_arc(double px, double py, double t) const
-{
-  const double s_lab = frame_.drum_radius * wrapped(std::atan2(py - frame_.cy, px - frame_.cx) - nip_angle_);
-  return s_lab - frame_.drum_omega * frame_.drum_radius * t;
-}
-
-bool DrumImage::exposed(double s) const
-{
-  if (period_ <= 0.0)
-    return false; // no period: uniformly dark, as in the field stage
-  const double u = s / period_ + 0.5 * duty_;
-  return u - std::floor(u) < duty_;
-}
-
-double DrumImage::exposed_length(double a, double b) const
-{
-  if (period_ <= 0.0)
-    return 0.0;
-  return period_ * (exposed_cumulative(b / period_ + 0.5 * duty_, duty_) -
-                    exposed_cumulative(a / period_ + 0.5 * duty_, duty_));
-}
 
 // ---------------------------------------------------------------------------------------
 bool TonerDevelopment::applies(const Case &c)
@@ -96,6 +58,8 @@ TonerDevelopment::TonerDevelopment(const Case &c)
     if (p.kind == ParticleKind::toner && toner_q_over_m_ == 0.0)
       toner_q_over_m_ = p.charge_to_mass;
   }
+  if (settings_.average_over == "image_periods")
+    line_.emplace(image_, frame_.slab_depth, settings_.phase_bins);
   bin_width_ = c.nip.bin_width;
   bins_half_ = static_cast<int>(std::lround(c.nip.half_width / c.nip.bin_width));
   arrived_.assign(static_cast<std::size_t>(2 * bins_half_ + 1), 0.0);
@@ -119,48 +83,103 @@ void TonerDevelopment::sample(const DemSystem &system)
     throw std::runtime_error("toner development: the run has no wall named 'drum'");
   system.wall_contacts(drum, records_);
   const ParticleState &p = system.particles();
-  toner_.clear();
+  layer_.assign(p.size(), 0);
   for (const auto &r : records_)
   {
     const auto s = static_cast<std::size_t>(p.species[r.particle]);
     if (s < is_toner_.size() && is_toner_[s])
-      toner_.push_back({p.id[r.particle], p.x[r.particle], p.y[r.particle], p.mass[r.particle], p.charge[r.particle]});
+      layer_[r.particle] = 1;
   }
+  stack_on_drum(system, is_toner_, is_carrier_, layer_);
+  toner_.clear();
+  for (std::size_t k = 0; k < p.size(); ++k)
+    if (layer_[k] > 0)
+      toner_.push_back({p.id[k], p.x[k], p.y[k], p.mass[k], p.charge[k], layer_[k]});
   add_sample(system.time(), toner_, toner_share_on_carriers(system, is_toner_, is_carrier_));
+}
+
+namespace {
+bool species_is(const ParticleState &p, const std::vector<std::uint8_t> &flags, std::size_t k)
+{
+  const auto s = static_cast<std::size_t>(p.species[k]);
+  return s < flags.size() && flags[s];
+}
+
+// Whether the pair q of the neighbour list holds together: touching (adhesion holds a contact),
+// or within the adhesion range of one another.
+bool held_pair(const DemSystem &system, std::size_t q)
+{
+  const NeighbourList &list = system.neighbour_list();
+  if (list.touching[q] != 0)
+    return true;
+  const double range = system.contact_table().adhesion_range();
+  if (range <= 0.0)
+    return false;
+  const ParticleState &p = system.particles();
+  const auto i = static_cast<std::size_t>(list.owner[q]), j = static_cast<std::size_t>(list.partner[q]);
+  const Vector3 s = list.shift(q);
+  const double dx = p.x[j] - p.x[i] + s.x, dy = p.y[j] - p.y[i] + s.y, dz = p.z[j] - p.z[i] + s.z;
+  return std::sqrt(dx * dx + dy * dy + dz * dz) - p.radius[i] - p.radius[j] <= range;
+}
+
+// Per particle: 1 for a toner held by a carrier.
+void mark_on_carriers(const DemSystem &system, const std::vector<std::uint8_t> &is_toner,
+                      const std::vector<std::uint8_t> &is_carrier, std::vector<std::uint8_t> &on)
+{
+  const ParticleState &p = system.particles();
+  const NeighbourList &list = system.neighbour_list();
+  on.assign(p.size(), 0);
+  for (std::size_t q = 0; q < list.pairs(); ++q)
+  {
+    const auto i = static_cast<std::size_t>(list.owner[q]), j = static_cast<std::size_t>(list.partner[q]);
+    const bool toner_carrier = species_is(p, is_toner, i) && species_is(p, is_carrier, j);
+    const bool carrier_toner = species_is(p, is_carrier, i) && species_is(p, is_toner, j);
+    if ((toner_carrier || carrier_toner) && held_pair(system, q))
+      on[toner_carrier ? i : j] = 1;
+  }
+}
+} // namespace
+
+void TonerDevelopment::stack_on_drum(const DemSystem &system, const std::vector<std::uint8_t> &is_toner,
+                                     const std::vector<std::uint8_t> &is_carrier, std::vector<std::uint8_t> &layer)
+{
+  const ParticleState &p = system.particles();
+  const NeighbourList &list = system.neighbour_list();
+  std::vector<std::uint8_t> on_carrier; // once per sample, not per step
+  mark_on_carriers(system, is_toner, is_carrier, on_carrier);
+  // Layer by layer: a pass over the pairs extends only from the layer below, so that the layers
+  // do not depend on the pairs' order.
+  for (int below = 1; below < max_layers; ++below)
+  {
+    bool grew = false;
+    for (std::size_t q = 0; q < list.pairs(); ++q)
+    {
+      const auto i = static_cast<std::size_t>(list.owner[q]), j = static_cast<std::size_t>(list.partner[q]);
+      const bool up_j = layer[i] == below && layer[j] == 0, up_i = layer[j] == below && layer[i] == 0;
+      if (!up_i && !up_j)
+        continue;
+      const std::size_t upper = up_j ? j : i;
+      if (!species_is(p, is_toner, upper) || !species_is(p, is_toner, up_j ? i : j) || on_carrier[upper] ||
+          !held_pair(system, q))
+        continue;
+      layer[upper] = static_cast<std::uint8_t>(below + 1);
+      grew = true;
+    }
+    if (!grew)
+      break;
+  }
 }
 
 double TonerDevelopment::toner_share_on_carriers(const DemSystem &system, const std::vector<std::uint8_t> &is_toner,
                                                  const std::vector<std::uint8_t> &is_carrier)
 {
   const ParticleState &p = system.particles();
-  const NeighbourList &list = system.neighbour_list();
-  const double range = system.contact_table().adhesion_range();
-  auto species_is = [&](const std::vector<std::uint8_t> &flags, std::size_t k) {
-    const auto s = static_cast<std::size_t>(p.species[k]);
-    return s < flags.size() && flags[s];
-  };
-  std::vector<std::uint8_t> on(p.size(), 0);
-  for (std::size_t q = 0; q < list.pairs(); ++q)
-  {
-    const auto i = static_cast<std::size_t>(list.owner[q]), j = static_cast<std::size_t>(list.partner[q]);
-    const bool toner_carrier = species_is(is_toner, i) && species_is(is_carrier, j);
-    const bool carrier_toner = species_is(is_carrier, i) && species_is(is_toner, j);
-    if (!toner_carrier && !carrier_toner)
-      continue;
-    bool held = list.touching[q] != 0;
-    if (!held && range > 0.0)
-    {
-      const Vector3 s = list.shift(q);
-      const double dx = p.x[j] - p.x[i] + s.x, dy = p.y[j] - p.y[i] + s.y, dz = p.z[j] - p.z[i] + s.z;
-      held = std::sqrt(dx * dx + dy * dy + dz * dz) - p.radius[i] - p.radius[j] <= range;
-    }
-    if (held)
-      on[toner_carrier ? i : j] = 1;
-  }
+  std::vector<std::uint8_t> on;
+  mark_on_carriers(system, is_toner, is_carrier, on);
   double all = 0.0, carried = 0.0;
   for (std::size_t k = 0; k < p.size(); ++k)
   {
-    if (species_is(is_toner, k))
+    if (species_is(p, is_toner, k))
     {
       all += p.mass[k];
       carried += on[k] ? p.mass[k] : 0.0;
@@ -217,18 +236,13 @@ void TonerDevelopment::add_sample(double time, const std::vector<DrumToner> &on_
   }
 
   // The measuring window in the drum's frame at this time.
-  auto surface_arc = [&](double x) {
-    const double psi = frame_.drum_angle_of_x(x);
-    const double px = frame_.cx + frame_.drum_radius * (-frame_.nx * std::cos(psi) + frame_.tx * std::sin(psi));
-    const double py = frame_.cy + frame_.drum_radius * (-frame_.ny * std::cos(psi) + frame_.ty * std::sin(psi));
-    return image_.drum_arc(px, py, time);
-  };
-  const double s1 = surface_arc(settings_.measure_from), s2 = surface_arc(settings_.measure_to);
+  const double s1 = image_.drum_arc_at_x(settings_.measure_from, time);
+  const double s2 = image_.drum_arc_at_x(settings_.measure_to, time);
   const double a = std::min(s1, s2), b = std::max(s1, s2);
   const double depth = frame_.slab_depth;
   const double image_area = image_.exposed_length(a, b) * depth, dark_area = (b - a) * depth - image_area;
   double m_image = 0, q_image = 0, m_dark = 0;
-  long n_image = 0, n_dark = 0;
+  long n_image = 0, n_dark = 0, n_stacked = 0;
   for (const auto &t : now)
   {
     const double x = frame_.x_along(t.x, t.y);
@@ -238,8 +252,9 @@ void TonerDevelopment::add_sample(double time, const std::vector<DrumToner> &on_
       m_image += t.mass, q_image += t.charge, ++n_image;
     else
       m_dark += t.mass, ++n_dark;
+    n_stacked += t.layer > 1;
   }
-  Row row{time, nan, nan, nan, nan, nan, on_carriers, n_image, n_dark};
+  Row row{time, nan, nan, nan, nan, nan, on_carriers, n_image, n_dark, n_stacked};
   if (image_area > 0.0)
   {
     row.tma = m_image / image_area;
@@ -255,6 +270,14 @@ void TonerDevelopment::add_sample(double time, const std::vector<DrumToner> &on_
   if (averaged)
     add_to_means(row, interval_averaged);
   rows_.push_back(row);
+  // The developed line: every drum element once, as it crosses measure_to.
+  if (line_)
+  {
+    line_toner_.clear();
+    for (const auto &t : now)
+      line_toner_.push_back({t.id, image_.drum_arc(t.x, t.y, time), t.mass, t.charge});
+    line_->add_sample(time, image_.drum_arc_at_x(settings_.measure_to, time), line_toner_, averaged);
+  }
   previous_time_ = time;
   before_ = std::move(now);
 }
@@ -291,17 +314,63 @@ std::vector<SummaryValue> TonerDevelopment::summary() const
   contrast.value = contrast_;
   contrast.unit = "V";
   contrast.meaning = "|bias - exposed potential|";
+  std::vector<SummaryValue> out;
+  if (line_)
+    out = period_summary();
+  else
+    out = {
+        sampled("tma_kg_per_m2", tma_, true, "kg/m^2", "toner mass per exposed drum area after the nip"),
+        sampled("fog_kg_per_m2", fog_, false, "kg/m^2", "toner mass per dark (background) drum area after the nip"),
+        sampled("developed_q_over_m_C_per_kg", q_over_m_, false, "C/kg", "charge per mass of the toner on the image"),
+        sampled("neutralisation_ratio", ratio_, false, "1", "developed charge per area / (eps0 epsr dV / L)"),
+        sampled("toner_transfer_rate_kg_per_s_m", transfer_, true, "kg/(s m)",
+                "toner mass arriving on the drum per time and slab depth"),
+    };
+  out.insert(out.begin() + 1, bound);
+  out.push_back(sampled("toner_on_carriers_fraction", on_carriers_, false, "1",
+                        "toner mass within the adhesion range of a carrier / all toner mass (the whole scene)"));
+  out.push_back(contrast);
+  return out;
+}
+
+// Over whole image periods: each period's image TMA, fog, q/m and neutralisation ratio are
+// ratios of its own sums (every phase of the image counted once), and its transfer rate the
+// mean of the samples' over the same span of time (the arrivals at the nip are periodic too).
+std::vector<SummaryValue> TonerDevelopment::period_summary() const
+{
+  std::vector<double> tma, fog, q_over_m, ratio, transfer;
+  for (const DevelopedLine::Period &p : line_->periods())
+  {
+    tma.push_back(p.image_mass / p.image_area);
+    fog.push_back(p.dark_mass / p.dark_area);
+    if (p.image_mass > 0.0)
+      q_over_m.push_back(p.image_charge / p.image_mass);
+    if (eps_layer_over_l_ > 0.0 && contrast_ > 0.0)
+      ratio.push_back(std::abs(p.image_charge / p.image_area) / (eps_layer_over_l_ * contrast_));
+    double sum = 0.0;
+    long n = 0;
+    for (std::size_t k = 1; k < rows_.size(); ++k)
+      if (rows_[k].time > p.t_start && rows_[k].time <= p.t_end && !std::isnan(rows_[k].transfer))
+        sum += rows_[k].transfer, ++n;
+    transfer.push_back(n > 0 ? sum / static_cast<double>(n) : nan);
+  }
+  SummaryValue periods;
+  periods.key = "image_periods_averaged";
+  periods.value = static_cast<double>(line_->periods().size());
+  periods.unit = "1";
+  periods.meaning = "whole latent-image periods past the line measure_to that the means average (their blocks)";
   return {
-      sampled("tma_kg_per_m2", tma_, true, "kg/m^2", "toner mass per exposed drum area after the nip"),
-      bound,
-      sampled("fog_kg_per_m2", fog_, false, "kg/m^2", "toner mass per dark (background) drum area after the nip"),
-      sampled("developed_q_over_m_C_per_kg", q_over_m_, false, "C/kg", "charge per mass of the toner on the image"),
-      sampled("neutralisation_ratio", ratio_, false, "1", "developed charge per area / (eps0 epsr dV / L)"),
-      sampled("toner_transfer_rate_kg_per_s_m", transfer_, true, "kg/(s m)",
-              "toner mass arriving on the drum per time and slab depth"),
-      sampled("toner_on_carriers_fraction", on_carriers_, false, "1",
-              "toner mass within the adhesion range of a carrier / all toner mass (the whole scene)"),
-      contrast,
+      summarise_blocks(tma, true, "tma_kg_per_m2", "kg/m^2",
+                       "toner mass per exposed drum area carried past measure_to, over whole image periods"),
+      summarise_blocks(fog, false, "fog_kg_per_m2", "kg/m^2",
+                       "toner mass per dark (background) drum area carried past measure_to, over whole periods"),
+      summarise_blocks(q_over_m, false, "developed_q_over_m_C_per_kg", "C/kg",
+                       "charge per mass of the toner on the image, over whole periods"),
+      summarise_blocks(ratio, false, "neutralisation_ratio", "1",
+                       "developed charge per area / (eps0 epsr dV / L), over whole periods"),
+      summarise_blocks(transfer, true, "toner_transfer_rate_kg_per_s_m", "kg/(s m)",
+                       "toner mass arriving on the drum per time and slab depth, over whole periods"),
+      periods,
   };
 }
 
@@ -313,12 +382,12 @@ std::string TonerDevelopment::csv() const
        "from t = "
     << settings_.average_from << " s\n";
   o << "time_s,tma_kg_per_m2,fog_kg_per_m2,developed_q_over_m_C_per_kg,neutralisation_ratio,"
-       "transfer_rate_kg_per_s_m,toner_on_carriers_fraction,image_toner,dark_toner\n";
+       "transfer_rate_kg_per_s_m,toner_on_carriers_fraction,image_toner,dark_toner,stacked_toner\n";
   char line[256];
   for (const Row &r : rows_)
   {
-    std::snprintf(line, sizeof line, "%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%ld,%ld\n", r.time, r.tma, r.fog,
-                  r.q_over_m, r.ratio, r.transfer, r.on_carriers, r.image_toner, r.dark_toner);
+    std::snprintf(line, sizeof line, "%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%ld,%ld,%ld\n", r.time, r.tma, r.fog,
+                  r.q_over_m, r.ratio, r.transfer, r.on_carriers, r.image_toner, r.dark_toner, r.stacked_toner);
     o << line;
   }
   return o.str();
@@ -347,6 +416,13 @@ void TonerDevelopment::write(const std::string &directory) const
   write_file_atomically((std::filesystem::path(directory) / "toner_development.csv").string(), csv());
   write_file_atomically((std::filesystem::path(directory) / "toner_transfer_profile.csv").string(),
                         transfer_profile_csv());
+  if (line_)
+  {
+    write_file_atomically((std::filesystem::path(directory) / "toner_developed_periods.csv").string(),
+                          line_->periods_csv());
+    write_file_atomically((std::filesystem::path(directory) / "toner_developed_profile.csv").string(),
+                          line_->profile_csv());
+  }
 }
 
 namespace {
@@ -389,10 +465,13 @@ void TonerDevelopment::write_state(StateOut &out) const
   for (const Row &r : rows_)
   {
     values.insert(values.end(), {r.time, r.tma, r.fog, r.q_over_m, r.ratio, r.transfer, r.on_carriers});
-    counts.insert(counts.end(), {r.image_toner, r.dark_toner});
+    counts.insert(counts.end(), {r.image_toner, r.dark_toner, r.stacked_toner});
   }
   out.put_array(values);
   out.put_array(counts);
+  out.put<std::uint8_t>(line_.has_value());
+  if (line_)
+    line_->write_state(out);
 }
 
 void TonerDevelopment::read_state(StateIn &in)
@@ -424,14 +503,20 @@ void TonerDevelopment::read_state(StateIn &in)
   std::vector<long> counts;
   in.get_array(values);
   in.get_array(counts);
-  if (values.size() % 7 != 0 || counts.size() != 2 * (values.size() / 7))
+  if (values.size() % 7 != 0 || counts.size() != 3 * (values.size() / 7))
     in.fail("is corrupt (the development rows)");
   rows_.clear();
-  for (std::size_t k = 0; k < counts.size() / 2; ++k)
+  for (std::size_t k = 0; k < counts.size() / 3; ++k)
   {
     const double *v = &values[7 * k];
-    rows_.push_back({v[0], v[1], v[2], v[3], v[4], v[5], v[6], counts[2 * k], counts[2 * k + 1]});
+    rows_.push_back({v[0], v[1], v[2], v[3], v[4], v[5], v[6], counts[3 * k], counts[3 * k + 1], counts[3 * k + 2]});
   }
+  const bool with_line = in.get<std::uint8_t>() != 0;
+  if (with_line != line_.has_value())
+    in.fail(with_line ? "averages over image periods, this case over samples (development.average_over)"
+                      : "averages over samples, this case over image periods (development.average_over)");
+  if (line_)
+    line_->read_state(in);
 }
 
 } // namespace magbrush::dem

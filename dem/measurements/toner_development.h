@@ -2,14 +2,12 @@
 // carries away from the nip, on the image and on the background, with what charge, and how
 // close that comes to the limit the latent image sets.
 //
-// The latent image moves with the drum surface. Its strips are those of the field stage
-// (field_solver/nip_electrostatics.h latent_image_value): along the drum surface arc s, counted
-// counter-clockwise about the drum centre from the nip point, exposed where
-// frac(s/period + duty/2) < duty (an exposed strip centred on the nip at t = 0). A point of the
-// drum surface moves with s(t) = s₀ + ω_d R_d t, so the image seen in the drum's own frame is
-// fixed at s_drum = s − ω_d R_d t.
+// The latent image moves with the drum surface (drum_image.h: its strips in the drum's frame).
 //
-// Every sample it takes the toner touching the drum (its wall contacts) and
+// Every sample it takes THE TONER ON THE DRUM'S LAYER: the toner touching the drum (its wall
+// contacts) and the toner resting on those, layer on layer (touching, or within the adhesion
+// range of, a toner of the layer below, and held by no carrier: toner on a carrier is in the
+// brush). A tape lift takes the stacked toner too; the contacts alone would miss it. Then
 //  * in the MEASURING WINDOW downstream of the nip (nip coordinate x from development.measure_from
 //    to development.measure_to, where the drum has left the brush): the toner mass per area on
 //    the exposed strips (TMA, the image) and on the dark strips (fog), the developed charge per
@@ -17,19 +15,28 @@
 //    against the charge that cancels the development contrast ΔV across the photoconductor
 //    (thickness L, εr) — 1 is the physical limit of development, where
 //        TMA_bound = ε0 εr ΔV / (L |q/m|);
-//  * along the whole nip: where toner ARRIVES on the drum (not touching at the previous sample,
-//    touching now) and leaves it again, per bin of x, and the transfer rate per slab depth;
+//  * with development.average_over = image_periods, the same four over WHOLE PERIODS of the
+//    latent image, each drum element counted once as it crosses measure_to (developed_line.h):
+//    the summary's means are then those of the periods, which are its blocks (standard error,
+//    steady-state test), and the developed profile across a strip is written. A moving image's
+//    TMA in a fixed window repeats with the image's period, so a mean over a window of samples
+//    depends on its phase unless it spans whole periods;
+//  * along the whole nip: where toner ARRIVES on the drum's layer (not on it at the previous
+//    sample, on it now) and leaves it again, per bin of x, and the transfer rate per slab depth;
 //  * in the whole scene: the share of the toner mass that sits on a carrier (within the adhesion
 //    range of one), the developer's hold on its toner — toner that leaves its carrier before the
 //    nip develops as a free cloud, whatever the contrast.
 // ΔV = |V_bias − V_exposed|; for an image given as surface charges, V_exposed = σ L/(ε0 εr),
 // the potential of the charged layer on its grounded substrate.
 //
-// Writes toner_development.csv (one row per sample), toner_transfer_profile.csv, and the key
+// Writes toner_development.csv (one row per sample), toner_transfer_profile.csv, with
+// image_periods toner_developed_periods.csv and toner_developed_profile.csv, and the key
 // numbers with standard errors for the study table (summary()).
 #pragma once
 
 #include "dem/measurement.h"
+#include "dem/measurements/developed_line.h"
+#include "dem/measurements/drum_image.h"
 #include "dem/measurements/nip_frame.h"
 #include "dem/measurements/sample_series.h"
 
@@ -38,34 +45,19 @@
 
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
 namespace magbrush::dem {
 
-// One toner particle touching the drum at one sample.
+// One toner particle on the drum's layer at one sample.
 struct DrumToner
 {
   std::int32_t id = 0;
   double x = 0, y = 0;       // centre in the x-y plane [m]
   double mass = 0, charge = 0;
-};
-
-// The latent image strips in the drum's own frame.
-class DrumImage
-{
-public:
-  DrumImage(const LatentImage &image, const NipFrame &frame);
-  // The arc coordinate of a point in the drum's frame at time t [m].
-  double drum_arc(double px, double py, double t) const;
-  bool exposed(double s_drum) const;
-  // Exposed length of the drum-frame arc interval [a, b] [m] (a ≤ b).
-  double exposed_length(double a, double b) const;
-
-private:
-  double period_, duty_;
-  NipFrame frame_;
-  double nip_angle_; // angle at the drum centre of the nip point (towards the sleeve) [rad]
+  int layer = 1;             // 1: touching the drum; 2, 3, ...: resting on the layer below
 };
 
 class TonerDevelopment : public Measurement
@@ -76,7 +68,8 @@ public:
   static bool applies(const Case &c);
 
   const char *name() const override { return "toner development"; }
-  int state_version() const override { return 2; } // 2: the toner on the carriers
+  // 2: the toner on the carriers; 3: stacked toner counted, the developed line
+  int state_version() const override { return 3; }
   double interval() const override { return settings_.sample_interval; }
   void sample(const DemSystem &system) override;
   void write(const std::string &directory) const override;
@@ -93,6 +86,12 @@ public:
   // carrier carries as its own mass (carried_until_gap) counts as on it.
   static double toner_share_on_carriers(const DemSystem &system, const std::vector<std::uint8_t> &is_toner,
                                         const std::vector<std::uint8_t> &is_carrier);
+  // The drum's layer: `layer` (per particle) holds 1 for the toner touching the drum and 0 else;
+  // on return 2, 3, ... (up to max_layers) mark the toner resting on the layer below, held by no
+  // carrier (neighbour-list pairs touching or within the adhesion range).
+  static void stack_on_drum(const DemSystem &system, const std::vector<std::uint8_t> &is_toner,
+                            const std::vector<std::uint8_t> &is_carrier, std::vector<std::uint8_t> &layer);
+  static constexpr int max_layers = 8;
 
   double contrast_potential() const { return contrast_; } // ΔV [V]
   double tma_bound() const;                                // [kg/m²]
@@ -103,6 +102,8 @@ public:
 
   std::string csv() const;
   std::string transfer_profile_csv() const;
+  // The developed line (average_over = image_periods), else null.
+  const DevelopedLine *developed_line() const { return line_ ? &*line_ : nullptr; }
 
 private:
   DevelopmentSettings settings_;
@@ -121,15 +122,20 @@ private:
   struct Row
   {
     double time, tma, fog, q_over_m, ratio, transfer, on_carriers;
-    long image_toner, dark_toner;
+    long image_toner, dark_toner, stacked_toner;
   };
   std::vector<Row> rows_; // every sample since the start
   // A row from average_from on into the means (its transfer when the interval before it is
   // inside the averaging window too).
   void add_to_means(const Row &row, bool with_transfer);
+  // The summary over whole image periods (average_over = image_periods).
+  std::vector<SummaryValue> period_summary() const;
+  std::optional<DevelopedLine> line_;
+  std::vector<LineToner> line_toner_;
   std::vector<WallContactRecord> records_;
   std::vector<DrumToner> toner_;
   std::vector<std::uint8_t> is_toner_, is_carrier_; // by species
+  std::vector<std::uint8_t> layer_;                 // by particle: on the drum's layer (stack_on_drum)
 };
 
 } // namespace magbrush::dem

@@ -10,10 +10,13 @@
 //   regulation sector          developer mass per area, flow report
 //   release sector             developer release
 //   compression box            plate compression (windows, contact maps)
+//   development cell, 1 um image period: the developed line over whole image periods
 #include <gtest/gtest.h>
+
 #include "tests/cli_run.h"
 #include "tests/test_temp_dir.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <ostream>
@@ -89,6 +92,12 @@ TEST_P(MeasurementRestart, RestartedRunWritesTheUninterruptedRunsFilesByteForByt
     EXPECT_TRUE(expected == got) << file << " differs after the restart:\n--- whole run\n"
                                  << expected.substr(0, 2000) << "\n--- restarted\n" << got.substr(0, 2000);
   }
+  // The developed line's periods closed on both sides of the restart (header lines: 2).
+  if (std::string(scene.name) == "development_periods")
+  {
+    const std::string periods = contents(whole / "toner_developed_periods.csv");
+    EXPECT_GE(std::count(periods.begin(), periods.end(), '\n'), 4) << periods;
+  }
   fs::remove_all(dir);
 }
 
@@ -109,6 +118,15 @@ INSTANTIATE_TEST_SUITE_P(
               "--set dem.checkpoint_interval=5us",
               {"toner_development.csv", "toner_transfer_profile.csv", "nip_profile.csv", "nip_time_series.csv",
                "summary.csv"}},
+        // The developed line over image periods: an image period of 1 um (the drum passes 2.7
+        // of them in the 10 us) so that whole periods close before and after the restart.
+        Scene{"development_periods",
+              "tests/scenes/development/development_cell.yaml",
+              true,
+              "--set dem.duration=10us --set development.average_from=0s --set nip.average_from=0s "
+              "--set dem.checkpoint_interval=5us --set development.average_over=image_periods "
+              "--set electric.image.period=1um --set development.phase_bins=4",
+              {"toner_development.csv", "toner_developed_periods.csv", "toner_developed_profile.csv", "summary.csv"}},
         Scene{"regulation",
               "cases/kweon_regulation.yaml",
               true,

@@ -8,6 +8,7 @@
 #include "dem/dem_system.h"
 #include "dem/run_summary.h"
 
+#include "common/state_stream.h"
 #include "coupling/case_parser.h"
 
 #include <gtest/gtest.h>
@@ -15,6 +16,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <memory>
 
 using namespace magbrush;
@@ -303,4 +305,132 @@ TEST(TonerDevelopment, TheShareOnCarriersIsSampledIntoTheSummary)
       found = std::abs(v.value - 0.7) < 1e-12;
   EXPECT_TRUE(found);
   EXPECT_NE(m.csv().find("toner_on_carriers_fraction"), std::string::npos);
+}
+
+// The drum's layer: toner resting on the toner that touches the drum counts, layer on layer, as
+// long as no carrier holds it. Placed by hand in a box (the layer touching the drum given): B
+// overlaps A (10 nm), C is 1 nm from B (inside the 4 nm adhesion range), D touches B but also a
+// carrier (in the brush: not developed), E is 10 nm from A (free), F touches A across the
+// periodic boundary.
+TEST(TonerDevelopment, TheDrumsLayerIsTheTonerTouchingItAndTheTonerStackedOnThat)
+{
+  const Case c = parse_case_text(R"(
+name: stack
+scene: box
+materials:
+  carrier: {youngs_modulus: 1e3 MPa, poisson_ratio: 0.35, density: 2200 kg/m^3, friction: 0.45, damping: 0.6, hamaker: 1e-19 J}
+  toner: {youngs_modulus: 3e3 MPa, poisson_ratio: 0.35, density: 1100 kg/m^3, friction: 0.3, damping: 0.6, hamaker: 1e-19 J}
+  wall: {youngs_modulus: 5e4 MPa, poisson_ratio: 0.3, friction: 0.35, hamaker: 0 J}
+planes:
+  - {name: floor, point: [0 mm, 0 mm, 0 mm], normal: [0, 0, 1], material: wall}
+populations:
+  - {name: carrier, kind: carrier, diameter: 35 um, count: 1, insert_box: [[0 mm, 0 mm, 0 mm], [1 mm, 1 mm, 1 mm]]}
+  - {name: toner, kind: toner, diameter: 7 um, count: 1, charge_to_mass: -30 uC/g, insert_box: [[0 mm, 0 mm, 0 mm], [1 mm, 1 mm, 1 mm]]}
+dem: {gravity: [0, 0, 0], periodic_length_x: 1 mm, periodic_length_y: 1 mm}
+)",
+                                 "stack.yaml");
+  DemSystem system(c);
+  ParticleState &p = system.particles();
+  const double r = 3.5e-6, y = 0.5e-3, z = 0.5e-3;
+  auto toner = [&](double x) { p.add({x, y, z}, r, 1100.0, 1, -1e-15); };
+  const double xb = 0.3e-3 + 2 * r - 10e-9;
+  toner(0.3e-3);                        // 0: A, touching the drum (given)
+  toner(xb);                            // 1: B on A (10 nm overlap)
+  toner(0.3e-3 + 4 * r - 10e-9 + 1e-9); // 2: C on B (1 nm gap)
+  toner(xb);                            // 3: D, below B, touching it ...
+  p.y.back() = y - 2 * r + 10e-9;
+  p.add({xb, y - 2 * r + 10e-9 - r - 17.5e-6 + 5e-9, z}, 17.5e-6, 2200.0, 0, 0.0); // 4: ... and held by a carrier
+  toner(0.3e-3 - 2 * r - 10e-9);        // 5: E, 10 nm from A
+  toner(1e-3 - 1e-6);                   // 6: A2 at the far side, touching the drum (given)
+  toner(1e-3 - 1e-6 + 2 * r - 10e-9 - 1e-3); // 7: F, on A2 across the boundary
+  system.initialize();
+  ASSERT_GT(system.contact_table().adhesion_range(), 1e-9);
+  // The engine sorts its particles in space: they are found by their ids (the order added).
+  std::vector<std::uint8_t> layer(p.size(), 0);
+  for (std::size_t k = 0; k < p.size(); ++k)
+    layer[k] = (p.id[k] == 0 || p.id[k] == 6) ? 1 : 0;
+  TonerDevelopment::stack_on_drum(system, {0, 1}, {1, 0}, layer);
+  // B on A, C on B, F on A2 through the boundary; D (held by a carrier) and E (free) are not.
+  const std::vector<int> expected = {1, 2, 3, 0, 0, 0, 1, 2};
+  for (std::size_t k = 0; k < p.size(); ++k)
+    EXPECT_EQ(layer[k], expected[static_cast<std::size_t>(p.id[k])]) << "particle " << p.id[k];
+}
+
+// With development.average_over = image_periods the summary's TMA, fog, q/m and neutralisation
+// ratio are those of whole periods of the drum's layer carried past measure_to. A layer of toner
+// on the drum surface at the drum-frame lattice (k + ½) µm, 3e-13 kg on the exposed strips and
+// 2e-14 kg on the dark ones, sampled every 20 µs for 2.2 periods as the drum turns: two whole
+// periods, each with exactly the lattice's mass per area (test_developed_line.cpp), and a
+// checkpoint half-way that continues to the same summary.
+TEST(TonerDevelopment, OverImagePeriodsTheSummaryIsThatOfTheWholePeriodsPastTheLine)
+{
+  Case c = development_case();
+  c.development.average_over = "image_periods";
+  c.development.measure_from = 1.2e-3;
+  c.development.measure_to = 2e-3;
+  const NipFrame f = NipFrame::from_case(c);
+  const DrumImage image(c.electric.image, f);
+  const double spacing = 1e-6, m_image = 3e-13, m_dark = 2e-14, qm = -0.03;
+  auto layer_at = [&](double t) {
+    const double s_line = image.drum_arc_at_x(c.development.measure_to, t);
+    std::vector<DrumToner> out;
+    const long first = static_cast<long>(std::floor((s_line - 70e-6) / spacing));
+    for (long k = first; k <= first + 140; ++k)
+    {
+      const double s = (static_cast<double>(k) + 0.5) * spacing;
+      const double m = image.exposed(s) ? m_image : m_dark;
+      const auto [x, y] = on_drum(f, s, t);
+      out.push_back({static_cast<std::int32_t>(k + 1000000), x, y, m, qm * m});
+    }
+    return out;
+  };
+  const double period_time = 2e-3 / std::abs(f.drum_omega * f.drum_radius);
+  TonerDevelopment whole(c), first(c);
+  std::unique_ptr<TonerDevelopment> second;
+  const double dt = 20e-6;
+  const int samples = static_cast<int>(2.2 * period_time / dt);
+  for (int n = 0; n <= samples; ++n)
+  {
+    const double t = n * dt;
+    whole.add_sample(t, layer_at(t), 0.9);
+    if (n <= samples / 2)
+      first.add_sample(t, layer_at(t), 0.9);
+    else
+    {
+      if (!second)
+      {
+        MemoryStateOut out;
+        first.write_state(out);
+        second = std::make_unique<TonerDevelopment>(c);
+        MemoryStateIn in(out.bytes(), "test state");
+        second->read_state(in);
+        ASSERT_EQ(in.remaining(), 0u);
+      }
+      second->add_sample(t, layer_at(t), 0.9);
+    }
+  }
+  const double depth = c.dem.periodic_length;
+  const double tma = m_image / (spacing * depth), fog = m_dark / (spacing * depth);
+  const double limit = eps0 * 3.0 * 650.0 / 20e-6;
+  std::map<std::string, SummaryValue> s;
+  for (const auto &v : whole.summary())
+    s[v.key] = v;
+  ASSERT_TRUE(s.count("image_periods_averaged"));
+  EXPECT_EQ(s["image_periods_averaged"].value, 2.0);
+  EXPECT_NEAR(s["tma_kg_per_m2"].value, tma, 1e-9 * tma);
+  EXPECT_NEAR(s["tma_kg_per_m2"].standard_error, 0.0, 1e-9 * tma);
+  EXPECT_NEAR(s["tma_kg_per_m2"].drift, 0.0, 1e-9);
+  EXPECT_NEAR(s["fog_kg_per_m2"].value, fog, 1e-9 * fog);
+  EXPECT_NEAR(s["developed_q_over_m_C_per_kg"].value, qm, 1e-12);
+  EXPECT_NEAR(s["neutralisation_ratio"].value, std::abs(qm) * tma / limit, 1e-9 * std::abs(qm) * tma / limit);
+  EXPECT_NEAR(s["tma_kg_per_m2_bound"].value, limit / 0.03, 1e-9 * limit / 0.03);
+  // The fixed window's samples repeat with the image: their rows stay in the file, not in the summary.
+  EXPECT_NE(whole.csv().find("stacked_toner"), std::string::npos);
+  ASSERT_NE(whole.developed_line(), nullptr);
+  EXPECT_EQ(second->developed_line()->periods_csv(), whole.developed_line()->periods_csv());
+  std::map<std::string, double> resumed;
+  for (const auto &v : second->summary())
+    resumed[v.key] = v.value;
+  EXPECT_EQ(resumed["tma_kg_per_m2"], s["tma_kg_per_m2"].value);
+  EXPECT_EQ(resumed["toner_transfer_rate_kg_per_s_m"], s["toner_transfer_rate_kg_per_s_m"].value);
 }

@@ -432,6 +432,16 @@ def window_halves(t, values, t_from):
                     for part in (window[:half], window[half:])]
 
 
+def period_halves(t_start, t_end, values):
+    """The whole image periods' halves as the steady-state test takes them (the older n // 2
+    periods and the newer rest): (first start, last end, mean) each; none with fewer than 2."""
+    n = len(values)
+    if n < 2:
+        return []
+    cut = n // 2
+    return [(t_start[a], t_end[b - 1], sum(values[a:b]) / (b - a)) for a, b in ((0, cut), (cut, n))]
+
+
 def development_plot(plt, dem_dir, run_summary, out):
     """TMA and fog against time (toner_development.csv), the averaging window shaded, its mean
     with the standard error, the means of its two halves (the steady-state test compares them)
@@ -450,15 +460,29 @@ def development_plot(plt, dem_dir, run_summary, out):
             return float("nan")
 
     t = [v * 1e3 for v in dev["time_s"]]
+    # Over whole image periods (development.average_over: image_periods) the means are those
+    # of the periods past the line; the window's samples repeat with the image.
+    periods = read_csv(os.path.join(dem_dir, "toner_developed_periods.csv"))
     fig, ax = plt.subplots(figsize=(8, 4))
-    ax.plot(t, dev["tma_kg_per_m2"], lw=0.9, label="TMA (image strips)")
+    ax.plot(t, dev["tma_kg_per_m2"], lw=0.9, alpha=0.5 if periods is not None else 1.0,
+            label="TMA in the window (image strips)")
     ax.plot(t, dev["fog_kg_per_m2"], lw=0.9, color="tab:gray", label="fog (dark strips)")
     ax.axvspan(t_from * 1e3, t[-1], color="tab:blue", alpha=0.08, label="averaging window")
     mean, se = number("tma_kg_per_m2"), number("tma_kg_per_m2", "standard_error")
     window, halves = window_halves(t, dev["tma_kg_per_m2"], t_from * 1e3)
+    if periods is not None:
+        starts = [v * 1e3 for v in periods.get("t_start_s", [])]
+        ends = [v * 1e3 for v in periods.get("t_end_s", [])]
+        values = periods.get("tma_kg_per_m2", [])
+        if values:
+            ax.hlines(values, starts, ends, color="tab:green", lw=3,
+                      label="TMA of each whole image period past the line")
+        halves = period_halves(starts, ends, values)
+        window = list(zip(starts, values)) + list(zip(ends[-1:], values[-1:]))
     if mean == mean and window:
+        what = f" over {len(periods.get('tma_kg_per_m2', []))} periods" if periods is not None else ""
         ax.hlines(mean, window[0][0], window[-1][0], color="tab:blue", lw=2,
-                  label=f"mean {mean:.3g} ± {se:.2g} kg/m²")
+                  label=f"mean{what} {mean:.3g} ± {se:.2g} kg/m²")
         for begin, end, value in halves:
             ax.hlines(value, begin, end, color="tab:orange", lw=1.5, ls="--")
         if halves:
@@ -480,6 +504,37 @@ def development_plot(plt, dem_dir, run_summary, out):
     save(fig, os.path.join(out, "toner_development.png"))
     plt.close(fig)
     return "toner_development.png"
+
+
+def developed_profile_plot(plt, dem_dir, out):
+    """The developed profile across one image period (toner_developed_profile.csv): toner mass
+    per area against the position from the exposed strip's centre, the exposed strip shaded.
+    None when the run did not average over image periods or closed none."""
+    path = os.path.join(dem_dir, "toner_developed_profile.csv")
+    prof = read_csv(path)
+    if not prof or not prof.get("position_mm"):
+        return None
+    with open(path) as f:
+        header = f.readline().lstrip("# ").strip()
+    x, y, exposed = prof["position_mm"], prof["toner_mass_per_area_kg_per_m2"], prof["exposed"]
+    if not any(v == v for v in y):
+        return None
+    fig, ax = plt.subplots(figsize=(8, 3.5))
+    width = (x[1] - x[0]) if len(x) > 1 else 1.0
+    ax.bar(x, [v if v == v else 0.0 for v in y], width=width * 0.95,
+           color=["tab:blue" if e == 1 else "tab:gray" for e in exposed])
+    lit = [xi for xi, e in zip(x, exposed) if e == 1]
+    if lit:
+        ax.axvspan(min(lit) - width / 2, max(lit) + width / 2, color="tab:blue", alpha=0.08,
+                   label="exposed strip (image)")
+        ax.legend(fontsize=8, loc="upper right")
+    ax.set_title(header.split(";")[0], fontsize=8)
+    ax.set_xlabel("position from the exposed strip's centre [mm]")
+    ax.set_ylabel("toner mass per area [kg/m²]")
+    ax.grid(alpha=0.3)
+    save(fig, os.path.join(out, "toner_developed_profile.png"))
+    plt.close(fig)
+    return "toner_developed_profile.png"
 
 
 # ------------------------------------------------------------------------------------------
@@ -683,6 +738,9 @@ def main():
     development = development_plot(plt, args.dem_dir, run_summary, args.out)
     if development:
         images.append(development)
+    profile_image = developed_profile_plot(plt, args.dem_dir, args.out)
+    if profile_image:
+        images.append(profile_image)
     flow = read_csv(os.path.join(args.dem_dir, "flow_report.csv"))
     rows = key_numbers(summary, nip_series, series, flux, run_summary, flow)
     build_index(args, images, rows, run_times, phases, snapshot_time, dem_done)

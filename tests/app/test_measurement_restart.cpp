@@ -119,7 +119,10 @@ INSTANTIATE_TEST_SUITE_P(
               {"toner_development.csv", "toner_transfer_profile.csv", "nip_profile.csv", "nip_time_series.csv",
                "summary.csv"}},
         // The developed line over image periods: an image period of 1 um (the drum passes 2.7
-        // of them in the 10 us) so that whole periods close before and after the restart.
+        // of them in the 10 us) so that whole periods close before and after the restart. Its
+        // state passes through the engine's checkpoint here; too little toner crosses the line
+        // in 10 us to count (the counting with toner across a restart: test_developed_line.cpp,
+        // test_toner_development.cpp).
         Scene{"development_periods",
               "tests/scenes/development/development_cell.yaml",
               true,

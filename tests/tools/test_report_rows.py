@@ -59,6 +59,12 @@ class DevelopmentWindow(unittest.TestCase):
         self.assertEqual(halves, [(2, 4, 1.5), (5, 7, (3.0 + 4.0 + 6.0) / 3)])
         self.assertEqual(report.window_halves(t, v, 6)[1], [])  # two samples: no halves
 
+    def test_period_halves_are_the_older_and_the_newer_whole_periods(self):
+        # Three periods: the older half holds one, the newer two (as the summary's drift).
+        halves = report.period_halves([20.0, 27.5, 35.0], [27.5, 35.0, 42.5], [2.0, 3.0, 5.0])
+        self.assertEqual(halves, [(20.0, 27.5, 2.0), (27.5, 42.5, 4.0)])
+        self.assertEqual(report.period_halves([20.0], [27.5], [2.0]), [])  # one period: no halves
+
 
 def summary(drift_nf, se_nf, resolution, significant, reached):
     """dem/summary.csv rows as report.py reads them (one tested mean)."""

@@ -37,11 +37,7 @@ def save(fig, path):
     os.replace(tmp, path)
 
 
-def number(text):
-    try:
-        return float(text)
-    except ValueError:
-        return float("nan")
+number = development_threshold.number  # a table cell as a float, NaN when it is none
 
 
 def verdicts(col, r, key):

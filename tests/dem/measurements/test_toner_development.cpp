@@ -244,14 +244,13 @@ TEST(TonerDevelopment, AppliesToNipScenesWithTonerAndAField)
   EXPECT_FALSE(TonerDevelopment::applies(c));
 }
 
-// The developer's hold on its toner: the toner mass within the adhesion range of a carrier (or
-// overlapping one) over all toner mass, from the neighbour list's pairs. Toner placed by hand
-// around one carrier at known gaps: 1 nm (held: inside the 4 nm range), 10 nm (free), a 10 nm
-// overlap (held), one touching only another toner, one far away, and one held across the
-// periodic boundary (the pair's image shift counts).
-TEST(TonerDevelopment, TonerOnCarriersIsTheMassWithinTheAdhesionRangeOfOne)
+namespace {
+
+// A periodic box (1 mm x 1 mm) of carrier and toner material with adhesion and no gravity,
+// where a test places its particles by hand.
+Case box_of_carriers_and_toner()
 {
-  const Case c = parse_case_text(R"(
+  return parse_case_text(R"(
 name: retention
 scene: box
 materials:
@@ -265,7 +264,19 @@ populations:
   - {name: toner, kind: toner, diameter: 7 um, count: 1, charge_to_mass: -30 uC/g, insert_box: [[0 mm, 0 mm, 0 mm], [1 mm, 1 mm, 1 mm]]}
 dem: {gravity: [0, 0, 0], periodic_length_x: 1 mm, periodic_length_y: 1 mm}
 )",
-                                 "retention.yaml");
+                         "box.yaml");
+}
+
+} // namespace
+
+// The developer's hold on its toner: the toner mass within the adhesion range of a carrier (or
+// overlapping one) over all toner mass, from the neighbour list's pairs. Toner placed by hand
+// around one carrier at known gaps: 1 nm (held: inside the 4 nm range), 10 nm (free), a 10 nm
+// overlap (held), one touching only another toner, one far away, and one held across the
+// periodic boundary (the pair's image shift counts).
+TEST(TonerDevelopment, TonerOnCarriersIsTheMassWithinTheAdhesionRangeOfOne)
+{
+  const Case c = box_of_carriers_and_toner();
   DemSystem system(c);
   ParticleState &p = system.particles();
   const double rc = 17.5e-6, centre = 0.5e-3;
@@ -314,21 +325,7 @@ TEST(TonerDevelopment, TheShareOnCarriersIsSampledIntoTheSummary)
 // periodic boundary.
 TEST(TonerDevelopment, TheDrumsLayerIsTheTonerTouchingItAndTheTonerStackedOnThat)
 {
-  const Case c = parse_case_text(R"(
-name: stack
-scene: box
-materials:
-  carrier: {youngs_modulus: 1e3 MPa, poisson_ratio: 0.35, density: 2200 kg/m^3, friction: 0.45, damping: 0.6, hamaker: 1e-19 J}
-  toner: {youngs_modulus: 3e3 MPa, poisson_ratio: 0.35, density: 1100 kg/m^3, friction: 0.3, damping: 0.6, hamaker: 1e-19 J}
-  wall: {youngs_modulus: 5e4 MPa, poisson_ratio: 0.3, friction: 0.35, hamaker: 0 J}
-planes:
-  - {name: floor, point: [0 mm, 0 mm, 0 mm], normal: [0, 0, 1], material: wall}
-populations:
-  - {name: carrier, kind: carrier, diameter: 35 um, count: 1, insert_box: [[0 mm, 0 mm, 0 mm], [1 mm, 1 mm, 1 mm]]}
-  - {name: toner, kind: toner, diameter: 7 um, count: 1, charge_to_mass: -30 uC/g, insert_box: [[0 mm, 0 mm, 0 mm], [1 mm, 1 mm, 1 mm]]}
-dem: {gravity: [0, 0, 0], periodic_length_x: 1 mm, periodic_length_y: 1 mm}
-)",
-                                 "stack.yaml");
+  const Case c = box_of_carriers_and_toner();
   DemSystem system(c);
   ParticleState &p = system.particles();
   const double r = 3.5e-6, y = 0.5e-3, z = 0.5e-3;

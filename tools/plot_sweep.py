@@ -128,7 +128,10 @@ def plot_keys(plt, directory, header, rows, requested):
             if log:
                 ax.set_yscale("log")
                 bound = [b if b > 0 else float("nan") for b in bound]
-            ax.plot(xs, bound, "k--", lw=1.2, label="physical bound")
+            # Through the points that have one: a point not run (NaN) would break the line
+            # into single points, which a dashed line does not draw.
+            drawn = [(x, b) for x, b in zip(xs, bound) if b == b]
+            ax.plot([x for x, _ in drawn], [b for _, b in drawn], "k--", lw=1.2, label="physical bound")
             if log:
                 ax.plot([], [], " ", label="log scale: the values lie below 5 % of the bound")
         if key == "tma_kg_per_m2":

@@ -90,12 +90,14 @@ void TonerDevelopment::sample(const DemSystem &system)
     if (s < is_toner_.size() && is_toner_[s])
       layer_[r.particle] = 1;
   }
-  stack_on_drum(system, is_toner_, is_carrier_, layer_);
+  // Which toner a carrier holds: once per sample, for both the stack and the share on carriers.
+  mark_on_carriers(system, is_toner_, is_carrier_, on_carrier_);
+  stack_on_drum(system, is_toner_, on_carrier_, layer_);
   toner_.clear();
   for (std::size_t k = 0; k < p.size(); ++k)
     if (layer_[k] > 0)
       toner_.push_back({p.id[k], p.x[k], p.y[k], p.mass[k], p.charge[k], layer_[k]});
-  add_sample(system.time(), toner_, toner_share_on_carriers(system, is_toner_, is_carrier_));
+  add_sample(system.time(), toner_, toner_share_on_carriers(system, is_toner_, on_carrier_));
 }
 
 namespace {
@@ -122,9 +124,10 @@ bool held_pair(const DemSystem &system, std::size_t q)
   return std::sqrt(dx * dx + dy * dy + dz * dz) - p.radius[i] - p.radius[j] <= range;
 }
 
-// Per particle: 1 for a toner held by a carrier.
-void mark_on_carriers(const DemSystem &system, const std::vector<std::uint8_t> &is_toner,
-                      const std::vector<std::uint8_t> &is_carrier, std::vector<std::uint8_t> &on)
+} // namespace
+
+void TonerDevelopment::mark_on_carriers(const DemSystem &system, const std::vector<std::uint8_t> &is_toner,
+                                        const std::vector<std::uint8_t> &is_carrier, std::vector<std::uint8_t> &on)
 {
   const ParticleState &p = system.particles();
   const NeighbourList &list = system.neighbour_list();
@@ -138,15 +141,12 @@ void mark_on_carriers(const DemSystem &system, const std::vector<std::uint8_t> &
       on[toner_carrier ? i : j] = 1;
   }
 }
-} // namespace
 
 void TonerDevelopment::stack_on_drum(const DemSystem &system, const std::vector<std::uint8_t> &is_toner,
-                                     const std::vector<std::uint8_t> &is_carrier, std::vector<std::uint8_t> &layer)
+                                     const std::vector<std::uint8_t> &on_carrier, std::vector<std::uint8_t> &layer)
 {
   const ParticleState &p = system.particles();
   const NeighbourList &list = system.neighbour_list();
-  std::vector<std::uint8_t> on_carrier; // once per sample, not per step
-  mark_on_carriers(system, is_toner, is_carrier, on_carrier);
   // Layer by layer: a pass over the pairs extends only from the layer below, so that the layers
   // do not depend on the pairs' order.
   for (int below = 1; below < max_layers; ++below)
@@ -171,11 +171,9 @@ void TonerDevelopment::stack_on_drum(const DemSystem &system, const std::vector<
 }
 
 double TonerDevelopment::toner_share_on_carriers(const DemSystem &system, const std::vector<std::uint8_t> &is_toner,
-                                                 const std::vector<std::uint8_t> &is_carrier)
+                                                 const std::vector<std::uint8_t> &on)
 {
   const ParticleState &p = system.particles();
-  std::vector<std::uint8_t> on;
-  mark_on_carriers(system, is_toner, is_carrier, on);
   double all = 0.0, carried = 0.0;
   for (std::size_t k = 0; k < p.size(); ++k)
   {

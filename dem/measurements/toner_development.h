@@ -81,16 +81,20 @@ public:
   // the toner mass on carriers / all toner mass (NaN: not known).
   void add_sample(double time, const std::vector<DrumToner> &on_drum,
                   double on_carriers = std::numeric_limits<double>::quiet_NaN());
-  // The toner mass within the adhesion range of a carrier (its touching pairs, when the
-  // contacts do not attract) over all toner mass, from the neighbour list's pairs; toner a
+  // Per particle, `on` = 1 for a toner held by a carrier: within the adhesion range of one (its
+  // touching pairs, when the contacts do not attract), from the neighbour list's pairs.
+  // `is_toner`, `is_carrier`: per species.
+  static void mark_on_carriers(const DemSystem &system, const std::vector<std::uint8_t> &is_toner,
+                               const std::vector<std::uint8_t> &is_carrier, std::vector<std::uint8_t> &on);
+  // The toner mass held by a carrier (`on`, from mark_on_carriers) over all toner mass; toner a
   // carrier carries as its own mass (carried_until_gap) counts as on it.
   static double toner_share_on_carriers(const DemSystem &system, const std::vector<std::uint8_t> &is_toner,
-                                        const std::vector<std::uint8_t> &is_carrier);
+                                        const std::vector<std::uint8_t> &on);
   // The drum's layer: `layer` (per particle) holds 1 for the toner touching the drum and 0 else;
   // on return 2, 3, ... (up to max_layers) mark the toner resting on the layer below, held by no
-  // carrier (neighbour-list pairs touching or within the adhesion range).
+  // carrier (`on_carrier`, from mark_on_carriers; pairs touching or within the adhesion range).
   static void stack_on_drum(const DemSystem &system, const std::vector<std::uint8_t> &is_toner,
-                            const std::vector<std::uint8_t> &is_carrier, std::vector<std::uint8_t> &layer);
+                            const std::vector<std::uint8_t> &on_carrier, std::vector<std::uint8_t> &layer);
   static constexpr int max_layers = 8;
 
   double contrast_potential() const { return contrast_; } // ΔV [V]
@@ -136,6 +140,7 @@ private:
   std::vector<DrumToner> toner_;
   std::vector<std::uint8_t> is_toner_, is_carrier_; // by species
   std::vector<std::uint8_t> layer_;                 // by particle: on the drum's layer (stack_on_drum)
+  std::vector<std::uint8_t> on_carrier_;            // by particle: held by a carrier (mark_on_carriers)
 };
 
 } // namespace magbrush::dem

@@ -299,9 +299,12 @@ TEST(TonerDevelopment, TonerOnCarriersIsTheMassWithinTheAdhesionRangeOfOne)
   const double held = mass(3.0e-6) + mass(4.0e-6) + mass(3.7e-6);
   const double all = held + mass(3.5e-6) + 2 * mass(3.2e-6);
   ASSERT_GT(system.contact_table().adhesion_range(), 1e-9);
-  EXPECT_NEAR(TonerDevelopment::toner_share_on_carriers(system, {0, 1}, {1, 0}), held / all, 1e-12);
+  std::vector<std::uint8_t> on;
+  TonerDevelopment::mark_on_carriers(system, {0, 1}, {1, 0}, on);
+  EXPECT_NEAR(TonerDevelopment::toner_share_on_carriers(system, {0, 1}, on), held / all, 1e-12);
   // Species flags the other way round: no toner, no share.
-  EXPECT_TRUE(std::isnan(TonerDevelopment::toner_share_on_carriers(system, {0, 0}, {1, 0})));
+  TonerDevelopment::mark_on_carriers(system, {0, 0}, {1, 0}, on);
+  EXPECT_TRUE(std::isnan(TonerDevelopment::toner_share_on_carriers(system, {0, 0}, on)));
 }
 
 TEST(TonerDevelopment, TheShareOnCarriersIsSampledIntoTheSummary)
@@ -346,7 +349,9 @@ TEST(TonerDevelopment, TheDrumsLayerIsTheTonerTouchingItAndTheTonerStackedOnThat
   std::vector<std::uint8_t> layer(p.size(), 0);
   for (std::size_t k = 0; k < p.size(); ++k)
     layer[k] = (p.id[k] == 0 || p.id[k] == 6) ? 1 : 0;
-  TonerDevelopment::stack_on_drum(system, {0, 1}, {1, 0}, layer);
+  std::vector<std::uint8_t> on_carrier;
+  TonerDevelopment::mark_on_carriers(system, {0, 1}, {1, 0}, on_carrier);
+  TonerDevelopment::stack_on_drum(system, {0, 1}, on_carrier, layer);
   // B on A, C on B, F on A2 through the boundary; D (held by a carrier) and E (free) are not.
   const std::vector<int> expected = {1, 2, 3, 0, 0, 0, 1, 2};
   for (std::size_t k = 0; k < p.size(); ++k)

@@ -39,7 +39,7 @@ std::vector<KeySpec> particle_keys()
       choice("populations[].kind", {"carrier", "toner"}, "Particle kind.").def("carrier"),
       text("populations[].material", "Material (key in materials).").def("<kind>"),
       quantity("populations[].diameter", D::length, "Mean diameter.").required().positive(),
-      quantity("populations[].diameter_std", D::length, "Standard deviation of the diameter (normal, truncated).")
+      quantity("populations[].diameter_std", D::length, "Standard deviation of the diameter (normal; truncated at ±3σ and at 5 % of the mean for particles made during a run: inflow, toner released from its carrier; at insertion to positive sizes).")
           .def("0 um").non_negative(),
       integer("populations[].count", "Number of particles (give exactly one of count, mass, concentration).")
           .def("0").non_negative(),

@@ -58,10 +58,7 @@ CarriedTonerRelease::CarriedTonerRelease(const Case &c, const DemWalls &walls, c
   const Population &p = c.populations[static_cast<std::size_t>(species_)];
   population_ = p;
   density_ = c.material(p.material).density;
-  d_mean_ = p.diameter_mean;
-  d_std_ = std::max(0.0, p.diameter_std);
-  d_min_ = std::max(0.05 * d_mean_, d_mean_ - 3.0 * d_std_);
-  d_max_ = d_mean_ + 3.0 * d_std_;
+  size_ = SizeDistribution(p.diameter_mean, p.diameter_std);
   gap_ = p.carried_until_gap;
   const Vec2 centre = c.drum.center(c.sleeve->radius);
   drum_x_ = centre[0];
@@ -73,7 +70,7 @@ CarriedTonerRelease::CarriedTonerRelease(const Case &c, const DemWalls &walls, c
 
 void CarriedTonerRelease::smallest_particles(ParticleState &out) const
 {
-  out.add({0, 0, 0}, 0.5 * d_min_, density_, species_, 0.0);
+  out.add({0, 0, 0}, 0.5 * size_.min(), density_, species_, 0.0);
 }
 
 // Surface-to-surface distance of particle k to the drum (negative when overlapping it).
@@ -97,7 +94,7 @@ void CarriedTonerRelease::gather_near(const ParticleState &state, const Particle
   near_x_.clear();
   near_r_.clear();
   const Vector3 c = state.position(k);
-  const double reach = state.radius[k] + d_max_;
+  const double reach = state.radius[k] + size_.max();
   auto consider = [&](const ParticleState &s, std::size_t j) {
     double d[3] = {s.x[j] - c.x, s.y[j] - c.y, s.z[j] - c.z};
     for (int a = 0; a < 3; ++a)
@@ -141,15 +138,10 @@ void CarriedTonerRelease::release_carrier(ParticleState &state, std::size_t k, d
 {
   const std::size_t n = static_cast<std::size_t>(state.carried_count[k]);
   d_.resize(n);
-  std::normal_distribution<double> normal(d_mean_, d_std_);
   double drawn = 0.0;
   for (double &d : d_)
   {
-    d = d_mean_;
-    if (d_std_ > 0.0)
-      do
-        d = normal(rng_);
-      while (d < d_min_ || d > d_max_);
+    d = size_.draw(rng_);
     drawn += sphere_mass(d, density_);
   }
   const double scale = std::cbrt(state.carried_mass[k] / drawn);

@@ -34,6 +34,7 @@
 
 #include "dem/neighbour_list.h"
 #include "dem/particle_state.h"
+#include "dem/size_distribution.h"
 #include "dem/wall_contacts.h"
 
 #include "coupling/case_model.h"
@@ -91,7 +92,8 @@ private:
   const DemWalls &walls_;
   PeriodicBox box_;
   int species_ = -1;
-  double density_ = 0.0, d_mean_ = 0.0, d_std_ = 0.0, d_min_ = 0.0, d_max_ = 0.0;
+  double density_ = 0.0;
+  SizeDistribution size_; // the released toner's diameters [m]
   double gap_ = 0.0;
   double drum_x_ = 0.0, drum_y_ = 0.0, drum_radius_ = 0.0;
 

@@ -32,12 +32,7 @@ ParticleSource::ParticleSource(const Case &c, const DemWalls &walls, const Perio
     Feed fd;
     fd.species = static_cast<int>(s);
     fd.density = c.material(p.material).density;
-    fd.d_mean = p.diameter_mean;
-    fd.d_std = std::max(0.0, p.diameter_std);
-    // The normal distribution truncated at ±3σ (and to positive sizes): the smallest size
-    // bounds the stable time step before the particle exists.
-    fd.d_min = std::max(0.05 * fd.d_mean, fd.d_mean - 3.0 * fd.d_std);
-    fd.d_max = fd.d_mean + 3.0 * fd.d_std;
+    fd.size = SizeDistribution(p.diameter_mean, p.diameter_std);
     fd.population = p;
     fd.concentration = p.concentration;
     fd.carried = p.carried_until_gap > 0.0;
@@ -74,14 +69,14 @@ ParticleSource::ParticleSource(const Case &c, const DemWalls &walls, const Perio
   prefill_at_rest_ = c.dem.settle_time > 0.0;
   carrier_share_ = 1.0 / (1.0 + tc);
   // Random insertion jams near 30-40 % solid; refuse a layer that would need more.
-  const double free_height = height_ - carrier_.d_mean;
+  const double free_height = height_ - carrier_.size.mean();
   const double solid = free_height > 0.0 ? carrier_share_ * areal_mass_ / (carrier_.density * free_height) : 1.0;
   if (solid > 0.3)
     throw std::invalid_argument("inflow.layer_height: a layer of " + std::to_string(height_ * 1e3) +
                                 " mm cannot hold inflow.areal_mass = " + std::to_string(areal_mass_) +
                                 " kg/m^2 of carriers by random placement (" + std::to_string(100.0 * solid) +
                                 " % solid; at most 30 %): raise inflow.layer_height to at least " +
-                                std::to_string(1e3 * (carrier_share_ * areal_mass_ / (0.3 * carrier_.density) + carrier_.d_mean)) + " mm");
+                                std::to_string(1e3 * (carrier_share_ * areal_mass_ / (0.3 * carrier_.density) + carrier_.size.mean())) + " mm");
   owed_toner_.assign(toner_.size(), 0.0);
   count_.assign(c.populations.size(), 0);
   mass_.assign(c.populations.size(), 0.0);
@@ -128,23 +123,12 @@ double ParticleSource::sleeve_rotation(double t) const
 
 void ParticleSource::smallest_particles(ParticleState &out) const
 {
-  out.add({0, 0, 0}, 0.5 * carrier_.d_min, carrier_.density, carrier_.species, 0.0);
+  out.add({0, 0, 0}, 0.5 * carrier_.size.min(), carrier_.density, carrier_.species, 0.0);
   for (const Feed &t : toner_)
-    out.add({0, 0, 0}, 0.5 * t.d_min, t.density, t.species, 0.0);
+    out.add({0, 0, 0}, 0.5 * t.size.min(), t.density, t.species, 0.0);
 }
 
-double ParticleSource::draw_diameter(const Feed &f)
-{
-  if (f.d_std <= 0.0)
-    return f.d_mean;
-  std::normal_distribution<double> normal(f.d_mean, f.d_std);
-  for (;;)
-  {
-    const double d = normal(rng_);
-    if (d >= f.d_min && d <= f.d_max)
-      return d;
-  }
-}
+double ParticleSource::draw_diameter(const Feed &f) { return f.size.draw(rng_); }
 
 // The particles present within reach of the arc θ0 … θ0 + Δφ (and of the layer).
 void ParticleSource::gather_near(const ParticleState &s, double theta0, double dphi)
@@ -157,9 +141,9 @@ void ParticleSource::gather_near(const ParticleState &s, double theta0, double d
 // Adds the particles of `s` within reach of the arc to those gathered.
 void ParticleSource::add_near(const ParticleState &s, double theta0, double dphi)
 {
-  double d_big = carrier_.d_max;
+  double d_big = carrier_.size.max();
   for (const Feed &t : toner_)
-    d_big = std::max(d_big, carrier_.d_max + 2.0 * t.d_max);
+    d_big = std::max(d_big, carrier_.size.max() + 2.0 * t.size.max());
   const double mid = theta0 + 0.5 * dphi, half = 0.5 * std::abs(dphi) + (height_ + 2.0 * d_big) / R_;
   const double r_out = R_ + height_ + 2.0 * d_big;
   for (std::size_t i = 0; i < s.size(); ++i)
@@ -292,7 +276,7 @@ void ParticleSource::create(const ParticleState &state, double t, ParticleState 
   owed_carrier_ += carrier_share_ * areal_mass_ * R_ * std::abs(dphi) * Lz_;
   // The arc the new carriers' centres go into: the one swept, but at least two diameters long
   // (an exchange every few steps sweeps far less than a bead; what does not fit waits).
-  const double span = std::copysign(std::max(std::abs(dphi), 2.0 * carrier_.d_max / R_), dphi);
+  const double span = std::copysign(std::max(std::abs(dphi), 2.0 * carrier_.size.max() / R_), dphi);
   gather_near(state, theta_in_, span);
   drawing_ = true;
   fill_owed(t, theta_in_, span, sump_, enter);
@@ -352,14 +336,14 @@ void ParticleSource::prefill(const ParticleState &present, ParticleState &add)
   const auto created_mass = mass_;
   const std::size_t first = add.size();
   const double sense = omega_ < 0.0 ? -1.0 : 1.0;
-  const double piece = 2.0 * carrier_.d_max / R_;
+  const double piece = 2.0 * carrier_.size.max() / R_;
   const int pieces = std::max(1, static_cast<int>(std::ceil(prefill_arc_ / piece)));
   const double span = sense * prefill_arc_ / pieces;
   const double per_piece = carrier_share_ * areal_mass_ * R_ * std::abs(span) * Lz_;
-  const double backlog = std::max(per_piece, 10.0 * sphere_mass(carrier_.d_mean, carrier_.density));
+  const double backlog = std::max(per_piece, 10.0 * sphere_mass(carrier_.size.mean(), carrier_.density));
   // Thin: a piece that leaves more than two carriers unplaced has no room for the layer (random
   // placement near its packing limit falls behind by a fraction of one).
-  const double shortfall = 2.0 * sphere_mass(carrier_.d_mean, carrier_.density);
+  const double shortfall = 2.0 * sphere_mass(carrier_.size.mean(), carrier_.density);
   double passed = 1.0; // the fraction of the layer the narrowest piece so far took (thin)
   for (int k = 0; k < pieces; ++k)
   {
@@ -412,7 +396,7 @@ void ParticleSource::prefill(const ParticleState &present, ParticleState &add)
 // After create()'s placement: a fixed supply that has fallen far behind what it owes stops.
 void ParticleSource::check_owed() const
 {
-  const double mean_mass = sphere_mass(carrier_.d_mean, carrier_.density);
+  const double mean_mass = sphere_mass(carrier_.size.mean(), carrier_.density);
   if (owed_carrier_ > 50.0 * mean_mass)
     throw std::runtime_error("inflow: the developer owed (" + std::to_string(owed_carrier_ / mean_mass) +
                              " carriers) does not fit into the entry arc: the particles there do not move on "

@@ -47,6 +47,7 @@
 
 #include "dem/neighbour_list.h"
 #include "dem/particle_state.h"
+#include "dem/size_distribution.h"
 #include "dem/wall_contacts.h"
 
 #include "coupling/case_model.h"
@@ -116,7 +117,8 @@ private:
   {
     int species = 0;
     Population population; // a copy (the case need not outlive the source): q/m, counter-charge
-    double density = 0.0, d_mean = 0.0, d_std = 0.0, d_min = 0.0, d_max = 0.0;
+    double density = 0.0;
+    SizeDistribution size; // diameters [m]
     double concentration = 0.0; // toner: mass per carrier mass
     bool carried = false;       // toner: rides the carrier as its mass and charge (carried_toner.h)
   };

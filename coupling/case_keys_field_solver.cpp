@@ -23,7 +23,7 @@ std::vector<KeySpec> field_solver_keys()
           .def("16").min(1).max(1024).affects(A::electric),
       quantity("field.probe_radius", D::length, "Radius of the exported sleeve flux profile (0 = sleeve radius).")
           .def("0 mm").non_negative().affects(A::magnetic),
-      text("field.output_dir", "Directory of the stored field files.").def("fields"),
+      text("field.output_dir", "Directory of the stored field files (empty: <output.directory>/fields).").def(""),
   };
 }
 

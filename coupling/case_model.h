@@ -205,7 +205,7 @@ struct FieldSettings
   double grid_electric_spacing = 10e-6; // Cartesian nip grid spacing [m]
   int electric_phase_samples = 16;      // latent-image phases stored per image period
   double probe_radius = 0.0;            // sleeve-profile probe radius [m] (0 = sleeve radius)
-  std::string output_dir = "fields";
+  std::string output_dir = "results/fields"; // <output.directory>/fields: the parser makes an empty key so
 };
 
 struct DemSettings

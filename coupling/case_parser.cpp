@@ -797,6 +797,11 @@ private:
     c.output.directory = str(o, "directory");
     c.output.vtu = flag(o, "vtu");
     c.output.xdmf = flag(o, "xdmf");
+    // The stored fields belong to the run's results unless the case puts them elsewhere: two
+    // runs of one case into two folders (two biases, two tests side by side) then never
+    // replace each other's field while the other reads it.
+    if (c.field.output_dir.empty())
+      c.field.output_dir = (std::filesystem::path(c.output.directory) / "fields").string();
     return c;
   }
 

@@ -8,7 +8,7 @@ the knob affects.
 
 Scenes and observables (docs/pipeline_cost.md):
   field of kawamoto_nip, field of kweon_development   sleeve |B| profile (the field stage's
-      fields/<name>_profile_sleeve.csv): knobs element degree, mesh size
+      results/fields/<name>_profile_sleeve.csv): knobs element degree, mesh size
   nip: kawamoto_nip at a small size (a 0.25 mm slab, 1,075 beads, 0.5 ms)   slip, pressure,
       touching-bead density (dem/summary.csv, dem/nip_profile.csv): knobs time-step fraction,
       magnetic far-field order, magnetic refresh, staleness, field grid spacing
@@ -215,7 +215,7 @@ def run_field(case, name, overrides, folder, reuse):
     args = set_args(overrides)
     mesh_s = magbrush(["mesh", case] + args, folder, log)
     field_s = magbrush(["field", case, "--only", "magnetic", "--no-vtu"] + args, folder, log)
-    profile = read_sleeve_profile(os.path.join(folder, "fields", name + "_profile_sleeve.csv"))
+    profile = read_sleeve_profile(os.path.join(folder, "results", "fields", name + "_profile_sleeve.csv"))
     with open(log) as f:
         check = re.search(r"vs the exact multipole ring: ([-+0-9.eE]+)", f.read())
     return store(folder, {"times": {"mesh": mesh_s, "field": field_s, "mesh+field": mesh_s + field_s},

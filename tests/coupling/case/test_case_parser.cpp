@@ -264,6 +264,15 @@ TEST(CaseFiles, KweonDevelopmentHasTheBiasRangeAndChargedToner)
   EXPECT_GT(c.dem.duration, c.development.average_from);
 }
 
+// The stored fields go with the run's results unless the case puts them elsewhere, so that
+// two runs of one case into two folders (two biases; two tests side by side) never share one.
+TEST(CaseParser, TheFieldsAreStoredInTheOutputDirectoryUnlessTheCaseSaysWhere)
+{
+  EXPECT_EQ(load_case(minimal).field.output_dir, "results/fields");
+  EXPECT_EQ(load_case(minimal, {"output.directory=runs/a"}).field.output_dir, "runs/a/fields");
+  EXPECT_EQ(load_case(minimal, {"output.directory=runs/a", "field.output_dir=shared"}).field.output_dir, "shared");
+}
+
 TEST(CaseParser, DefaultsAgreeWithTheContractStruct)
 {
   const Case c = load_case(minimal);

@@ -73,10 +73,18 @@ def draw_threshold(ax, directory, header, rows, xs):
     x0 = result["threshold"]
     if x0 != x0:
         return
-    ends = [min(xs + [x0]), max(xs + [x0])]
+    # Down to the threshold when it lies within one span of the points; a threshold farther
+    # off (two points with a large intercept) would squeeze the points' ticks together, so the
+    # line then stops a fifth of the span past them and the legend gives the threshold.
+    finite = [x for x in xs if x == x]
+    lo, hi = min(finite), max(finite)
+    span = hi - lo
+    near = lo - span <= x0 <= hi + span
+    ends = [min(lo, x0), max(hi, x0)] if near else [lo - 0.2 * span, hi + 0.2 * span]
     ax.plot(ends, [result["intercept"] + result["slope"] * x for x in ends], ":", color="C1",
-            label=development_threshold.describe(result))
-    if result["contrast_zero"] == result["contrast_zero"]:
+            label=development_threshold.describe(result) + ("" if near else " (off the axis)"))
+    cz = result["contrast_zero"]
+    if cz == cz and ends[0] - 0.05 * span <= cz <= ends[1] + 0.05 * span:
         ax.axvline(result["contrast_zero"], color="0.6", lw=0.8, ls="-.",
                    label=f"zero contrast (the bound vanishes): {result['contrast_zero']:.0f} V")
 

@@ -11,6 +11,7 @@ import unittest
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tools"))
 
 import development_threshold as dt  # noqa: E402
+import plot_sweep  # noqa: E402
 
 BIASES = [-500.0, -600.0, -700.0, -800.0]
 
@@ -107,6 +108,48 @@ class StudyTable(unittest.TestCase):
         self.assertAlmostEqual(float(row["threshold"]), -300.0, delta=1e-4)
         self.assertEqual(row["points"], "4")
         self.assertEqual(row["weighted"], "1")
+
+
+class RecordingAxes:
+    """What tools/plot_sweep.py draws, without matplotlib."""
+
+    def __init__(self):
+        self.lines, self.vertical = [], []
+
+    def plot(self, xs, ys, *args, **kwargs):
+        self.lines.append((list(xs), list(ys), kwargs.get("label", "")))
+
+    def axvline(self, x, **kwargs):
+        self.vertical.append(x)
+
+
+class DrawnThreshold(unittest.TestCase):
+    header = StudyTable.header
+
+    def drawn(self, rows):
+        ax = RecordingAxes()
+        with tempfile.TemporaryDirectory() as d:
+            xs = [float(r[2]) for r in rows]
+            plot_sweep.draw_threshold(ax, d, self.header, rows, xs)
+        return ax
+
+    def test_a_threshold_near_the_points_is_drawn_down_to(self):
+        ax = self.drawn(StudyTable().rows()[:4])
+        (xs, ys, label), = ax.lines
+        self.assertEqual(xs, [-800.0, -300.0])
+        self.assertAlmostEqual(ys[1], 0.0, delta=1e-12)
+        self.assertNotIn("off the axis", label)
+        self.assertEqual(ax.vertical, [])  # zero contrast (0 V) lies beyond the line's reach
+
+    def test_a_threshold_far_off_leaves_the_axis_to_the_points(self):
+        # Two points whose line reaches zero at +538 V: drawn over the points' span and a fifth.
+        rows = [["p0", "-500V", "-500", "2.08e-3", "", "2.2e-2", "ok"],
+                ["p3", "-800V", "-800", "2.68e-3", "", "3.5e-2", "ok"]]
+        ax = self.drawn(rows)
+        (xs, _, label), = ax.lines
+        self.assertEqual(xs, [-860.0, -440.0])
+        self.assertIn("off the axis", label)
+        self.assertEqual(ax.vertical, [])
 
 
 if __name__ == "__main__":

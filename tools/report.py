@@ -3,7 +3,7 @@
 
 Called by `magbrush report CASE` (which checks the inputs and finds this script):
 
-    report.py --case-name NAME --dem-dir RESULTS/dem --field-prefix fields/NAME_ --out RESULTS/report
+    report.py --case-name NAME --dem-dir RESULTS/dem --field-prefix RESULTS/fields/NAME_ --out RESULTS/report
               [--run-times RESULTS/run_times.csv] [--measured-flux report/measured_flux.csv]
               [--sleeve-radius R --drum-radius RD --drum-center X,Y]
 
@@ -666,7 +666,7 @@ def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--case-name", required=True)
     p.add_argument("--dem-dir", required=True)
-    p.add_argument("--field-prefix", required=True, help="fields/<case>_ (the field stage's file prefix)")
+    p.add_argument("--field-prefix", required=True, help="<output.directory>/fields/<case>_ (the field stage's file prefix)")
     p.add_argument("--out", required=True)
     p.add_argument("--run-times")
     p.add_argument("--measured-flux")

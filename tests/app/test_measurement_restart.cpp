@@ -66,12 +66,7 @@ TEST_P(MeasurementRestart, RestartedRunWritesTheUninterruptedRunsFilesByteForByt
   const Scene &scene = GetParam();
   const fs::path dir = magbrush::testing::test_temp_dir(std::string("measurement_restart_") + scene.name);
   const std::string case_file = std::string(MAGBRUSH_SOURCE_DIR) + "/" + scene.case_file;
-  // Each scene keeps its fields in its own folder: the default (fields/ in the working
-  // directory, shared by every test) would let two scenes of one case with different fields
-  // (the development cell with and without its 1 um image period) replace each other's file
-  // while the other runs, and the restart would then refuse the field it finds.
-  const std::string common = std::string(" ") + scene.settings + " --threads 1" +
-                             (scene.fields ? " --set field.output_dir=" + (dir / "fields").string() : "");
+  const std::string common = std::string(" ") + scene.settings + " --threads 1";
   const fs::path whole = scene.fields ? dir / "whole" / "dem" : dir / "whole";
   const CliResult a =
       scene.fields ? run("magbrush", "run '" + case_file + "' --set output.directory=" + (dir / "whole").string() + common)
@@ -81,7 +76,8 @@ TEST_P(MeasurementRestart, RestartedRunWritesTheUninterruptedRunsFilesByteForByt
   const fs::path halfway = dir / "halfway.bin";
   fs::copy_file(whole / "checkpoint.previous.bin", halfway);
   const fs::path continued = dir / "continued";
-  // (magbrush-dem finds the fields where the whole run put them: field.output_dir.)
+  // (magbrush-dem finds the fields where the whole run put them, <output.directory>/fields:
+  // each scene's own, so the development cell's two scenes, whose fields differ, never share one.)
   const CliResult b = run("magbrush-dem", "'" + case_file + "'" + common + " --set output.directory=" +
                                               (dir / "whole").string() + " --restart " + halfway.string() +
                                               " --output " + continued.string());

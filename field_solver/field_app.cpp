@@ -305,7 +305,8 @@ bool compute_electric_field(const Case &c, const FieldRunOptions &options, MPI_C
   const LatentImage &image = c.electric.image;
   LatentImage no_image = image;
   no_image.dark_value = no_image.light_value = 0.0;
-  const bool moving = image.period > 0.0 && image.kind != LatentImage::Kind::none;
+  // A uniform image (solid or dark) looks the same at every phase: one solve.
+  const bool moving = image.striped() && image.kind != LatentImage::Kind::none;
   const int K = moving ? c.field.electric_phase_samples : 1;
   grid.image_period = moving ? image.period : 0.0;
   grid.drum_center = layout.drum_center;

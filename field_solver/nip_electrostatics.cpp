@@ -20,14 +20,12 @@ double wrap(double a)
 
 double latent_image_value(const LatentImage &image, double s)
 {
-  if (image.period <= 0.0)
+  if (image.solid())
+    return image.light_value; // a solid area, whatever the period
+  if (!image.striped())
     return image.dark_value;
   // s' ∈ [−P/2, P/2): the place within the period; e: the distance inside the exposed strip
   // from its nearer edge (negative outside it).
-  if (image.duty >= 1.0)
-    return image.light_value;
-  if (image.duty <= 0.0)
-    return image.dark_value;
   const double P = image.period;
   const double v = s / P + 0.5;
   const double s_local = (v - std::floor(v) - 0.5) * P;

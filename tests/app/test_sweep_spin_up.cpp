@@ -3,7 +3,7 @@
 // the points' averages start after the settle, and a point whose values are the spin-up's own
 // continues the state bit for bit (its last row equals an uninterrupted run's, and its series
 // starts after the fork): the fork is a restart, not a new start.
-#include "common/child_process.h"
+#include "tests/app/run_magbrush.h"
 
 #include "tests/app/sweep_box_case.h"
 #include "tests/csv_columns.h"
@@ -19,26 +19,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Result
-{
-  int status;
-  std::string output;
-};
-
-Result run_magbrush(const fs::path &dir, const std::vector<std::string> &args)
-{
-  std::vector<std::string> command = {std::string(MAGBRUSH_BINARY_DIR) + "/bin/magbrush"};
-  command.insert(command.end(), args.begin(), args.end());
-  magbrush::ChildOutput output;
-  output.stdout_path = (dir / "log.txt").string();
-  output.stderr_to_stdout = true;
-  Result r{magbrush::run_program(command, output), {}};
-  std::ifstream in(dir / "log.txt");
-  std::ostringstream text;
-  text << in.rdbuf();
-  r.output = text.str();
-  return r;
-}
+using magbrush::testing::run_magbrush;
+using Result = magbrush::testing::CliRun;
 
 std::string last_line(const fs::path &file)
 {

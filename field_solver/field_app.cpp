@@ -110,10 +110,16 @@ PotentialProblemDescription::LinearSolver preferred_solver(MPI_Comm comm)
            : PotentialProblemDescription::LinearSolver::cg_amg;
 }
 
+// The backend and the solver that ran, as the log names them: "PETSc MUMPS (sparse direct)",
+// "Trilinos CG + ML AMG 57 iterations".
 std::string solver_summary(const SolveReport &r)
 {
-  return r.iterations <= 1 ? std::string("sparse direct solver")
-                           : "CG+AMG " + std::to_string(r.iterations) + " iterations";
+  const LinearAlgebraNames names = names_of(r.linear_algebra);
+  return std::string(names.backend) + " " +
+         (r.linear_solver == PotentialProblemDescription::LinearSolver::direct
+            ? std::string(names.direct_solver) + " (sparse direct)"
+            : std::string(names.iterative_solver) + " " + std::to_string(r.iterations) +
+                " iterations");
 }
 
 } // namespace

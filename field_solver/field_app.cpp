@@ -101,8 +101,10 @@ double ring_error_on(const RollerMagnetostatics::Profile &p, const Roller &rolle
 }
 
 // On one process the 2D systems are solved fastest and most robustly by a sparse direct
-// factorisation (field_bench: CG+AMG needs hundreds of iterations against the iron's μr and
-// the shell's anisotropy); in parallel CG + AMG scales.
+// factorisation: against the iron's μr and the shell's anisotropy CG needs over a hundred
+// iterations with Trilinos' ML, 20-30 with PETSc's BoomerAMG, and is slower than MUMPS with
+// either (the test LinearAlgebraBackends.* prints both on the default cases); in parallel
+// CG + AMG scales.
 PotentialProblemDescription::LinearSolver preferred_solver(MPI_Comm comm)
 {
   return dealii::Utilities::MPI::n_mpi_processes(comm) == 1

@@ -79,6 +79,7 @@ PotentialProblemDescription NipElectrostatics::describe() const
   d.degree = discretisation.degree;
   d.solver_tolerance = discretisation.solver_tolerance;
   d.linear_solver = discretisation.linear_solver;
+  d.linear_algebra = discretisation.linear_algebra;
   d.estimate_error = false; // the Kelly indicator only for the VTU (write_vtu)
   d.coefficient[nip_region::air] = eps0;
   d.coefficient[nip_region::photoconductor] = eps0 * layer_eps_r;

@@ -554,7 +554,7 @@ private:
     {
     case KeyType::quantity:
       v.written = node.Scalar();
-      v.number = parse_quantity(v.written, spec.dimension);
+      v.number = parse_quantity(v.written, spec.dimension, BareNumber::refused, typical_value(spec));
       check_range(spec, v.number, v.written);
       break;
     case KeyType::integer:
@@ -624,6 +624,28 @@ private:
     return v;
   }
 
+  // The scale a key's values usually have, for the unit suggested for a bare number: its
+  // default if non-zero, else the middle of a bounded positive range, else 0 (the dimension's
+  // usual scale).
+  static double typical_value(const KeySpec &spec)
+  {
+    if (spec.type == KeyType::quantity && !spec.default_text.empty() && spec.default_text[0] != '<')
+    {
+      try
+      {
+        const double d = parse_quantity(spec.default_text, spec.dimension, BareNumber::si);
+        if (d != 0.0)
+          return d;
+      }
+      catch (const UnitError &)
+      {
+      }
+    }
+    if (spec.min && spec.max && *spec.min > 0.0 && *spec.max > 0.0)
+      return std::sqrt(*spec.min * *spec.max);
+    return 0.0;
+  }
+
   static std::vector<double> point(const YAML::Node &node, size_t n, Dimension d, const std::string &what)
   {
     if (!node.IsSequence() || node.size() != n)
@@ -651,8 +673,6 @@ private:
     const std::string pretty = format_quantity(v, spec.dimension);
     if (spec.dimension != Dimension::dimensionless && spec.type == KeyType::quantity && pretty != written)
       message += " (= " + pretty + ")";
-    if (spec.dimension == Dimension::angle && written.find_first_not_of("0123456789.+-eE ") == std::string::npos)
-      message += "; a bare number is in radians: write e.g. '90 deg'";
     throw UnitError(message);
   }
 

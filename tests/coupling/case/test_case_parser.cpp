@@ -310,7 +310,7 @@ TEST(CaseParser, DefaultsAgreeWithTheContractStruct)
 
 TEST(CaseParser, OverridesUseTheSameConversionAndNames)
 {
-  const Case c = load_case(minimal, {"drum.gap=0.3mm", "roller.poles.S1.angle=95deg", "roller.poles.[0].strength=1.2e5",
+  const Case c = load_case(minimal, {"drum.gap=0.3mm", "roller.poles.S1.angle=95deg", "roller.poles.[0].strength=1.2e5 A/m",
                                      "sleeve.rpm=-2 rad/s", "electric.bias=-500 V"});
   EXPECT_NEAR(c.drum.gap, 0.3e-3, 1e-18);
   EXPECT_NEAR(c.roller->poles[1].angle, 95 * pi / 180, 1e-15);
@@ -320,6 +320,11 @@ TEST(CaseParser, OverridesUseTheSameConversionAndNames)
   EXPECT_DOUBLE_EQ(c.electric.bias, -500.0);
   // A later override wins.
   EXPECT_NEAR(load_case(minimal, {"drum.gap=1mm", "drum.gap=2mm"}).drum.gap, 2e-3, 1e-18);
+  // A bare number needs its unit in an override as in the file (0 excepted).
+  const std::string bare = error_of(read_file(minimal), {"drum.gap=0.3"});
+  EXPECT_NE(bare.find("--set 'drum.gap=0.3': drum.gap: 0.3 \u2014 a length needs a unit: 0.3 mm?"), std::string::npos)
+      << bare;
+  EXPECT_EQ(load_case(minimal, {"drum.pc_thickness=0"}).drum.pc_thickness, 0.0);
   // Errors name the override, not the file.
   const std::string e = error_of(read_file(minimal), {"roller.poles.S1.angle=-5deg"});
   EXPECT_NE(e.find("--set 'roller.poles.S1.angle=-5deg': roller.poles.S1.angle: expected an angle in [0 deg, 360 deg)"),

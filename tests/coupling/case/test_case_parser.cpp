@@ -389,6 +389,40 @@ TEST(CaseParser, GeometryNonsenseIsCaughtInProcess)
   EXPECT_NE(two.find("(2 errors)"), std::string::npos) << two;
 }
 
+// Every measurement's averaging window lies inside the run and holds more than one sample
+// interval (the developed image over its periods: at least one period of drum travel), or the
+// case is refused naming both keys and their values.
+TEST(CaseParser, AveragingWindowsLieInsideTheRun)
+{
+  const std::string fed = source_dir + "/cases/kawamoto_nip_fed.yaml";
+  const std::string late = error_of(read_file(fed), {"dem.duration=0.5ms"});
+  EXPECT_NE(late.find("nip.average_from: the averaging window of the nip profiles starts at or after the end of the "
+                      "run (nip.average_from = 25 ms, dem.duration = 500 us)"),
+            std::string::npos)
+      << late;
+  EXPECT_NE(late.find("flow_report.average_from"), std::string::npos) << late;
+  EXPECT_NO_THROW(load_case(fed, {"dem.duration=0.5ms", "nip.average_from=0s", "flow_report.average_from=0s"}));
+  const std::string short_window = error_of(read_file(fed), {"dem.duration=25.01ms"});
+  EXPECT_NE(short_window.find("shorter than one sample interval (flow_report.sample_interval = 20 us)"),
+            std::string::npos)
+      << short_window;
+  // The developed image over whole periods: 1 um of drum at ~0.27 m/s is ~3.7 us.
+  const std::string cell = source_dir + "/tests/scenes/development/development_cell.yaml";
+  const std::vector<std::string> periods{"development.average_over=image_periods", "electric.image.period=1um",
+                                         "dem.duration=10us", "nip.average_from=0s"};
+  auto with = [&](std::string o) {
+    auto v = periods;
+    v.push_back(std::move(o));
+    return v;
+  };
+  const std::string block = error_of(read_file(cell), with("development.average_from=9us"));
+  EXPECT_NE(block.find("shorter than one block of the developed image's means, one image period"), std::string::npos)
+      << block;
+  EXPECT_NO_THROW(load_case(cell, with("development.average_from=0s")));
+  // A measurement the scene does not have is not checked (no periodic slab: no nip measurement).
+  EXPECT_NO_THROW(load_case(minimal, {"dem.duration=1ms", "nip.average_from=5ms"}));
+}
+
 TEST(CaseParser, GeneratedBladePolygon)
 {
   const auto p = generated_blade_polygon(0.01, pi / 2, 0.5e-3, 1e-3, 5e-3);

@@ -421,9 +421,10 @@ UsualUnits usual_units(Dimension d)
 std::string bare_number_message(const std::string &number_text, double number, Dimension d, double typical_si)
 {
   const std::vector<std::string> units = likely_units(number, d, typical_si);
-  std::string message = shortened(number_text) + " \xE2\x80\x94 " + dimension_description(d) + " needs a unit: ";
+  const std::string written = shortened(number_text);
+  std::string message = written + " \xE2\x80\x94 " + dimension_description(d) + " needs a unit: ";
   for (size_t k = 0; k < units.size(); ++k)
-    message += (k ? " or " : "") + number_text + " " + units[k];
+    message += (k ? " or " : "") + written + " " + units[k];
   return message + "? (a bare number is not read as SI; only 0 may go without a unit)";
 }
 } // namespace

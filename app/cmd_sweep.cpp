@@ -22,6 +22,7 @@
 #include "app/subcommand.h"
 #include "app/sweep_ranks.h"
 #include "app/sweep_slurm.h"
+#include "app/sweep_spin_up.h"
 
 #include "coupling/case_hash.h"
 #include "coupling/case_parser.h"
@@ -124,6 +125,15 @@ run_time_s):
                        the sbatch line; edit the resource lines first.
   --point INDEX / --merge   the two steps by hand (a point's run time and status are kept in
                        its folder, <point>/sweep_point.csv).
+  --spin-up DURATION --settle DURATION
+                       build the scene once (the case at the --set values, to t = DURATION, in
+                       sweep_<NAME>/spin_up/; reused when it finished with the same case) and fork
+                       every point from its checkpoint (--restart --restart-anyway: the point's
+                       values act from the fork on). The points' averages (every measurement's
+                       average_from) start no earlier than DURATION + settle, when what the
+                       spin-up's values left in the scene has passed the measured region; without
+                       --settle the sweep says what the speeds give. Each point's sweep_point.csv
+                       names the spin-up it came from; dem.duration stays the points' end time.
   --resume             a point stopped before its end (a time limit, by hand, a crash) continues
                        from its own dem/checkpoint.bin, its files then covering the whole run;
                        one without a checkpoint starts afresh, a finished one only rewrites its
@@ -144,6 +154,8 @@ run_time_s):
                  {"--point", {}, "INDEX", "run only point INDEX (0-based, in the order of the table) and keep its\n"
                                           "result in its folder: one task of a job array; --merge builds the table"},
                  {"--merge", {}, "", "run nothing: the table, profiles and plots from the points' folders"},
+                 {"--spin-up", {}, "DURATION", "run the case once to t = DURATION and fork every point from its end"},
+                 {"--settle", {}, "DURATION", "with --spin-up: the points average from DURATION + settle on"},
                  {"--emit", {}, "slurm", "run nothing: write a Slurm job array (one task per point, --point) and its\n"
                                          "merge step (--merge) into the sweep's folder", false, {"slurm"}}};
     const auto of_stages = stage_options();
@@ -347,6 +359,7 @@ struct SweepPlan
   Case base;
   fs::path sweep_dir;
   std::vector<std::vector<std::size_t>> points; // per point: the index of its value of each --vary
+  std::optional<SweepSpinUp> spin_up;           // --spin-up: every point forks from it
 };
 
 SweepPlan plan_sweep(const cli::ParsedArguments &args)
@@ -376,6 +389,9 @@ SweepPlan plan_sweep(const cli::ParsedArguments &args)
       plan.name += (plan.name.empty() ? "" : "_") + v.key.substr(v.key.find_last_of('.') + 1);
   plan.sweep_dir = fs::path(plan.base.output.directory) / ("sweep_" + plan.name);
   plan.repeats = repeats_of(args);
+  if (args.has("--spin-up") && args.has("--restart"))
+    throw cli::UsageError("--spin-up gives every point its restart: do not also give --restart");
+  plan.spin_up = plan_spin_up(args.value("--spin-up"), args.value("--settle"), plan.base, plan.sweep_dir);
   if (plan.repeats > 1)
   {
     // The repeats are the last varied key, so that a point's repeats are neighbours in the
@@ -474,11 +490,14 @@ PointSetup set_up_point(const SweepPlan &plan, std::size_t n)
 constexpr const char *point_result_name = "sweep_point.csv";
 
 // `rank`: the MPI rank that ran it (0 without mpirun), for the record (not in the table).
-void write_point_result(const fs::path &dir, const std::string &run_time_cell, const std::string &status, int rank)
+// `spin_up`: the spin-up the point was forked from, recorded beside its result.
+void write_point_result(const fs::path &dir, const std::string &run_time_cell, const std::string &status, int rank,
+                        const std::optional<SweepSpinUp> &spin_up)
 {
   write_text_atomically((dir / point_result_name).string(),
-                        "# magbrush sweep: this point's run, for the sweep's table\nrun_time_s,status,rank\n" +
-                            run_time_cell + "," + status + "," + std::to_string(rank) + "\n");
+                        "# magbrush sweep: this point's run, for the sweep's table\nrun_time_s,status,rank" +
+                            spin_up_header_cells() + "\n" + run_time_cell + "," + status + "," +
+                            std::to_string(rank) + spin_up_cells(spin_up) + "\n");
 }
 
 // {run time cell, status}; {"nan", "missing"} when the point has not (or not yet) run.
@@ -546,7 +565,7 @@ int run_point(const SweepPlan &plan, std::size_t n, const cli::ParsedArguments &
     // A result of an earlier run must not stand for this one: the point says it is running
     // (and keeps saying so if it is stopped), with the time it had already spent when resumed.
     earlier = args.has("--resume") ? time_spent_before(point.dir) : 0.0;
-    write_point_result(point.dir, seconds_cell(earlier), "running", rank);
+    write_point_result(point.dir, seconds_cell(earlier), "running", rank, plan.spin_up);
     std::cout << "\n##### magbrush sweep: point " << n + 1 << "/" << plan.points.size() << ": " << point.label
               << " (" << (point.point_case.populations.empty() ? 0 : point.point_case.populations[0].count)
               << " beads) #####" << std::endl;
@@ -558,6 +577,13 @@ int run_point(const SweepPlan &plan, std::size_t n, const cli::ParsedArguments &
     }
     const auto stage_words = options_for_the_stages(args);
     run_args.insert(run_args.end(), stage_words.begin(), stage_words.end());
+    // A fork of the spin-up, unless it resumes its own checkpoint.
+    const bool resumes_itself = args.has("--resume") && fs::exists(point.dir / "dem" / "checkpoint.bin");
+    if (plan.spin_up && !resumes_itself)
+    {
+      const auto fork = fork_words(*plan.spin_up, point.point_case);
+      run_args.insert(run_args.end(), fork.begin(), fork.end());
+    }
     if (threads > 0 && !args.has("--threads"))
     {
       run_args.push_back("--threads");
@@ -574,7 +600,7 @@ int run_point(const SweepPlan &plan, std::size_t n, const cli::ParsedArguments &
   try
   {
     fs::create_directories(dir);
-    write_point_result(dir, seconds_cell(run_time), rc == 0 ? "ok" : "failed", rank);
+    write_point_result(dir, seconds_cell(run_time), rc == 0 ? "ok" : "failed", rank, plan.spin_up);
   }
   catch (const std::exception &e)
   {
@@ -582,6 +608,55 @@ int run_point(const SweepPlan &plan, std::size_t n, const cli::ParsedArguments &
     rc = rc == 0 ? 1 : rc;
   }
   return rc;
+}
+
+// The spin-up every point forks from (sweep_spin_up.h): the case at the sweep's --set values to
+// the fork, in its own folder, once; a spin-up that finished with the same case is reused, and
+// one stopped before its end continues from its checkpoint with --resume.
+int run_spin_up(const SweepPlan &plan, const cli::ParsedArguments &args, int threads)
+{
+  const SweepSpinUp &spin = *plan.spin_up;
+  if (spin_up_done(spin))
+  {
+    std::cout << "magbrush sweep: the spin-up in " << spin.dir.string() << "/ (to "
+              << spin.duration * 1e3 << " ms) is done: every point forks from it" << std::endl;
+    return 0;
+  }
+  const auto started = std::chrono::steady_clock::now();
+  std::vector<std::string> overrides = plan.overrides;
+  char duration[64];
+  std::snprintf(duration, sizeof duration, "dem.duration=%.9gs", spin.duration);
+  overrides.push_back(duration);
+  overrides.push_back("output.directory=" + spin.dir.string());
+  const Case spin_case = load_case(plan.case_path, overrides);
+  overrides.push_back("field.output_dir=" + (plan.sweep_dir / "fields" /
+                                             (field_hash(spin_case, FieldKind::magnetic) + "_" +
+                                              field_hash(spin_case, FieldKind::electric)))
+                                                .string());
+  std::cout << "\n##### magbrush sweep: the spin-up, to " << spin.duration * 1e3 << " ms, into " << spin.dir.string()
+            << "/ #####" << std::endl;
+  std::vector<std::string> run_args = {"run", plan.case_path, "--skip", plan.skip + ",report"};
+  for (const auto &o : overrides)
+  {
+    run_args.push_back("--set");
+    run_args.push_back(o);
+  }
+  const auto stage_words = options_for_the_stages(args);
+  run_args.insert(run_args.end(), stage_words.begin(), stage_words.end());
+  if (threads > 0 && !args.has("--threads"))
+  {
+    run_args.push_back("--threads");
+    run_args.push_back(std::to_string(threads));
+  }
+  fs::create_directories(spin.dir);
+  const int rc = run_pipeline(run_args);
+  if (rc != 0)
+  {
+    std::cerr << "magbrush sweep: the spin-up failed (exit " << rc << "): no point can fork from it\n";
+    return rc;
+  }
+  record_spin_up(spin, std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+  return 0;
 }
 
 // sweep_mean.csv: the repeats of each point (neighbours in the run table, the seed varied
@@ -838,12 +913,29 @@ int sweep(const cli::ParsedArguments &args)
   if (merge_only)
     return merge_points(plan);
   fs::create_directories(plan.sweep_dir);
+  if (plan.spin_up)
+    std::cout << "magbrush sweep: every point forks from a spin-up to " << plan.spin_up->duration * 1e3
+              << " ms and averages from " << plan.spin_up->averages_from() * 1e3 << " ms on.\n"
+              << settle_estimate(plan.base);
   if (one_point)
+  {
+    // A task of a job array: the first task to find no spin-up builds it (run one task, or a
+    // sweep with --spin-up and --point 0, before the others).
+    if (plan.spin_up && run_spin_up(plan, args, 0) != 0)
+      return 1;
     return run_point(plan, point_index(args, plan), args, 0, 0);
+  }
 
   // Every point, dealt to the ranks of an MPI job (one rank of one without mpirun).
   const SweepRanks ranks;
   const int threads = ranks.threads_per_rank();
+  if (plan.spin_up)
+  {
+    // Rank 0 builds it (with the node's cores when alone); the others wait for it.
+    const int spin_failed = ranks.rank() == 0 ? (run_spin_up(plan, args, ranks.distributed() ? 0 : threads) != 0) : 0;
+    if (ranks.sum_over_ranks(spin_failed) > 0)
+      return 1;
+  }
   if (ranks.rank() == 0)
     std::cout << "magbrush sweep: " << plan.points.size() << " points into " << plan.sweep_dir.string() << "/\n";
   if (ranks.distributed())

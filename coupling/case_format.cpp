@@ -314,6 +314,7 @@ std::vector<ResolvedEntry> resolved_entries(const Case &c)
   e.q("development.average_from", "development.average_from", c.development.average_from);
   e.s("development.average_over", "development.average_over", c.development.average_over);
   e.i("development.phase_bins", "development.phase_bins", c.development.phase_bins);
+  e.q("development.block_length", "development.block_length", c.development.block_length);
   e.q("dma.after_blade", "dma.after_blade", c.dma.after_blade);
   e.q("dma.window", "dma.window", c.dma.window);
   e.q("dma.height", "dma.height", c.dma.height);

@@ -22,9 +22,9 @@ std::vector<KeySpec> electric_keys()
           .affects(A::electric),
       quantity("electric.image.light_charge", D::surface_charge, "Surface charge of the exposed (image) areas.")
           .affects(A::electric),
-      quantity("electric.image.period", D::length, "Strip period along the drum surface (0 = uniform dark).")
+      quantity("electric.image.period", D::length, "Strip period along the drum surface (0 = uniform: dark, or exposed everywhere at duty 1).")
           .def("0 mm").non_negative().affects(A::electric),
-      number("electric.image.duty", "Exposed fraction of one period.").def("0.5").min(0.0).max(1.0).affects(A::electric),
+      number("electric.image.duty", "Exposed fraction of one period; 1 = a solid exposed area (a TMA patch), 0 = dark everywhere.").def("0.5").min(0.0).max(1.0).affects(A::electric),
       // Coulomb and the conductors' images (DEM only: dem/force_terms/coulomb, conductor_images).
       boolean("electric.coulomb",
               "Coulomb forces between the charged particles, without a cutoff, over the periodic images of the slab (on when some population is charged).")

@@ -37,11 +37,16 @@ std::vector<KeySpec> measurement_keys()
              "through the window: a development cell); image_periods: each drum element is counted once as it "
              "crosses measure_to, with the toner it carries then, and the means are over whole periods of the "
              "latent image (its blocks for the standard error and the steady-state test): a moving image's TMA "
-             "repeats with its period in any fixed window.")
+             "repeats with its period in any fixed window; on a uniform image the blocks are development.block_length.")
           .def("samples"),
       integer("development.phase_bins", "Bins per latent-image period of the developed profile "
                                         "(toner_developed_profile.csv; image_periods only).")
           .def("40").min(1).max(100000),
+      quantity("development.block_length", D::length,
+               "With image_periods on a uniform image (a solid area: electric.image.duty 1; or a dark drum), "
+               "which has no period: the drum length past measure_to that makes one block of the means "
+               "(0: the image period).")
+          .def("0 m").non_negative(),
 
       section("dma", "The developer on the sleeve after the doctor blade (a roller scene with a doctor blade): "
                      "developer mass per area (DMA) in a window past the blade and from the flux through it, the "

@@ -144,9 +144,15 @@ struct LatentImage
   enum class Kind { none, surface_charge, surface_potential } kind = Kind::none;
   double dark_value = 0.0;       // C/m² or V, in the unexposed (dark) areas
   double light_value = 0.0;      // C/m² or V, in the exposed (image) areas
-  double period = 0.0;           // strip period along the drum surface [m] (0 = uniform dark)
-  double duty = 0.5;             // exposed fraction of one period
+  double period = 0.0;           // strip period along the drum surface [m] (0 = uniform)
+  double duty = 0.5;             // exposed fraction of one period (1: a solid area, whatever the period)
   double edge_width = 0.0;       // width of the raised-cosine transition at each strip edge [m] (0 = sharp)
+
+  // A printer's TMA patch is a solid exposed area; a uniform image is the same everywhere on
+  // the drum, so its field does not move with the drum. Exposed everywhere at duty 1, dark
+  // everywhere at duty 0 or without a period; strips otherwise.
+  bool solid() const { return duty >= 1.0; }
+  bool striped() const { return period > 0.0 && duty > 0.0 && duty < 1.0; }
 };
 
 struct Electric
@@ -298,6 +304,9 @@ struct DevelopmentSettings
   // (dem/measurements/developed_line.h).
   std::string average_over = "samples";
   int phase_bins = 40; // bins of the developed profile per image period
+  // The drum length of one block of the developed line on a uniform image (solid or dark),
+  // which has no period to close its blocks [m]; 0: the image period.
+  double block_length = 0.0;
 };
 
 // The developer on the sleeve after the doctor blade (dem/measurements/developer_mass_per_area.h):

@@ -927,6 +927,7 @@ private:
     c.development.average_from = q(dv, "average_from");
     c.development.average_over = str(dv, "average_over");
     c.development.phase_bins = static_cast<int>(integer(dv, "phase_bins"));
+    c.development.block_length = q(dv, "block_length");
     const Scope dm = top.child("dma");
     c.dma.after_blade = q(dm, "after_blade");
     c.dma.window = q(dm, "window");

@@ -452,9 +452,15 @@ void check_measurements(const Case &c, std::vector<CaseIssue> &out)
   if (c.development.measure_to <= c.development.measure_from)
     out.push_back({"development.measure_to", "the measuring window ends at " + L(c.development.measure_to) +
                                                  ", not downstream of its start " + L(c.development.measure_from)});
-  if (c.development.average_over == "image_periods" && !(c.electric.image.period > 0.0))
-    out.push_back({"development.average_over", "image_periods needs a latent image with a period "
-                                               "(electric.image.period > 0)"});
+  const LatentImage &image = c.electric.image;
+  if (c.development.average_over == "image_periods" && !image.striped() && !(c.development.block_length > 0.0))
+    out.push_back({"development.average_over",
+                   std::string("image_periods on a uniform image (") + (image.solid() ? "solid: duty 1" : "dark") +
+                       ") needs the drum length of a block: set development.block_length, or strips "
+                       "(electric.image.period > 0 and 0 < duty < 1)"});
+  if (c.development.block_length > 0.0 && image.striped())
+    out.push_back({"development.block_length", "the blocks of a striped image are its periods (electric.image.period); "
+                                               "block_length is for a uniform image (duty 1 or 0)"});
 }
 
 } // namespace

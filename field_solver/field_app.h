@@ -30,5 +30,8 @@ bool compute_electric_field(const Case &c, const FieldRunOptions &options, MPI_C
 // Element counts derived from the case's mesh sizes (see the .cpp for the rule).
 struct RollerDiscretisation;
 RollerDiscretisation roller_discretisation(const Case &c);
+struct NipDiscretisation;
+struct NipLayout;
+NipDiscretisation nip_discretisation(const Case &c, const NipLayout &layout);
 
 } // namespace magbrush::field

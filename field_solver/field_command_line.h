@@ -5,6 +5,7 @@
 #pragma once
 
 #include "common/command_line.h"
+#include "field_solver/linear_algebra.h"
 
 #include <string>
 
@@ -23,7 +24,11 @@ inline cli::CommandSpec solver_command_line(const std::string &program)
       "            and probe flux profiles (CSV), VTU for ParaView\n"
       "  electric  the nip potential on a window over the nip, VTU\n"
       "A stored field whose case hash still matches is reused (\"up to date\"); only the field whose\n"
-      "inputs changed is recomputed.\n";
+      "inputs changed is recomputed.\n"
+      "Linear algebra: " + std::string(names_of(LA).backend) +
+      ", chosen when building (cmake -DMAGBRUSH_LINEAR_ALGEBRA=PETSc|Trilinos):\n"
+      "  on one process the sparse direct solver " + names_of(LA).direct_solver +
+      ", in parallel " + names_of(LA).iterative_solver + ".\n";
   spec.positionals = {{"CASE", "the case file"}};
   spec.options = {
       cli::set_option(),

@@ -20,14 +20,12 @@ double wrap(double a)
 
 double latent_image_value(const LatentImage &image, double s)
 {
-  if (image.period <= 0.0)
+  if (image.solid())
+    return image.light_value; // a solid area, whatever the period
+  if (!image.striped())
     return image.dark_value;
   // s' ∈ [−P/2, P/2): the place within the period; e: the distance inside the exposed strip
   // from its nearer edge (negative outside it).
-  if (image.duty >= 1.0)
-    return image.light_value;
-  if (image.duty <= 0.0)
-    return image.dark_value;
   const double P = image.period;
   const double v = s / P + 0.5;
   const double s_local = (v - std::floor(v) - 0.5) * P;
@@ -81,6 +79,7 @@ PotentialProblemDescription NipElectrostatics::describe() const
   d.degree = discretisation.degree;
   d.solver_tolerance = discretisation.solver_tolerance;
   d.linear_solver = discretisation.linear_solver;
+  d.linear_algebra = discretisation.linear_algebra;
   d.estimate_error = false; // the Kelly indicator only for the VTU (write_vtu)
   d.coefficient[nip_region::air] = eps0;
   d.coefficient[nip_region::photoconductor] = eps0 * layer_eps_r;

@@ -28,6 +28,7 @@ struct NipDiscretisation
   double solver_tolerance = 1e-12;
   PotentialProblemDescription::LinearSolver linear_solver =
     PotentialProblemDescription::LinearSolver::cg_amg;
+  LinearAlgebraBackend linear_algebra = LA; // the configured backend (linear_algebra.h)
 };
 
 // The latent image along the drum surface as a function of the arc length s from the nip

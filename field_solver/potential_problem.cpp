@@ -8,11 +8,8 @@
 #include <deal.II/fe/fe_values.h>
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
 #include <deal.II/lac/full_matrix.h>
-#include <deal.II/lac/solver_cg.h>
 #include <deal.II/lac/solver_control.h>
 #include <deal.II/lac/sparsity_tools.h>
-#include <deal.II/lac/trilinos_precondition.h>
-#include <deal.II/lac/trilinos_solver.h>
 #include <deal.II/numerics/data_out.h>
 #include <deal.II/numerics/data_postprocessor.h>
 #include <deal.II/numerics/error_estimator.h>
@@ -24,6 +21,8 @@
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+#include <type_traits>
+#include <variant>
 
 namespace magbrush::field {
 
@@ -34,6 +33,21 @@ namespace {
 double seconds_since(std::chrono::steady_clock::time_point start)
 {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Calls f with the linear system that setup_system made, in whichever backend it is: the code
+// in f is written once and compiled for both.
+template <class LinearSystemVariant, class F>
+void with_system(LinearSystemVariant &system, F &&f)
+{
+  std::visit(
+    [&](auto &s) {
+      if constexpr (std::is_same_v<std::decay_t<decltype(s)>, std::monostate>)
+        throw std::logic_error("PotentialProblem: setup_system() must come first");
+      else
+        f(s);
+    },
+    system);
 }
 
 std::string point_string(const Point<2> &p)
@@ -169,10 +183,18 @@ void PotentialProblem::setup_system()
   DoFTools::make_sparsity_pattern(dofs, dsp, constraints, false);
   SparsityTools::distribute_sparsity_pattern(dsp, locally_owned_dofs, mpi_communicator,
                                              locally_relevant_dofs);
-  system_matrix.reinit(locally_owned_dofs, locally_owned_dofs, dsp, mpi_communicator);
-  system_rhs.reinit(locally_owned_dofs, mpi_communicator);
+  if (description.linear_algebra == LinearAlgebraBackend::petsc)
+    linear_system.emplace<LinearSystem<LinearAlgebraBackend::petsc>>();
+  else
+    linear_system.emplace<LinearSystem<LinearAlgebraBackend::trilinos>>();
+  with_system(linear_system, [&](auto &system) {
+    system.matrix.reinit(locally_owned_dofs, locally_owned_dofs, dsp, mpi_communicator);
+    system.rhs.reinit(locally_owned_dofs, mpi_communicator);
+  });
   ghosted_solution.reinit(locally_owned_dofs, locally_relevant_dofs, mpi_communicator);
 
+  solve_report.linear_algebra = description.linear_algebra;
+  solve_report.linear_solver = description.linear_solver;
   solve_report.n_dofs = dofs.n_dofs();
   solve_report.n_cells = triangulation.n_active_cells();
   solve_report.setup_seconds = seconds_since(start);
@@ -209,38 +231,40 @@ void PotentialProblem::assemble_system()
   Vector<double> cell_rhs(n);
   std::vector<types::global_dof_index> local_dof_indices(n);
 
-  system_matrix = 0;
-  system_rhs = 0;
-  for (const auto &cell : dofs.active_cell_iterators())
-  {
-    if (!cell->is_locally_owned())
-      continue;
-    cell_matrix = 0;
-    cell_rhs = 0;
-    fe_values.reinit(cell);
-    const MaterialId material = cell->material_id();
-    for (const unsigned int q : fe_values.quadrature_point_indices())
+  with_system(linear_system, [&](auto &system) {
+    system.matrix = 0;
+    system.rhs = 0;
+    for (const auto &cell : dofs.active_cell_iterators())
     {
-      const Point<2> &x = fe_values.quadrature_point(q);
-      const Tensor<2, 2> K = coefficient_at(x, material);
-      const Tensor<1, 2> s =
-        description.vector_source ? description.vector_source(x, material) : Tensor<1, 2>();
-      const double JxW = fe_values.JxW(q);
-      for (unsigned int i = 0; i < n; ++i)
+      if (!cell->is_locally_owned())
+        continue;
+      cell_matrix = 0;
+      cell_rhs = 0;
+      fe_values.reinit(cell);
+      const MaterialId material = cell->material_id();
+      for (const unsigned int q : fe_values.quadrature_point_indices())
       {
-        const Tensor<1, 2> K_grad_i = K * fe_values.shape_grad(i, q);
-        for (unsigned int j = 0; j < n; ++j)
-          cell_matrix(i, j) += K_grad_i * fe_values.shape_grad(j, q) * JxW;
-        cell_rhs(i) += s * fe_values.shape_grad(i, q) * JxW;
+        const Point<2> &x = fe_values.quadrature_point(q);
+        const Tensor<2, 2> K = coefficient_at(x, material);
+        const Tensor<1, 2> s =
+          description.vector_source ? description.vector_source(x, material) : Tensor<1, 2>();
+        const double JxW = fe_values.JxW(q);
+        for (unsigned int i = 0; i < n; ++i)
+        {
+          const Tensor<1, 2> K_grad_i = K * fe_values.shape_grad(i, q);
+          for (unsigned int j = 0; j < n; ++j)
+            cell_matrix(i, j) += K_grad_i * fe_values.shape_grad(j, q) * JxW;
+          cell_rhs(i) += s * fe_values.shape_grad(i, q) * JxW;
+        }
       }
+      assemble_surface_charges(cell, cell_rhs);
+      cell->get_dof_indices(local_dof_indices);
+      constraints.distribute_local_to_global(cell_matrix, cell_rhs, local_dof_indices,
+                                             system.matrix, system.rhs);
     }
-    assemble_surface_charges(cell, cell_rhs);
-    cell->get_dof_indices(local_dof_indices);
-    constraints.distribute_local_to_global(cell_matrix, cell_rhs, local_dof_indices,
-                                           system_matrix, system_rhs);
-  }
-  system_matrix.compress(VectorOperation::add);
-  system_rhs.compress(VectorOperation::add);
+    system.matrix.compress(VectorOperation::add);
+    system.rhs.compress(VectorOperation::add);
+  });
   solve_report.assemble_seconds = seconds_since(start);
 }
 
@@ -274,73 +298,72 @@ void PotentialProblem::assemble_surface_charges(const DoFHandler<2>::active_cell
   }
 }
 
-// CG with algebraic multigrid (the operator is symmetric positive definite). Failure to
-// converge is reported with what was reached and what to change.
+// MUMPS, or CG with algebraic multigrid (the operator is symmetric positive definite), in the
+// backend of the system (linear_system.h). Failure is reported with what was reached and what
+// to change. The solution, its constraints distributed, is copied into deal.II's own ghosted
+// vector, from which everything after the solve reads.
 void PotentialProblem::solve()
 {
   const auto start = std::chrono::steady_clock::now();
-  TrilinosWrappers::MPI::Vector distributed_solution(locally_owned_dofs, mpi_communicator);
-  const double rhs_norm = system_rhs.l2_norm();
-  if (rhs_norm == 0.0)
-  {
-    distributed_solution = 0;
-    solve_report.iterations = 0;
-    solve_report.residual = 0.0;
-  }
-  else if (description.linear_solver == PotentialProblemDescription::LinearSolver::direct)
-  {
-    SolverControl control(1, 0.0, false, false);
-    // MUMPS (nested-dissection ordering, BLAS kernels) is several times faster than the
-    // default KLU on finite-element matrices.
-    TrilinosWrappers::SolverDirect direct(
-      control, TrilinosWrappers::SolverDirect::AdditionalData(false, "Amesos_Mumps"));
-    direct.solve(system_matrix, distributed_solution, system_rhs);
-    // the residual of the factorised solve, for the report
-    TrilinosWrappers::MPI::Vector residual(locally_owned_dofs, mpi_communicator);
-    system_matrix.vmult(residual, distributed_solution);
-    residual -= system_rhs;
-    solve_report.iterations = 1;
-    solve_report.residual = residual.l2_norm();
-    if (!(solve_report.residual <= 1e-8 * rhs_norm))
-      throw std::runtime_error(
-        description.name + ": the direct solver's residual " +
-        std::to_string(solve_report.residual) + " is not small against the right-hand side " +
-        std::to_string(rhs_norm) + "; the system is singular or badly scaled (check that "
-        "every region touches a Dirichlet boundary or is coupled to one)");
-  }
-  else
-  {
-    TrilinosWrappers::PreconditionAMG amg;
-    TrilinosWrappers::PreconditionAMG::AdditionalData amg_data;
-    amg_data.elliptic = true;
-    amg_data.higher_order_elements = fe.degree > 1;
-    amg_data.smoother_sweeps = 2;
-    amg_data.aggregation_threshold = 0.02;
-    amg.initialize(system_matrix, amg_data);
-
-    SolverControl control(description.max_iterations, description.solver_tolerance * rhs_norm,
-                          false, false);
-    SolverCG<TrilinosWrappers::MPI::Vector> cg(control);
-    try
+  const LinearAlgebraNames names = names_of(description.linear_algebra);
+  with_system(linear_system, [&](const auto &system) {
+    using BackendVector = typename std::decay_t<decltype(system)>::Vector;
+    BackendVector distributed_solution(locally_owned_dofs, mpi_communicator);
+    const double rhs_norm = system.rhs.l2_norm();
+    if (rhs_norm == 0.0)
     {
-      cg.solve(system_matrix, distributed_solution, system_rhs, amg);
+      distributed_solution = 0;
+      solve_report.iterations = 0;
+      solve_report.residual = 0.0;
     }
-    catch (const SolverControl::NoConvergence &e)
+    else if (description.linear_solver == PotentialProblemDescription::LinearSolver::direct)
     {
-      std::ostringstream msg;
-      msg << description.name << ": the linear solver (CG + AMG) did not converge: after "
-          << e.last_step << " iterations the residual is " << e.last_residual
-          << " (relative " << e.last_residual / rhs_norm << ", wanted "
-          << description.solver_tolerance << ", " << solve_report.n_dofs
-          << " unknowns). Check that every region has a sensible μr/εr (very large contrasts "
-             "slow AMG down), that the mesh has no sliver cells, or raise the iteration limit.";
-      throw std::runtime_error(msg.str());
+      system.solve_direct(distributed_solution);
+      // the residual of the factorised solve, for the report
+      BackendVector residual(locally_owned_dofs, mpi_communicator);
+      system.matrix.vmult(residual, distributed_solution);
+      residual -= system.rhs;
+      solve_report.iterations = 1;
+      solve_report.residual = residual.l2_norm();
+      if (!(solve_report.residual <= 1e-8 * rhs_norm))
+        throw std::runtime_error(
+          description.name + ": the direct solver's (" + names.backend + " " +
+          names.direct_solver + ") residual " + std::to_string(solve_report.residual) +
+          " is not small against the right-hand side " + std::to_string(rhs_norm) +
+          "; the system is singular or badly scaled (check that every region touches a "
+          "Dirichlet boundary or is coupled to one)");
     }
-    solve_report.iterations = control.last_step();
-    solve_report.residual = control.last_value();
-  }
-  constraints.distribute(distributed_solution);
-  ghosted_solution = distributed_solution;
+    else
+    {
+      SolverControl control(description.max_iterations,
+                            description.solver_tolerance * rhs_norm, false, false);
+      try
+      {
+        system.solve_cg_amg(distributed_solution, control, fe.degree);
+      }
+      catch (const SolverControl::NoConvergence &e)
+      {
+        std::ostringstream msg;
+        msg << description.name << ": the linear solver (" << names.backend << " "
+            << names.iterative_solver << ") did not converge: after " << e.last_step
+            << " iterations the residual is " << e.last_residual << " (relative "
+            << e.last_residual / rhs_norm << ", wanted " << description.solver_tolerance
+            << ", " << solve_report.n_dofs
+            << " unknowns). Check that every region has a sensible μr/εr (very large "
+               "contrasts slow AMG down), that the mesh has no sliver cells, or raise the "
+               "iteration limit.";
+        throw std::runtime_error(msg.str());
+      }
+      solve_report.iterations = control.last_step();
+      solve_report.residual = control.last_value();
+    }
+    constraints.distribute(distributed_solution);
+    std::vector<types::global_dof_index> owned;
+    locally_owned_dofs.fill_index_vector(owned);
+    distributed_solution.extract_subvector_to(owned.begin(), owned.end(),
+                                              ghosted_solution.begin());
+  });
+  ghosted_solution.update_ghost_values();
   solve_report.solve_seconds = seconds_since(start);
 }
 

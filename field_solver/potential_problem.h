@@ -14,9 +14,13 @@
 //
 // run() reads like the algorithm (deal.II step-40): setup → assemble → solve → estimate.
 // Parallel: the triangulation is a parallel::shared::Triangulation partitioned by METIS; the
-// linear system is a Trilinos matrix solved by CG with algebraic multigrid.
+// linear system is a matrix of the configured backend (linear_algebra.h: PETSc or Trilinos),
+// solved by MUMPS or by CG with algebraic multigrid (linear_system.h). The solution is kept in
+// deal.II's own distributed vector, so evaluation and output never depend on the backend.
 #pragma once
 
+#include "field_solver/linear_algebra.h"
+#include "field_solver/linear_system.h"
 #include "field_solver/shell_transformation.h"
 
 #include <deal.II/base/index_set.h>
@@ -28,13 +32,13 @@
 #include <deal.II/fe/mapping_q.h>
 #include <deal.II/fe/mapping_q_cache.h>
 #include <deal.II/lac/affine_constraints.h>
-#include <deal.II/lac/trilinos_sparse_matrix.h>
-#include <deal.II/lac/trilinos_vector.h>
+#include <deal.II/lac/la_parallel_vector.h>
 
 #include <functional>
 #include <map>
 #include <optional>
 #include <string>
+#include <variant>
 #include <vector>
 
 namespace magbrush::field {
@@ -83,15 +87,21 @@ struct PotentialProblemDescription
   double solver_tolerance = 1e-12;                 // relative residual of CG
   unsigned int max_iterations = 5000;
   // CG + algebraic multigrid (scales to large and parallel problems), or a sparse direct
-  // factorisation (Amesos KLU: robust against the μr contrast and the shell's anisotropy,
-  // and in 2D faster than AMG up to a few 10^5 unknowns).
+  // factorisation (MUMPS: robust against the μr contrast and the shell's anisotropy, and in
+  // 2D faster than AMG up to a few 10^5 unknowns).
   enum class LinearSolver { cg_amg, direct } linear_solver = LinearSolver::cg_amg;
+  // The backend the system is assembled and solved in: the configured one; only the test
+  // that compares the backends asks for the other.
+  LinearAlgebraBackend linear_algebra = LA;
   bool estimate_error = true; // run() ends with the Kelly indicator (estimate())
 };
 
 // What the solver did, for logs and for the error messages when it fails.
 struct SolveReport
 {
+  LinearAlgebraBackend linear_algebra = LA;
+  PotentialProblemDescription::LinearSolver linear_solver =
+    PotentialProblemDescription::LinearSolver::cg_amg;
   dealii::types::global_dof_index n_dofs = 0;
   unsigned int n_cells = 0;
   unsigned int iterations = 0;
@@ -132,7 +142,6 @@ public:
   const SolveReport &report() const { return solve_report; }
   const dealii::DoFHandler<2> &dof_handler() const { return dofs; }
   const dealii::Mapping<2> &mapping() const { return curved_mapping; }
-  const dealii::TrilinosWrappers::MPI::Vector &solution() const { return ghosted_solution; }
   MPI_Comm communicator() const { return mpi_communicator; }
 
 private:
@@ -155,9 +164,11 @@ private:
   dealii::IndexSet locally_relevant_dofs;
   dealii::AffineConstraints<double> constraints;
 
-  dealii::TrilinosWrappers::SparseMatrix system_matrix;
-  dealii::TrilinosWrappers::MPI::Vector system_rhs;
-  dealii::TrilinosWrappers::MPI::Vector ghosted_solution;
+  // Empty until setup_system makes the system of description.linear_algebra.
+  std::variant<std::monostate, LinearSystem<LinearAlgebraBackend::petsc>,
+               LinearSystem<LinearAlgebraBackend::trilinos>>
+    linear_system;
+  dealii::LinearAlgebra::distributed::Vector<double> ghosted_solution;
   dealii::Vector<float> error_indicator;
 
   SolveReport solve_report;

@@ -200,6 +200,7 @@ PotentialProblemDescription RollerMagnetostatics::describe() const
   d.degree = discretisation.degree;
   d.solver_tolerance = discretisation.solver_tolerance;
   d.linear_solver = discretisation.linear_solver;
+  d.linear_algebra = discretisation.linear_algebra;
   d.estimate_error = false; // the Kelly indicator only for the VTU (write_vtu)
   MaterialId magnet_region = roller_region::magnet;
   if (mesh_file)

@@ -53,6 +53,7 @@ struct RollerDiscretisation
   double solver_tolerance = 1e-12;
   PotentialProblemDescription::LinearSolver linear_solver =
     PotentialProblemDescription::LinearSolver::cg_amg;
+  LinearAlgebraBackend linear_algebra = LA; // the configured backend (linear_algebra.h)
 };
 
 // The Gmsh roller mesh (geometry/mesh_roller.h) and what the solver needs to know about it.

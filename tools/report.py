@@ -266,6 +266,7 @@ def nip_plots(plt, profile, out, relative_speed):
         [("normal", [v / 1e3 for v in profile["normal_pressure_Pa"]], "o-"),
          ("tangential", [v / 1e3 for v in profile["tangential_pressure_Pa"]], "s-")],
         "Normal and tangential pressure on the drum (cf. Fig. 18)")
+    written.append(mirrored_pressure_plot(plt, profile, out))
     one("nip_ratio.png", "tangential / normal", [("tangential / normal pressure", profile["tangential_over_normal"], "o-")],
         "Ratio of tangential to normal pressure", 0.35, "bead-drum friction coefficient 0.35")
     one("nip_density.png", "touching beads [1/mm²]", [("beads touching the drum", profile["density_per_mm2"], "o-")],
@@ -274,6 +275,27 @@ def nip_plots(plt, profile, out, relative_speed):
         [("mean normal force per bead", [v * 1e6 for v in profile["normal_force_per_bead_N"]], "o-")],
         "Differential force: normal force per touching bead (cf. Fig. 20)")
     return written
+
+
+def mirrored_pressure_plot(plt, profile, out):
+    """The normal pressure and the touching density against the distance from the gap centre,
+    the upstream half folded onto the downstream one: a symmetric nip draws one curve twice."""
+    x = profile["x_mm"]
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+    for ax, key, scale, label in ((axes[0], "normal_pressure_Pa", 1e-3, "normal pressure [kPa]"),
+                                  (axes[1], "density_per_mm2", 1.0, "touching beads [1/mm²]")):
+        up = [(-xi, v * scale) for xi, v in zip(x, profile[key]) if xi <= 0]
+        down = [(xi, v * scale) for xi, v in zip(x, profile[key]) if xi >= 0]
+        ax.plot([a for a, _ in up], [b for _, b in up], "o-", label="before the centre (x < 0), mirrored")
+        ax.plot([a for a, _ in down], [b for _, b in down], "s-", label="after the centre (x > 0)")
+        ax.set_xlabel("|x| from the gap centre [mm]")
+        ax.set_ylabel(label)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle("The nip folded about the gap centre (Kawamoto: almost symmetric)")
+    save(fig, os.path.join(out, "nip_pressure_mirrored.png"))
+    plt.close(fig)
+    return "nip_pressure_mirrored.png"
 
 
 def chain_plot(plt, chains, flux, out):
@@ -540,6 +562,42 @@ def developed_profile_plot(plt, dem_dir, out):
 # ------------------------------------------------------------------------------------------
 # Key numbers and the index
 
+def symmetry_rows(run_summary):
+    """How symmetric the nip is about the gap centre (dem/measurements/nip_asymmetry.h), with the
+    standard errors of dem/summary.csv: the pressure's centroid against its spread, and the
+    pressure and the touching beads before the centre over after it (Kawamoto: almost symmetric,
+    the touching density slightly higher at the outlet)."""
+    by_key = {r["key"]: r for r in run_summary or []}
+
+    def get(key):
+        r = by_key.get(key)
+        if r is None:
+            return float("nan"), float("nan")
+        try:
+            return float(r["value"]), float(r["standard_error"])
+        except ValueError:
+            return float("nan"), float("nan")
+
+    c, c_se = get("pressure_centroid_m")
+    w, w_se = get("pressure_spread_m")
+    if not math.isfinite(c):
+        return []
+    p, p_se = get("pressure_upstream_over_downstream")
+    t, t_se = get("touching_upstream_over_downstream")
+    tc, tc_se = get("touching_centroid_m")
+    side = "upstream" if c < 0 else "downstream"
+    return [
+        ("normal pressure: centroid / spread", f"{fmt(c * 1e3, 3)} ± {fmt(c_se * 1e3, 2)} mm / "
+         f"{fmt(w * 1e3, 3)} ± {fmt(w_se * 1e3, 2)} mm",
+         "Kawamoto: almost symmetric about the gap centre (centroid ≈ 0)",
+         f"centroid {fmt(abs(c) / w if w else float('nan'), 2)} × the spread, {side}"),
+        ("normal pressure before / after the gap centre", f"{fmt(p, 3)} ± {fmt(p_se, 2)}", "1: symmetric", ""),
+        ("touching beads: centroid; before / after the centre",
+         f"{fmt(tc * 1e3, 3)} ± {fmt(tc_se * 1e3, 2)} mm; {fmt(t, 3)} ± {fmt(t_se, 2)}",
+         "Kawamoto: almost symmetric, slightly more at the outlet (ratio < 1)", ""),
+    ]
+
+
 def key_numbers(summary, nip_series, series, flux, run_summary=None, flow=None):
     """[(what, value, reference, verdict)] for the summary table."""
     rows = steady_state_rows(run_summary, supplied=flow is not None)
@@ -578,6 +636,7 @@ def key_numbers(summary, nip_series, series, flux, run_summary=None, flow=None):
                      f"B²/2μ0 = {fmt(pm / 1e3)} kPa at B = {fmt(b * 1e3)} mT (gap centre)",
                      f"{fmt(peak / pm if pm else float('nan'), 3)} × B²/2μ0"))
         rows.append(("normal pressure at the gap centre", f"{fmt(val('normal_pressure_at_gap_centre') / 1e3)} kPa", "", ""))
+        rows += symmetry_rows(run_summary)
         rows.append(("tangential / normal (whole nip)", fmt(val("tangential_over_normal"), 3),
                      "bead-drum friction coefficient 0.35 (Kawamoto: ≈ 0.35)", ""))
         rows.append(("touching-bead density at the gap centre", f"{fmt(val('density_at_gap_centre'))} /mm²",

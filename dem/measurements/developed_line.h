@@ -41,8 +41,9 @@ struct LineToner
 class DevelopedLine
 {
 public:
-  // `image` must have a period; `phase_bins` bins per period for the profile.
-  DevelopedLine(const DrumImage &image, double slab_depth, int phase_bins);
+  // The blocks are the image's periods; a uniform image (a solid area or a dark drum) has none,
+  // and `block_length` [m] gives them. `phase_bins` bins per block for the profile.
+  DevelopedLine(const DrumImage &image, double slab_depth, int phase_bins, double block_length = 0.0);
 
   // One sample at `time`: `s_line` the drum-frame arc at the line now, `on_drum` the toner on the
   // drum's layer, sorted by id. The interval since the previous sample is counted when both
@@ -53,12 +54,16 @@ public:
   struct Period
   {
     double t_start = 0, t_end = 0;         // when its first and last element crossed [s]
+    double s_start = 0;                    // the drum arc of its first element [m]
     double image_mass = 0, image_area = 0; // [kg], [m²]
     double image_charge = 0;               // [C]
     double dark_mass = 0, dark_area = 0;
     long image_toner = 0, dark_toner = 0;
   };
   const std::vector<Period> &periods() const { return periods_; }
+  // A uniform image's block by its place on the drum: blocks of two lines with the same index
+  // hold the same drum elements (the grid is fixed to the drum; align_to_grid).
+  long grid_index(const Period &p) const;
   // The arc swept so far into the period not yet closed [m].
   double open_period_length() const { return swept_; }
 
@@ -70,8 +75,10 @@ public:
     long toner = 0;
   };
   const std::vector<Bin> &profile() const { return profile_; }
-  // The bin's centre measured from the exposed strip's centre [m] (exposed: |position| < duty·period/2).
+  // The bin's centre measured from the exposed strip's centre [m] (exposed: |position| < duty·period/2);
+  // on a uniform image from the block's start.
   double bin_position(int k) const;
+  double block_length() const { return block_; } // [m]
 
   std::string periods_csv() const;
   std::string profile_csv() const;
@@ -82,11 +89,16 @@ private:
   // Count the elements of the swept sub-interval [from, to] (positions along the sweep from
   // s_previous_) and the toner among `candidates` that lies in it.
   void count_segment(double from, double to, bool last, const std::vector<LineToner> &candidates);
-  void close_period(double time);
+  void close_period(double time, double s_cut);
+  void align_to_grid();
+  // Where s lies in its block, in [0, 1): the image's phase on strips.
+  double phase(double s) const;
 
   DrumImage image_;
   double depth_;
   int bins_;
+  double block_;        // the image period, or the block length of a uniform image [m]
+  double phase_offset_; // duty/2 on strips (a strip's centre at the block's duty/2), else 0
   // The sweep: the line's arc at the previous sample, its direction along s (+1 or −1, 0: not
   // known yet) and its time.
   bool has_previous_ = false, previous_counting_ = false;
@@ -95,6 +107,7 @@ private:
   // The open period.
   Period open_;
   bool open_started_ = false;
+  bool open_partial_ = false; // the open block began off the grid: swept, not kept
   double swept_ = 0;
   std::vector<Bin> open_bins_, profile_;
   std::vector<Period> periods_;

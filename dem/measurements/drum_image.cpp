@@ -18,7 +18,7 @@ double exposed_cumulative(double u, double duty)
 } // namespace
 
 DrumImage::DrumImage(const LatentImage &image, const NipFrame &frame)
-  : period_(image.period), duty_(image.duty), frame_(frame),
+  : period_(image.striped() ? image.period : 0.0), duty_(image.duty), solid_(image.solid()), frame_(frame),
     nip_angle_(std::atan2(frame.sy - frame.cy, frame.sx - frame.cx))
 {
 }
@@ -41,7 +41,7 @@ double DrumImage::drum_arc_at_x(double x, double t) const
 bool DrumImage::exposed(double s) const
 {
   if (period_ <= 0.0)
-    return false; // no period: uniformly dark, as in the field stage
+    return solid_; // uniform, as in the field stage: a solid area or dark
   return phase(s) < duty_;
 }
 
@@ -56,7 +56,7 @@ double DrumImage::phase(double s) const
 double DrumImage::exposed_length(double a, double b) const
 {
   if (period_ <= 0.0)
-    return 0.0;
+    return solid_ ? b - a : 0.0;
   return period_ * (exposed_cumulative(b / period_ + 0.5 * duty_, duty_) -
                     exposed_cumulative(a / period_ + 0.5 * duty_, duty_));
 }

@@ -144,12 +144,14 @@ void NipProfile::add_sample(double time, const std::vector<DrumContact> &contact
   ++samples_;
   double fn = 0.0, ft = 0.0, centre_slip = 0.0, centre_chain = 0.0;
   long touching = 0, centre = 0;
+  asymmetry_.start_sample();
   for (const auto &c : contacts)
   {
     const DrumContactInFrame r = resolve_drum_contact(frame_, c);
     const int b = bin_of(r.x);
     if (b < 0)
       continue;
+    asymmetry_.add_contact(r.x, r.normal);
     const auto k = static_cast<std::size_t>(b);
     fn_[k] += r.normal;
     ft_[k] += r.tangential;
@@ -168,6 +170,7 @@ void NipProfile::add_sample(double time, const std::vector<DrumContact> &contact
     if (b == bins_half_)
       centre_slip += r.slip, centre_chain += r.chain_speed, ++centre;
   }
+  asymmetry_.end_sample();
   normal_force_.add(fn / frame_.slab_depth);
   tangential_force_.add(ft / frame_.slab_depth);
   touching_.add(static_cast<double>(touching));
@@ -347,6 +350,14 @@ std::string NipProfile::summary_csv() const
   row("density_at_gap_centre", centre.density * 1e-6, "1/mm^2", "touching beads per drum area, centre bin");
   row("gap_centre_field", gap_field_, "T", "|B| of the applied field at the gap centre");
   row("magnetic_pressure", gap_field_ * gap_field_ / (2.0 * mu0), "Pa", "B^2/2mu0 at the gap centre");
+  // How symmetric about the gap centre (standard errors in summary.csv).
+  for (const SummaryValue &v : asymmetry_.summary(static_cast<std::size_t>(statistics_.blocks)))
+  {
+    const bool length = v.unit == "m";
+    std::snprintf(line, sizeof line, "%s,%.6g,%s,%s\n", (length ? v.key.substr(0, v.key.size() - 2) : v.key).c_str(),
+                  length ? v.value * 1e3 : v.value, length ? "mm" : v.unit.c_str(), v.meaning.c_str());
+    o << line;
+  }
   return o.str();
 }
 
@@ -374,7 +385,7 @@ std::vector<SummaryValue> NipProfile::summary() const
                                "speed of the touching beads' centres over the drum in the centre bin");
   chain.value = chain_speed_at_gap_centre();
   chain.drift = chain.drift_standard_error = std::numeric_limits<double>::quiet_NaN();
-  return {
+  std::vector<SummaryValue> out = {
       slip,
       chain,
       plain("relative_surface_speed_m_s", frame_.relative_surface_speed(), "m/s", "sleeve minus drum surface speed"),
@@ -387,6 +398,9 @@ std::vector<SummaryValue> NipProfile::summary() const
       sampled("touching_beads", touching_, "1", "beads touching the drum within the profile"),
       plain("magnetic_pressure_Pa", gap_field_ * gap_field_ / (2.0 * mu0), "Pa", "B^2/2mu0 at the gap centre"),
   };
+  const auto symmetry = asymmetry_.summary(blocks);
+  out.insert(out.end(), symmetry.begin(), symmetry.end());
+  return out;
 }
 
 void NipProfile::write(const std::string &directory) const
@@ -417,6 +431,7 @@ void NipProfile::write_state(StateOut &out) const
   out.put(t_last_);
   for (const auto *s : {&normal_force_, &tangential_force_, &touching_, &centre_slip_, &centre_chain_})
     s->write_state(out);
+  asymmetry_.write_state(out);
 }
 
 void NipProfile::read_state(StateIn &in)
@@ -437,6 +452,7 @@ void NipProfile::read_state(StateIn &in)
   t_last_ = in.get<double>();
   for (auto *s : {&normal_force_, &tangential_force_, &touching_, &centre_slip_, &centre_chain_})
     s->read_state(in);
+  asymmetry_.read_state(in);
 }
 
 } // namespace magbrush::dem

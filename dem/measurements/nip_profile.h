@@ -30,13 +30,15 @@
 // Files (in the run's output folder): nip_profile.csv (one row per bin, units in the header)
 // and nip_summary.csv (key numbers: slip at the gap centre against the relative surface speed,
 // peak normal pressure against the magnetic pressure B²/2μ0 at the gap centre, tangential /
-// normal, touching density, samples and averaging window).
+// normal, touching density, samples and averaging window; how symmetric the pressure and the
+// touching beads are about the gap centre: nip_asymmetry.h).
 #pragma once
 
 #include "dem/dem_system.h"
 #include "dem/measurement.h"
-#include "dem/measurements/sample_series.h"
+#include "dem/measurements/nip_asymmetry.h"
 #include "dem/measurements/nip_frame.h"
+#include "dem/measurements/sample_series.h"
 #include "dem/vector3.h"
 
 #include "coupling/case_model.h"
@@ -87,6 +89,7 @@ public:
   explicit NipProfile(const Case &c);
 
   const char *name() const override { return "nip profile"; }
+  int state_version() const override { return 2; } // 2: with the asymmetry's series
   double interval() const override { return settings_.sample_interval; }
   void sample(const DemSystem &system) override;
   void write(const std::string &directory) const override;
@@ -135,6 +138,7 @@ private:
   double t_first_ = -1.0, t_last_ = -1.0;
   // Per-sample totals over the profile (for standard errors and the steady-state test).
   SampleSeries normal_force_, tangential_force_, touching_, centre_slip_, centre_chain_;
+  NipAsymmetry asymmetry_; // centroid, spread and up/down ratio of the pressure and the touching beads
   double gap_field_;
   std::vector<WallContactRecord> records_; // reused between samples
   std::vector<DrumContact> contacts_;

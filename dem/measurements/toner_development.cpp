@@ -59,7 +59,10 @@ TonerDevelopment::TonerDevelopment(const Case &c)
       toner_q_over_m_ = p.charge_to_mass;
   }
   if (settings_.average_over == "image_periods")
-    line_.emplace(image_, frame_.slab_depth, settings_.phase_bins);
+  {
+    line_.emplace(image_, frame_.slab_depth, settings_.phase_bins, settings_.block_length);
+    near_line_.emplace(image_, frame_.slab_depth, settings_.phase_bins, settings_.block_length);
+  }
   bin_width_ = c.nip.bin_width;
   bins_half_ = static_cast<int>(std::lround(c.nip.half_width / c.nip.bin_width));
   arrived_.assign(static_cast<std::size_t>(2 * bins_half_ + 1), 0.0);
@@ -275,6 +278,7 @@ void TonerDevelopment::add_sample(double time, const std::vector<DrumToner> &on_
     for (const auto &t : now)
       line_toner_.push_back({t.id, image_.drum_arc(t.x, t.y, time), t.mass, t.charge});
     line_->add_sample(time, image_.drum_arc_at_x(settings_.measure_to, time), line_toner_, averaged);
+    near_line_->add_sample(time, image_.drum_arc_at_x(settings_.measure_from, time), line_toner_, averaged);
   }
   previous_time_ = time;
   before_ = std::move(now);
@@ -314,7 +318,11 @@ std::vector<SummaryValue> TonerDevelopment::summary() const
   contrast.meaning = "|bias - exposed potential|";
   std::vector<SummaryValue> out;
   if (line_)
+  {
     out = period_summary();
+    const auto near = near_line_summary();
+    out.insert(out.end(), near.begin(), near.end());
+  }
   else
     out = {
         sampled("tma_kg_per_m2", tma_, true, "kg/m^2", "toner mass per exposed drum area after the nip"),
@@ -339,12 +347,12 @@ std::vector<SummaryValue> TonerDevelopment::period_summary() const
   std::vector<double> tma, fog, q_over_m, ratio, transfer;
   for (const DevelopedLine::Period &p : line_->periods())
   {
-    tma.push_back(p.image_mass / p.image_area);
-    fog.push_back(p.dark_mass / p.dark_area);
+    tma.push_back(p.image_area > 0.0 ? p.image_mass / p.image_area : nan);
+    fog.push_back(p.dark_area > 0.0 ? p.dark_mass / p.dark_area : nan);
     if (p.image_mass > 0.0)
       q_over_m.push_back(p.image_charge / p.image_mass);
     if (eps_layer_over_l_ > 0.0 && contrast_ > 0.0)
-      ratio.push_back(std::abs(p.image_charge / p.image_area) / (eps_layer_over_l_ * contrast_));
+      ratio.push_back(p.image_area > 0.0 ? std::abs(p.image_charge / p.image_area) / (eps_layer_over_l_ * contrast_) : nan);
     double sum = 0.0;
     long n = 0;
     for (std::size_t k = 1; k < rows_.size(); ++k)
@@ -356,11 +364,14 @@ std::vector<SummaryValue> TonerDevelopment::period_summary() const
   periods.key = "image_periods_averaged";
   periods.value = static_cast<double>(line_->periods().size());
   periods.unit = "1";
-  periods.meaning = "whole latent-image periods past the line measure_to that the means average (their blocks)";
+  periods.meaning = "whole latent-image periods (on a uniform image: blocks of development.block_length) past "
+                    "the line measure_to that the means average (their blocks)";
+  // A dark drum (a fog point) has no image: its steady state is that of the fog.
+  const bool dark_drum = image_.period() <= 0.0 && !image_.solid();
   return {
-      summarise_blocks(tma, true, "tma_kg_per_m2", "kg/m^2",
+      summarise_blocks(tma, !dark_drum, "tma_kg_per_m2", "kg/m^2",
                        "toner mass per exposed drum area carried past measure_to, over whole image periods"),
-      summarise_blocks(fog, false, "fog_kg_per_m2", "kg/m^2",
+      summarise_blocks(fog, dark_drum, "fog_kg_per_m2", "kg/m^2",
                        "toner mass per dark (background) drum area carried past measure_to, over whole periods"),
       summarise_blocks(q_over_m, false, "developed_q_over_m_C_per_kg", "C/kg",
                        "charge per mass of the toner on the image, over whole periods"),
@@ -370,6 +381,49 @@ std::vector<SummaryValue> TonerDevelopment::period_summary() const
                        "toner mass arriving on the drum per time and slab depth, over whole periods"),
       periods,
   };
+}
+
+// The same count at measure_from: the TMA and fog there, over its own whole blocks. Where the
+// brush has ended before measure_from, the developed layer only rides the drum from there to
+// measure_to, and the two agree within their errors: the line can then sit at measure_from and
+// the drum's transit between the two is saved.
+std::vector<SummaryValue> TonerDevelopment::near_line_summary() const
+{
+  std::vector<double> tma, fog;
+  for (const DevelopedLine::Period &p : near_line_->periods())
+  {
+    tma.push_back(p.image_area > 0.0 ? p.image_mass / p.image_area : nan);
+    fog.push_back(p.dark_area > 0.0 ? p.dark_mass / p.dark_area : nan);
+  }
+  // Element by element (a uniform image's blocks lie on a grid fixed to the drum): what the
+  // drum's layer gained (lost: negative) between the two lines, per block of the same elements.
+  std::vector<double> change;
+  if (image_.period() <= 0.0)
+  {
+    const auto &a = near_line_->periods();
+    for (const DevelopedLine::Period &p : line_->periods())
+      for (const DevelopedLine::Period &q : a)
+        if (line_->grid_index(p) == near_line_->grid_index(q))
+        {
+          const bool dark = !image_.solid();
+          change.push_back(dark ? p.dark_mass / p.dark_area - q.dark_mass / q.dark_area
+                                : p.image_mass / p.image_area - q.image_mass / q.image_area);
+          break;
+        }
+  }
+  SummaryValue blocks;
+  blocks.key = "image_periods_averaged_at_measure_from";
+  blocks.value = static_cast<double>(near_line_->periods().size());
+  blocks.unit = "1";
+  blocks.meaning = "whole periods (or blocks) past the line measure_from";
+  return {summarise_blocks(tma, false, "tma_at_measure_from_kg_per_m2", "kg/m^2",
+                           "toner mass per exposed drum area carried past measure_from, over whole periods"),
+          summarise_blocks(fog, false, "fog_at_measure_from_kg_per_m2", "kg/m^2",
+                           "toner mass per dark drum area carried past measure_from, over whole periods"),
+          summarise_blocks(change, false, "layer_change_past_measure_from_kg_per_m2", "kg/m^2",
+                           "toner per drum area at measure_to minus at measure_from, the same drum elements "
+                           "(blocks paired on the drum; uniform images): 0 where the layer only rides the drum"),
+          blocks};
 }
 
 std::string TonerDevelopment::csv() const
@@ -420,6 +474,8 @@ void TonerDevelopment::write(const std::string &directory) const
                           line_->periods_csv());
     write_file_atomically((std::filesystem::path(directory) / "toner_developed_profile.csv").string(),
                           line_->profile_csv());
+    write_file_atomically((std::filesystem::path(directory) / "toner_developed_periods_at_measure_from.csv").string(),
+                          near_line_->periods_csv());
   }
 }
 
@@ -469,7 +525,10 @@ void TonerDevelopment::write_state(StateOut &out) const
   out.put_array(counts);
   out.put<std::uint8_t>(line_.has_value());
   if (line_)
+  {
     line_->write_state(out);
+    near_line_->write_state(out);
+  }
 }
 
 void TonerDevelopment::read_state(StateIn &in)
@@ -514,7 +573,10 @@ void TonerDevelopment::read_state(StateIn &in)
     in.fail(with_line ? "averages over image periods, this case over samples (development.average_over)"
                       : "averages over samples, this case over image periods (development.average_over)");
   if (line_)
+  {
     line_->read_state(in);
+    near_line_->read_state(in);
+  }
 }
 
 } // namespace magbrush::dem

@@ -20,7 +20,10 @@
 //    the summary's means are then those of the periods, which are its blocks (standard error,
 //    steady-state test), and the developed profile across a strip is written. A moving image's
 //    TMA in a fixed window repeats with the image's period, so a mean over a window of samples
-//    depends on its phase unless it spans whole periods;
+//    depends on its phase unless it spans whole periods. On a uniform image (a solid area, or a
+//    dark drum for the fog) the blocks are development.block_length of drum. The same count at
+//    measure_from gives the TMA there (tma_at_measure_from_kg_per_m2): equal to the one at
+//    measure_to within the errors where the brush has ended before measure_from;
 //  * along the whole nip: where toner ARRIVES on the drum's layer (not on it at the previous
 //    sample, on it now) and leaves it again, per bin of x, and the transfer rate per slab depth;
 //  * in the whole scene: the share of the toner mass that sits on a carrier (within the adhesion
@@ -30,7 +33,8 @@
 // the potential of the charged layer on its grounded substrate.
 //
 // Writes toner_development.csv (one row per sample), toner_transfer_profile.csv, with
-// image_periods toner_developed_periods.csv and toner_developed_profile.csv, and the key
+// image_periods toner_developed_periods.csv, toner_developed_profile.csv and
+// toner_developed_periods_at_measure_from.csv, and the key
 // numbers with standard errors for the study table (summary()).
 #pragma once
 
@@ -69,7 +73,7 @@ public:
 
   const char *name() const override { return "toner development"; }
   // 2: the toner on the carriers; 3: stacked toner counted, the developed line
-  int state_version() const override { return 3; }
+  int state_version() const override { return 4; }
   double interval() const override { return settings_.sample_interval; }
   void sample(const DemSystem &system) override;
   void write(const std::string &directory) const override;
@@ -108,6 +112,7 @@ public:
   std::string transfer_profile_csv() const;
   // The developed line (average_over = image_periods), else null.
   const DevelopedLine *developed_line() const { return line_ ? &*line_ : nullptr; }
+  const DevelopedLine *developed_line_at_measure_from() const { return near_line_ ? &*near_line_ : nullptr; }
 
 private:
   DevelopmentSettings settings_;
@@ -134,7 +139,10 @@ private:
   void add_to_means(const Row &row, bool with_transfer);
   // The summary over whole image periods (average_over = image_periods).
   std::vector<SummaryValue> period_summary() const;
-  std::optional<DevelopedLine> line_;
+  std::vector<SummaryValue> near_line_summary() const;
+  // The developed line at measure_to (the TMA), and the same count at measure_from (whether the
+  // layer is already complete there).
+  std::optional<DevelopedLine> line_, near_line_;
   std::vector<LineToner> line_toner_;
   std::vector<WallContactRecord> records_;
   std::vector<DrumToner> toner_;

@@ -94,7 +94,7 @@ TEST_P(MeasurementRestart, RestartedRunWritesTheUninterruptedRunsFilesByteForByt
                                  << expected.substr(0, 2000) << "\n--- restarted\n" << got.substr(0, 2000);
   }
   // The developed line's periods closed on both sides of the restart (header lines: 2).
-  if (std::string(scene.name) == "development_periods")
+  if (std::string(scene.name) == "development_periods" || std::string(scene.name) == "development_solid")
   {
     const std::string periods = contents(whole / "toner_developed_periods.csv");
     EXPECT_GE(std::count(periods.begin(), periods.end(), '\n'), 4) << periods;
@@ -131,6 +131,17 @@ INSTANTIATE_TEST_SUITE_P(
               "--set dem.checkpoint_interval=5us --set development.average_over=image_periods "
               "--set electric.image.period=1um --set development.phase_bins=4",
               {"toner_development.csv", "toner_developed_periods.csv", "toner_developed_profile.csv", "summary.csv"}},
+        // A solid area: blocks of 0.5 um of drum on the drum's grid (the first, partial one swept
+        // and dropped before the restart), counted at both lines (measure_from and measure_to).
+        Scene{"development_solid",
+              "tests/scenes/development/development_cell.yaml",
+              true,
+              "--set dem.duration=10us --set development.average_from=0s --set nip.average_from=0s "
+              "--set dem.checkpoint_interval=5us --set development.average_over=image_periods "
+              "--set electric.image.duty=1 --set electric.image.period=0m --set development.block_length=0.5um "
+              "--set development.phase_bins=4",
+              {"toner_development.csv", "toner_developed_periods.csv", "toner_developed_periods_at_measure_from.csv",
+               "toner_developed_profile.csv", "summary.csv"}},
         Scene{"regulation",
               "cases/kweon_regulation.yaml",
               true,

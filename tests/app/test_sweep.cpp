@@ -1,7 +1,7 @@
 // `magbrush sweep` end to end on a small box scene (two points, DEM only): the summary table
 // has the varied value as given and in SI, the steady-state verdict, the run time and status of
 // each point; a measured series is compared point by point; a malformed one is refused.
-#include "common/child_process.h"
+#include "tests/app/run_magbrush.h"
 #include "common/study_table.h"
 
 #include "tests/app/sweep_box_case.h"
@@ -19,26 +19,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Result
-{
-  int status;
-  std::string output;
-};
-
-Result magbrush_run(const fs::path &dir, const std::vector<std::string> &args)
-{
-  std::vector<std::string> command = {std::string(MAGBRUSH_BINARY_DIR) + "/bin/magbrush"};
-  command.insert(command.end(), args.begin(), args.end());
-  magbrush::ChildOutput output;
-  output.stdout_path = (dir / "log.txt").string();
-  output.stderr_to_stdout = true;
-  Result r{magbrush::run_program(command, output), {}};
-  std::ifstream in(dir / "log.txt");
-  std::ostringstream text;
-  text << in.rdbuf();
-  r.output = text.str();
-  return r;
-}
+using magbrush::testing::run_magbrush;
+using Result = magbrush::testing::CliRun;
 
 } // namespace
 
@@ -49,7 +31,7 @@ TEST(Sweep, TabulatesEveryPointWithItsSIValueRunTimeAndMeasuredComparison)
   // The box scene has no measurement with a summary; its steady-state verdict is "nan" (nothing
   // tested), which the comparison must carry through as "no verdict".
   std::ofstream(dir / "measured.csv") << "# a measured series\npopulations.carrier.diameter,steady_state\n100um,1\n";
-  const Result r = magbrush_run(dir, {"sweep", (dir / "box.yaml").string(), "--vary",
+  const Result r = run_magbrush(dir, {"sweep", (dir / "box.yaml").string(), "--vary",
                                       "populations.carrier.diameter=100um,120um", "--skip", "mesh,field,report",
                                       "--set", "output.directory=" + (dir / "out").string(), "--measured",
                                       (dir / "measured.csv").string()});
@@ -78,7 +60,7 @@ TEST(Sweep, TabulatesEveryPointWithItsSIValueRunTimeAndMeasuredComparison)
 
   // A measured file whose header does not name the varied key is refused, saying what it expects.
   std::ofstream(dir / "bad.csv") << "bias,tma_kg_per_m2\n-500V,0.004\n";
-  const Result bad = magbrush_run(dir, {"sweep", (dir / "box.yaml").string(), "--vary",
+  const Result bad = run_magbrush(dir, {"sweep", (dir / "box.yaml").string(), "--vary",
                                         "populations.carrier.diameter=100um", "--skip", "mesh,field,report", "--set",
                                         "output.directory=" + (dir / "out2").string(), "--measured",
                                         (dir / "bad.csv").string()});
@@ -101,13 +83,13 @@ TEST(Sweep, PointsWithTheSameFieldInputsShareOneSolvedField)
       n += entry.is_directory() && fs::exists(entry.path() / "minimal_roller_magnetic.h5");
     return n;
   };
-  const Result same = magbrush_run(dir, {"sweep", roller, "--vary", "drum.rpm=-100rpm,-120rpm", "--name", "drum",
+  const Result same = run_magbrush(dir, {"sweep", roller, "--vary", "drum.rpm=-100rpm,-120rpm", "--name", "drum",
                                          "--skip", "mesh,dem,report", "--set",
                                          "output.directory=" + (dir / "out").string()});
   EXPECT_EQ(field_folders(dir / "out" / "sweep_drum" / "fields"), 1) << same.output;
   EXPECT_NE(same.output.find("magnetic field up to date"), std::string::npos) << same.output;
 
-  const Result differ = magbrush_run(dir, {"sweep", roller, "--vary", "roller.poles.N1.strength=150kA/m,160kA/m",
+  const Result differ = run_magbrush(dir, {"sweep", roller, "--vary", "roller.poles.N1.strength=150kA/m,160kA/m",
                                            "--name", "pole", "--skip", "mesh,dem,report", "--set",
                                            "output.directory=" + (dir / "out").string()});
   EXPECT_EQ(field_folders(dir / "out" / "sweep_pole" / "fields"), 2) << differ.output;
@@ -138,7 +120,7 @@ TEST(Sweep, ADiameterStudyOfAPopulationGivenByMassScalesItsSpreadAndTheStep)
   box.replace(box.find("count: 100"), std::string("count: 100").size(), "mass: 1.152e-7 kg, diameter_std: 10 um");
   box.replace(box.find("dem: {"), std::string("dem: {").size(), "dem: {time_step: 40 ns, ");
   std::ofstream(dir / "box.yaml") << box;
-  const Result r = magbrush_run(dir, {"sweep", (dir / "box.yaml").string(), "--vary",
+  const Result r = run_magbrush(dir, {"sweep", (dir / "box.yaml").string(), "--vary",
                                       "populations.carrier.diameter=100um,50um", "--skip", "mesh,field,dem,report",
                                       "--set", "output.directory=" + (dir / "out").string()});
   ASSERT_EQ(r.status, 0) << r.output;
@@ -171,7 +153,7 @@ TEST(Sweep, RepeatsAreAveragedWithTheStandardErrorOfTheirSpread)
   const std::vector<std::string> sweep = {"sweep", (dir / "box.yaml").string(), "--vary",
                                           "populations.carrier.diameter=100um,120um", "--repeats", "3", "--skip",
                                           "mesh,field,dem,report", "--set", "output.directory=" + (dir / "out").string()};
-  const Result r = magbrush_run(dir, sweep);
+  const Result r = run_magbrush(dir, sweep);
   ASSERT_EQ(r.status, 0) << r.output;
   const fs::path folder = dir / "out" / "sweep_diameter"; // named by the varied key, not the seeds
   const double tma[2][3] = {{1.0e-4, 2.0e-4, 6.0e-4}, {3.0e-4, 3.0e-4, 3.0e-4}};
@@ -189,7 +171,7 @@ TEST(Sweep, RepeatsAreAveragedWithTheStandardErrorOfTheirSpread)
     }
   std::vector<std::string> merge = sweep;
   merge.push_back("--merge");
-  const Result merged = magbrush_run(dir, merge);
+  const Result merged = run_magbrush(dir, merge);
   ASSERT_EQ(merged.status, 0) << merged.output;
 
   EXPECT_EQ(magbrush::testing::read_csv_rows(folder / "sweep_summary.csv").size(), 7u); // every run, with its seed
@@ -213,12 +195,12 @@ TEST(Sweep, RepeatsAreAveragedWithTheStandardErrorOfTheirSpread)
   // The seeds are the repeats': varying them as well is refused, as is a repeat count of 0.
   std::vector<std::string> both = sweep;
   both.insert(both.begin() + 4, {"--vary", "dem.seed=4,5"});
-  const Result refused = magbrush_run(dir, both);
+  const Result refused = run_magbrush(dir, both);
   EXPECT_NE(refused.status, 0);
   EXPECT_NE(refused.output.find("do not also vary dem.seed"), std::string::npos) << refused.output;
   std::vector<std::string> none = sweep;
   none[5] = "0";
-  const Result zero = magbrush_run(dir, none);
+  const Result zero = run_magbrush(dir, none);
   EXPECT_NE(zero.status, 0);
   EXPECT_NE(zero.output.find("--repeats expects a whole number of runs per point"), std::string::npos) << zero.output;
   fs::remove_all(dir);

@@ -1,5 +1,5 @@
-// deal.II's parallel triangulation and the Trilinos solvers need MPI; GoogleTest's main does
-// not start it. This global environment does (once per test program, single rank).
+// deal.II's parallel triangulation and the PETSc and Trilinos solvers need MPI; GoogleTest's
+// main does not start it. This global environment does (once per test program, single rank).
 #pragma once
 
 #include <deal.II/base/mpi.h>

@@ -1,5 +1,6 @@
 // Serial and `mpirun -np 2` solves of the same roller problem must agree to the solver
-// tolerance (METIS partitioning, Trilinos CG + AMG). Runs the probe program under mpirun.
+// tolerance (METIS partitioning, CG + AMG of the configured linear-algebra backend). Runs the
+// probe program under mpirun.
 #include <gtest/gtest.h>
 #include "tests/test_temp_dir.h"
 

@@ -37,6 +37,29 @@ class SumpRow(unittest.TestCase):
         self.assertTrue(report.sump_row(f)[3].startswith("NOT conserved"))
 
 
+class SymmetryRows(unittest.TestCase):
+    """The nip's asymmetry with its standard errors, from dem/summary.csv's rows."""
+
+    @staticmethod
+    def row(key, value, se):
+        return {"key": key, "value": repr(value), "standard_error": repr(se)}
+
+    def test_centroid_against_spread_and_the_side(self):
+        rows = report.symmetry_rows([self.row("pressure_centroid_m", -0.76e-3, 0.05e-3),
+                                     self.row("pressure_spread_m", 0.72e-3, 0.02e-3),
+                                     self.row("pressure_upstream_over_downstream", 3.1, 0.2),
+                                     self.row("touching_centroid_m", -0.4e-3, 0.03e-3),
+                                     self.row("touching_upstream_over_downstream", 1.4, 0.1)])
+        self.assertEqual(len(rows), 3)
+        self.assertIn("-0.76 ± 0.05 mm", rows[0][1])
+        self.assertTrue(rows[0][3].startswith("centroid 1.1 × the spread, upstream"), rows[0])
+        self.assertIn("3.1 ± 0.2", rows[1][1])
+
+    def test_no_rows_without_the_measurement(self):
+        self.assertEqual(report.symmetry_rows([]), [])
+        self.assertEqual(report.symmetry_rows(None), [])
+
+
 class DevelopmentWindow(unittest.TestCase):
     """The toner development plot's window: where averaging starts and the halves it compares."""
 

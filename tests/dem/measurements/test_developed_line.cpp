@@ -97,6 +97,55 @@ TEST(DevelopedLine, EveryWholePeriodHasTheLayersExactTmaAndFogWhateverItsPhase)
   }
 }
 
+// A solid area (duty 1) and a dark drum have no period: the blocks are the block length, every
+// block holds exactly its 700 lattice toner (0.7 mm blocks against 1 µm spacing, the block
+// boundaries between lattice points), all image on the solid area, all background on the dark
+// drum; the profile is flat. The blocks lie on a grid fixed to the drum, wherever the counting
+// starts: the stretch up to the first boundary is swept but not kept.
+TEST(DevelopedLine, AUniformImageIsAveragedOverBlocksOfTheGivenLength)
+{
+  constexpr double block = 0.7e-3;
+  for (double duty : {1.0, 0.0})
+  {
+    LatentImage uniform;
+    uniform.period = duty >= 1.0 ? period : 0.0; // a solid area whatever the period
+    uniform.duty = duty;
+    const DrumImage image(uniform, NipFrame{});
+    EXPECT_EQ(image.period(), 0.0);
+    EXPECT_EQ(image.exposed(0.3e-3), duty >= 1.0);
+    EXPECT_NEAR(image.exposed_length(-1e-3, 2e-3), duty >= 1.0 ? 3e-3 : 0.0, 1e-18);
+    EXPECT_THROW(DevelopedLine(image, depth, 7), std::invalid_argument); // no period, no block length
+    for (double s0 : {0.0, 0.3337e-3, -1.1e-3})
+    {
+      DevelopedLine line(image, depth, 7, block);
+      EXPECT_EQ(line.block_length(), block);
+      sweep(line, image, s0, 0.0, 3.5 * block);
+      ASSERT_EQ(line.periods().size(), 3u) << s0;
+      for (const auto &p : line.periods())
+      {
+        const double m = duty >= 1.0 ? m_image : m_dark;
+        EXPECT_EQ(p.image_toner + p.dark_toner, 700) << s0;
+        EXPECT_EQ(duty >= 1.0 ? p.dark_toner : p.image_toner, 0) << s0;
+        EXPECT_NEAR(duty >= 1.0 ? p.image_area : p.dark_area, block * depth, 1e-15);
+        EXPECT_NEAR((duty >= 1.0 ? p.image_mass / p.image_area : p.dark_mass / p.dark_area), m / (spacing * depth),
+                    1e-9 * m / (spacing * depth));
+        EXPECT_NEAR(p.t_end - p.t_start, block, 1e-12);
+      }
+      // The blocks lie on the drum's grid of 0.7 mm (the stretch before the first boundary is
+      // not kept): their indices say which drum elements they hold.
+      const long first = static_cast<long>(std::floor(s0 / block + 1e-9));
+      for (std::size_t k = 0; k < 3; ++k)
+        EXPECT_EQ(line.grid_index(line.periods()[k]), first - static_cast<long>(k)) << s0;
+      for (int k = 0; k < 7; ++k)
+      {
+        const auto &b = line.profile()[static_cast<std::size_t>(k)];
+        EXPECT_EQ(b.toner, 300) << k; // 100 µm bins, three blocks
+        EXPECT_NEAR(line.bin_position(k), (k + 0.5) * 100e-6, 1e-15);
+      }
+    }
+  }
+}
+
 TEST(DevelopedLine, TonerIsCountedOnceAndOnlyAsItsElementCrosses)
 {
   const DrumImage image = image_of_period();

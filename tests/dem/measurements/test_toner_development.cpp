@@ -436,3 +436,61 @@ TEST(TonerDevelopment, OverImagePeriodsTheSummaryIsThatOfTheWholePeriodsPastTheL
   EXPECT_EQ(resumed["tma_kg_per_m2"], s["tma_kg_per_m2"].value);
   EXPECT_EQ(resumed["toner_transfer_rate_kg_per_s_m"], s["toner_transfer_rate_kg_per_s_m"].value);
 }
+
+// On a solid area (a uniform image) the blocks lie on a grid fixed to the drum, so the lines at
+// measure_from and measure_to count the same drum elements in blocks of the same index, and
+// layer_change_past_measure_from compares them element by element. A layer on the drum's
+// lattice (k + ½) µm with 3e-13 kg per toner as it passes measure_from and `gain` times that as
+// it passes measure_to (as if the drum had collected toner in between): each line's TMA is its
+// lattice's mass per area, and the change is exactly the difference, over every paired block.
+TEST(TonerDevelopment, OnASolidAreaTheTwoLinesCompareTheSameDrumElements)
+{
+  for (double gain : {1.0, 1.5})
+  {
+    Case c = development_case();
+    c.electric.image.period = 0.0;
+    c.electric.image.duty = 1.0;
+    c.development.average_over = "image_periods";
+    c.development.block_length = 0.1e-3;
+    c.development.measure_from = 1e-3;
+    c.development.measure_to = 2e-3;
+    const NipFrame f = NipFrame::from_case(c);
+    const DrumImage image(c.electric.image, f);
+    ASSERT_TRUE(image.solid());
+    const double spacing = 1e-6, m = 3e-13, qm = -0.03;
+    auto layer_at = [&](double t) {
+      std::vector<DrumToner> out;
+      for (const double x : {c.development.measure_from, c.development.measure_to})
+      {
+        const double s_line = image.drum_arc_at_x(x, t);
+        const double mass = x == c.development.measure_to ? gain * m : m;
+        const long first = static_cast<long>(std::floor((s_line - 70e-6) / spacing));
+        for (long k = first; k <= first + 140; ++k)
+        {
+          const double s = (static_cast<double>(k) + 0.5) * spacing;
+          const auto [px, py] = on_drum(f, s, t);
+          out.push_back({static_cast<std::int32_t>(k + 1000000), px, py, mass, qm * mass});
+        }
+      }
+      std::sort(out.begin(), out.end(), [](const DrumToner &a, const DrumToner &b) { return a.id < b.id; });
+      return out;
+    };
+    const double speed = std::abs(f.drum_omega * f.drum_radius);
+    const double dt = 10e-6, duration = (1e-3 + 0.65e-3) / speed;
+    TonerDevelopment d(c);
+    for (int n = 0; n * dt <= duration; ++n)
+      d.add_sample(n * dt, layer_at(n * dt), 0.9);
+    std::map<std::string, SummaryValue> s;
+    for (const auto &v : d.summary())
+      s[v.key] = v;
+    const double tma = m / (spacing * c.dem.periodic_length);
+    ASSERT_TRUE(s.count("layer_change_past_measure_from_kg_per_m2"));
+    EXPECT_GE(s["image_periods_averaged"].value, 5.0);
+    EXPECT_GE(s["image_periods_averaged_at_measure_from"].value, 14.0);
+    EXPECT_NEAR(s["tma_at_measure_from_kg_per_m2"].value, tma, 1e-9 * tma) << gain;
+    EXPECT_NEAR(s["tma_kg_per_m2"].value, gain * tma, 1e-9 * tma) << gain;
+    EXPECT_NEAR(s["layer_change_past_measure_from_kg_per_m2"].value, (gain - 1.0) * tma, 1e-9 * tma) << gain;
+    EXPECT_NEAR(s["layer_change_past_measure_from_kg_per_m2"].standard_error, 0.0, 1e-9 * tma) << gain;
+    EXPECT_TRUE(std::isnan(s["fog_kg_per_m2"].value)); // no dark area on a solid one
+  }
+}

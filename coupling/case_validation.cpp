@@ -410,21 +410,27 @@ void check_averaging_windows(const Case &c, std::vector<CaseIssue> &out)
                                    T(duration - w.from) + ") is shorter than one sample interval (" + interval_key +
                                    " = " + T(w.interval) + "): its means would average at most one sample"});
   }
-  // The developed image averaged over whole image periods: the window must let the drum carry
-  // at least one period (one block of the means) past the measuring line.
+  // The developed image averaged in blocks fixed to the drum (development.average_over:
+  // image_periods): a striped image's blocks are its periods, a uniform image's (solid or dark)
+  // development.block_length. The window must let the drum carry at least one block past the
+  // measuring line, or no whole block is averaged.
+  const LatentImage &image = c.electric.image;
+  const bool striped = image.striped();
+  const double block = striped ? image.period : c.development.block_length;
   const double drum_speed = std::abs(c.drum.omega()) * c.drum.radius;
-  if (nip && c.electric.enabled && toner && c.development.average_over == "image_periods" &&
-      c.electric.image.period > 0.0 && c.development.average_from < duration && drum_speed > 0.0)
+  if (nip && c.electric.enabled && toner && c.development.average_over == "image_periods" && block > 0.0 &&
+      c.development.average_from < duration && drum_speed > 0.0)
   {
-    const double period_time = c.electric.image.period / drum_speed;
-    if (duration - c.development.average_from < period_time)
+    const double block_time = block / drum_speed;
+    if (duration - c.development.average_from < block_time)
       out.push_back({"development.average_from",
-                     "the averaging window (development.average_from = " + T(c.development.average_from) + " to dem.duration = " +
-                         T(duration) + ": " + T(duration - c.development.average_from) +
-                         ") is shorter than one block of the developed image's means, one image period (electric.image.period = " +
-                         format_quantity(c.electric.image.period, Dimension::length) + " of drum surface at " +
-                         format_quantity(drum_speed, Dimension::velocity) + ": " + T(period_time) +
-                         "): no whole period would be averaged"});
+                     "the averaging window (development.average_from = " + T(c.development.average_from) +
+                         " to dem.duration = " + T(duration) + ": " + T(duration - c.development.average_from) +
+                         ") is shorter than one block of the developed image's means (" +
+                         (striped ? "one image period, electric.image.period = " : "development.block_length = ") +
+                         format_quantity(block, Dimension::length) + " of drum surface at " +
+                         format_quantity(drum_speed, Dimension::velocity) + ": " + T(block_time) +
+                         "): no whole block would be averaged"});
   }
   // A plate-compression row is the mean of the samples in its window.
   if (c.scene == "box" && c.compression.average_window < c.compression.sample_interval)

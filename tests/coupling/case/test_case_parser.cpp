@@ -390,8 +390,8 @@ TEST(CaseParser, GeometryNonsenseIsCaughtInProcess)
 }
 
 // Every measurement's averaging window lies inside the run and holds more than one sample
-// interval (the developed image over its periods: at least one period of drum travel), or the
-// case is refused naming both keys and their values.
+// interval (the developed image in blocks: at least one block of drum travel), or the case is
+// refused naming both keys and their values.
 TEST(CaseParser, AveragingWindowsLieInsideTheRun)
 {
   const std::string fed = source_dir + "/cases/kawamoto_nip_fed.yaml";
@@ -416,9 +416,16 @@ TEST(CaseParser, AveragingWindowsLieInsideTheRun)
     return v;
   };
   const std::string block = error_of(read_file(cell), with("development.average_from=9us"));
-  EXPECT_NE(block.find("shorter than one block of the developed image's means, one image period"), std::string::npos)
+  EXPECT_NE(block.find("shorter than one block of the developed image's means (one image period, "
+                       "electric.image.period = 1 um"),
+            std::string::npos)
       << block;
   EXPECT_NO_THROW(load_case(cell, with("development.average_from=0s")));
+  // A solid area's blocks are development.block_length of drum.
+  const std::string solid = error_of(read_file(cell), {"development.average_over=image_periods", "electric.image.duty=1",
+                                                       "development.block_length=10um", "dem.duration=10us",
+                                                       "nip.average_from=0s", "development.average_from=9us"});
+  EXPECT_NE(solid.find("(development.block_length = 10 um of drum surface"), std::string::npos) << solid;
   // A measurement the scene does not have is not checked (no periodic slab: no nip measurement).
   EXPECT_NO_THROW(load_case(minimal, {"dem.duration=1ms", "nip.average_from=5ms"}));
 }

@@ -627,6 +627,7 @@ int run_spin_up(const SweepPlan &plan, const cli::ParsedArguments &args, int thr
   char duration[64];
   std::snprintf(duration, sizeof duration, "dem.duration=%.9gs", spin.duration);
   overrides.push_back(duration);
+  overrides.push_back("dem.leg=true"); // the points average after its end
   overrides.push_back("output.directory=" + spin.dir.string());
   const Case spin_case = load_case(plan.case_path, overrides);
   overrides.push_back("field.output_dir=" + (plan.sweep_dir / "fields" /

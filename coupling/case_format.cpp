@@ -285,6 +285,7 @@ std::vector<ResolvedEntry> resolved_entries(const Case &c)
   e.i("dem.threads", "dem.threads", d.threads);
   e.q("dem.max_overlap_fraction", "dem.max_overlap_fraction", d.max_overlap_fraction);
   e.s("dem.restitution_model", "dem.restitution_model", d.restitution_model);
+  e.b("dem.leg", "dem.leg", d.leg);
   e.q("dem.settle_time", "dem.settle_time", d.settle_time);
   e.q("dem.max_kinetic_energy_growth", "dem.max_kinetic_energy_growth", d.max_kinetic_energy_growth);
   e.q("dem.adhesion_cutoff", "dem.adhesion_cutoff", d.adhesion_cutoff);
@@ -535,7 +536,9 @@ std::string format_schema(bool markdown)
            "starts at or after the end, or is shorter than the measurement's `sample_interval` (the developed "
            "image over `image_periods`: shorter than one block of drum travel, an image period or, on a uniform "
            "image, `development.block_length`), is refused, as is a "
-           "`compression.average_window` shorter than `compression.sample_interval`.\n\n"
+           "`compression.average_window` shorter than `compression.sample_interval`. A run that is the first leg "
+           "of a longer one (continued with `--resume` or `--restart`; a sweep's spin-up) says so with "
+           "`dem.leg: true`, and its windows may then lie after its end.\n\n"
            "## Checking and overriding\n\n"
            "`magbrush check CASE` validates the file and prints every resolved key as `path = value`; each "
            "line works as an override: `--set path=value` (list elements by name, or `[i]` for unnamed "

@@ -1225,6 +1225,7 @@ private:
     d.time_step = q(s, "time_step");
     d.time_step_safety = q(s, "time_step_safety");
     d.duration = q(s, "duration");
+    d.leg = flag(s, "leg");
     d.output_interval = q(s, "output_interval");
     d.checkpoint_interval = q(s, "checkpoint_interval");
     d.checkpoint_wall_interval = q(s, "checkpoint_wall_interval");

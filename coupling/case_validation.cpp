@@ -369,8 +369,8 @@ void check_dem(const Case &c, std::vector<CaseIssue> &out)
 void check_averaging_windows(const Case &c, std::vector<CaseIssue> &out)
 {
   const double duration = c.dem.duration;
-  if (!(duration > 0.0))
-    return; // no run
+  if (!(duration > 0.0) || c.dem.leg)
+    return; // no run, or a first leg: the windows may open after it, in the run that continues it
   const auto T = [](double t) { return format_quantity(t, Dimension::time); };
   const bool slab = c.sleeve && c.dem.periodic_length > 0.0;
   const bool nip = slab && c.drum.present;
@@ -404,7 +404,8 @@ void check_averaging_windows(const Case &c, std::vector<CaseIssue> &out)
     if (w.from >= duration)
       out.push_back({from_key, "the averaging window of " + std::string(w.what) + " starts at or after the end of the run (" +
                                    from + ", " + end + "): its means would average no sample; set " + from_key +
-                                   " below dem.duration, or run longer"});
+                                   " below dem.duration, or run longer (a first leg of a run to be continued: "
+                                   "dem.leg: true)"});
     else if (duration - w.from < w.interval)
       out.push_back({from_key, "the averaging window of " + std::string(w.what) + " (" + from + " to " + end + ": " +
                                    T(duration - w.from) + ") is shorter than one sample interval (" + interval_key +

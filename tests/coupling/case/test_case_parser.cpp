@@ -402,6 +402,9 @@ TEST(CaseParser, AveragingWindowsLieInsideTheRun)
       << late;
   EXPECT_NE(late.find("flow_report.average_from"), std::string::npos) << late;
   EXPECT_NO_THROW(load_case(fed, {"dem.duration=0.5ms", "nip.average_from=0s", "flow_report.average_from=0s"}));
+  // A first leg of a longer run (a sweep's spin-up, a run to be continued) says so.
+  EXPECT_NE(late.find("a first leg of a run to be continued: dem.leg: true"), std::string::npos) << late;
+  EXPECT_NO_THROW(load_case(fed, {"dem.duration=0.5ms", "dem.leg=true"}));
   const std::string short_window = error_of(read_file(fed), {"dem.duration=25.01ms"});
   EXPECT_NE(short_window.find("shorter than one sample interval (flow_report.sample_interval = 20 us)"),
             std::string::npos)

@@ -261,7 +261,7 @@ double si_value(const std::string &key, const std::string &text)
   const KeySpec *spec = spec_of_path(key);
   try
   {
-    return parse_quantity(text, spec ? spec->dimension : Dimension::dimensionless);
+    return parse_quantity(text, spec ? spec->dimension : Dimension::dimensionless, BareNumber::si);
   }
   catch (const std::exception &)
   {
@@ -459,13 +459,13 @@ PointSetup set_up_point(const SweepPlan &plan, std::size_t n)
       point.overrides.push_back("populations." + selector + ".count=" + std::to_string(count));
     }
     char std_text[64];
-    std::snprintf(std_text, sizeof std_text, "%.9g", p0->diameter_std / ratio);
+    std::snprintf(std_text, sizeof std_text, "%.9g m", p0->diameter_std / ratio);
     point.overrides.push_back("populations." + selector + ".diameter_std=" + std_text);
     // The stable step scales with the bead size (Hertz contact time ∝ d): a case that fixes
     // its step keeps the same fraction of the limit.
     if (plan.base.dem.time_step > 0.0)
     {
-      std::snprintf(std_text, sizeof std_text, "%.9g", plan.base.dem.time_step / ratio);
+      std::snprintf(std_text, sizeof std_text, "%.9g s", plan.base.dem.time_step / ratio);
       point.overrides.push_back("dem.time_step=" + std::string(std_text));
     }
   }
@@ -627,6 +627,7 @@ int run_spin_up(const SweepPlan &plan, const cli::ParsedArguments &args, int thr
   char duration[64];
   std::snprintf(duration, sizeof duration, "dem.duration=%.9gs", spin.duration);
   overrides.push_back(duration);
+  overrides.push_back("dem.leg=true"); // the points average after its end
   overrides.push_back("output.directory=" + spin.dir.string());
   const Case spin_case = load_case(plan.case_path, overrides);
   overrides.push_back("field.output_dir=" + (plan.sweep_dir / "fields" /

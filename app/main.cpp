@@ -1,5 +1,6 @@
 // magbrush — the user-facing driver. `magbrush <subcommand> --help` explains each step.
 #include "app/subcommand.h"
+#include "coupling/case_schema.h"
 
 #include <cstdlib>
 #include <filesystem>
@@ -108,7 +109,18 @@ int main(int argc, char **argv)
         return 1;
       }
     }
-  std::cerr << "magbrush: unknown command '" << name << "'\n\n";
+  // A mistyped command gets the nearest one; a case file given first gets the command that runs it.
+  std::vector<std::string> names;
+  for (const auto &c : magbrush::subcommands())
+    names.push_back(c.name);
+  const std::string suggestion = magbrush::did_you_mean(name, names);
+  const bool case_file = name.size() > 5 && (name.compare(name.size() - 5, 5, ".yaml") == 0 ||
+                                             name.compare(name.size() - 4, 4, ".yml") == 0);
+  std::cerr << "magbrush: unknown command '" << name << "'"
+            << (!suggestion.empty() ? " (did you mean '" + suggestion + "'?)"
+                : case_file         ? " (a case file comes after the command: magbrush run " + name + ")"
+                                    : std::string())
+            << "\n\n";
   print_usage();
   return 2;
 }

@@ -14,6 +14,10 @@ std::vector<KeySpec> dem_keys()
       quantity("dem.time_step", D::time, "Time step (0 = automatic from the Rayleigh/Hertz criterion).").def("0 s").non_negative(),
       number("dem.time_step_safety", "Automatic step = this x Rayleigh time.").def("0.2").positive().max(1.0),
       quantity("dem.duration", D::time, "Simulated time.").def("0 s").non_negative(),
+      boolean("dem.leg", "This run is the first leg of a longer one (a sweep's spin-up, a run continued with --resume "
+                         "or --restart to a later dem.duration): its measurements' averaging windows may lie after its "
+                         "end, which is otherwise refused. Run control: a continued run may drop it.")
+          .def("false"),
       quantity("dem.output_interval", D::time, "Snapshot interval (0 = only at the end).").def("0 s").non_negative(),
       quantity("dem.checkpoint_interval", D::time,
                "Simulated time between checkpoints (0 = only at the end). Each one is written atomically and the one before it is kept (checkpoint.previous.bin); writing one changes nothing in the run (dem/README.md).")

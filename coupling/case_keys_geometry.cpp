@@ -20,7 +20,7 @@ std::vector<KeySpec> geometry_keys()
           .def("1").min(1.0).affects(A::magnetic),
       quantity("roller.shape_factor", D::inverse_angle_squared,
                "Default Gaussian shape factor alpha of the poles, M(theta) ~ exp(-alpha (theta-phi)^2).")
-          .def("10").positive().affects(A::magnetic),
+          .def("10 rad^-2").positive().affects(A::magnetic),
       list("roller.poles", "The poles: name, angle, strength (sign or polarity gives N/S), shape factor.")
           .required().affects(A::magnetic),
       text("roller.poles[].name", "Pole name, e.g. N1 (address it in overrides: roller.poles.N1.angle).")

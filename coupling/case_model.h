@@ -257,6 +257,7 @@ struct DemSettings
   std::string restitution_model = "ln_e"; // materials with `restitution`: "ln_e" (LIGGGHTS/LAMMPS
                                           // form, inexact for Hertz) | "hertz_exact" (damping
                                           // fitted so that Hertz gives exactly e)
+  bool leg = false;                  // a first leg: averaging windows may lie after dem.duration
   double settle_time = 0.0;          // after insertion, settle this long with walls at rest [s]
   double max_kinetic_energy_growth = 1e3; // stability guard: KE may not grow by more than this
                                           // factor between two guard checks (100 steps)

@@ -1,5 +1,6 @@
 // The case reader. Three passes, each collecting every error it can before stopping:
-//   1. text checks and YAML parsing (syntax errors carry yaml-cpp's line and column);
+//   1. text checks and YAML parsing (a syntax error quotes its line with a caret and a hint;
+//      an unclosed '{' or '[' is pointed at itself, not where yaml-cpp noticed it);
 //   2. overrides are grafted onto the YAML tree, then a walk of the tree against the schema
 //      (case_schema.h) checks keys, types, units and ranges and stores SI values by key path;
 //   3. the Case struct is assembled from those values (schema defaults for the rest) and
@@ -235,9 +236,123 @@ private:
     }
     catch (const YAML::Exception &e)
     {
-      error(location(e.mark), "", "YAML syntax error: " + e.msg);
+      syntax_error(text, e.mark, e.msg);
     }
     return YAML::Node();
+  }
+
+  // A YAML syntax error, quoted: the line with a caret under the column, and a hint. yaml-cpp
+  // notices an unclosed '{' or '[' only at the next key, a line or more after it, so for those
+  // the error points at the bracket that is never closed; otherwise at yaml-cpp's position,
+  // with the line before it for context.
+  void syntax_error(const std::string &text, const YAML::Mark &mark, const std::string &message)
+  {
+    if (mark.line < 0)
+      return error(file, "", "YAML syntax error: " + message);
+    std::vector<size_t> starts{0}; // byte offset of each line
+    for (size_t i = 0; i < text.size(); ++i)
+      if (text[i] == '\n')
+        starts.push_back(i + 1);
+    const size_t line = std::min(static_cast<size_t>(mark.line), starts.size() - 1);
+    size_t at = std::min(starts[line] + static_cast<size_t>(std::max(mark.column, 0)), text.size());
+    std::string hint;
+    const bool unclosed_map = message.find("end of map flow") != std::string::npos;
+    const bool unclosed_list = message.find("end of sequence flow") != std::string::npos;
+    bool moved = false;
+    if (unclosed_map || unclosed_list)
+    {
+      const size_t opener = unclosed_bracket(text, at, unclosed_map ? '{' : '[');
+      if (opener != std::string::npos)
+      {
+        at = opener;
+        moved = true;
+      }
+      hint = unclosed_map ? "this '{' is never closed: end the section with '}' on the same line, or write it as "
+                            "indented 'key: value' lines"
+                          : "this '[' is never closed: end the list with ']' on the same line";
+    }
+    else if (message.find("illegal map value") != std::string::npos)
+      hint = "a ':' where YAML expected none: a line indented deeper than the key above it, or a second "
+             "'key: value' on one line (keys of one section line up under each other; quote a value that "
+             "contains ': ')";
+    else if (message.find("end of map not found") != std::string::npos ||
+             message.find("end of sequence not found") != std::string::npos)
+      hint = "this line's indentation does not match the lines around it: the keys of one section line up "
+             "under each other, and '- ' list items sit under their key";
+    else
+      hint = "YAML may notice a mistake a line or two after it: check the lines above too";
+    const size_t l = static_cast<size_t>(std::upper_bound(starts.begin(), starts.end(), at) - starts.begin()) - 1;
+    const size_t column = at - starts[l];
+    const std::string where = file + ":" + std::to_string(l + 1) + ":" + std::to_string(display_width(text.substr(starts[l], column)) + 1);
+    std::string excerpt;
+    const auto quote = [&](size_t k) {
+      const size_t end = k + 1 < starts.size() ? starts[k + 1] - 1 : text.size();
+      std::string content = text.substr(starts[k], end - starts[k]);
+      if (!content.empty() && content.back() == '\r')
+        content.pop_back();
+      if (content.size() > 120)
+        content = content.substr(0, 117) + "...";
+      const std::string number = std::to_string(k + 1);
+      excerpt += "\n    " + std::string(6 - std::min<size_t>(number.size(), 5), ' ') + number + " | " + content;
+    };
+    // The line before, for context, unless it is blank or the error was moved onto its bracket.
+    if (!moved && l > 0 && text.find_first_not_of(" \t\r", starts[l - 1]) < starts[l] - 1)
+      quote(l - 1);
+    quote(l);
+    excerpt += "\n    " + std::string(6, ' ') + " | " + std::string(display_width(text.substr(starts[l], column)), ' ') + "^";
+    error(where, "", "YAML syntax error: " + message + excerpt + "\n    hint: " + hint);
+  }
+
+  // The last '{' (or '[') before `end` that no '}' (']') closes, outside quotes and comments;
+  // npos if there is none.
+  static size_t unclosed_bracket(const std::string &text, size_t end, char open)
+  {
+    std::vector<size_t> stack;
+    char quote = 0;
+    bool comment = false;
+    char previous = '\n'; // the last character before this one that is not a space
+    for (size_t i = 0; i < end && i < text.size(); ++i)
+    {
+      const char c = text[i];
+      if (comment)
+      {
+        comment = c != '\n';
+        previous = '\n';
+        continue;
+      }
+      if (quote)
+      {
+        if (c == '\\' && quote == '"')
+          ++i;
+        else if (c == quote)
+          quote = 0;
+        continue;
+      }
+      const bool starts_scalar = std::string("\n:,[{-?").find(previous) != std::string::npos;
+      if (c != ' ' && c != '\t')
+        previous = c;
+      if (c == '#' && (i == 0 || text[i - 1] == ' ' || text[i - 1] == '\n'))
+        comment = true;
+      else if ((c == '"' || c == '\'') && starts_scalar) // a quote inside a plain scalar is text
+        quote = c;
+      else if (c == '{' || c == '[')
+        stack.push_back(i);
+      else if ((c == '}' || c == ']') && !stack.empty())
+        stack.pop_back();
+    }
+    for (auto it = stack.rbegin(); it != stack.rend(); ++it)
+      if (text[*it] == open)
+        return *it;
+    return std::string::npos;
+  }
+
+  // Characters (not bytes) of UTF-8 text, for the caret's column.
+  static size_t display_width(const std::string &s)
+  {
+    size_t n = 0;
+    for (const unsigned char c : s)
+      n += (c & 0xC0) != 0x80;
+    return n;
   }
 
   // ---- overrides ----------------------------------------------------------------------
@@ -262,7 +377,19 @@ private:
       }
       catch (const YAML::Exception &e)
       {
-        error(where, key_path, "the value is not valid YAML: " + e.msg);
+        // The value quoted with a caret (at the unclosed bracket, if that is the error).
+        const std::string text = o.substr(eq + 1);
+        size_t at = e.mark.line == 0 && e.mark.column >= 0 ? static_cast<size_t>(e.mark.column) : text.size();
+        for (const char open : {'{', '['})
+          if (e.msg.find(open == '{' ? "end of map flow" : "end of sequence flow") != std::string::npos &&
+              unclosed_bracket(text, text.size(), open) != std::string::npos)
+            at = unclosed_bracket(text, text.size(), open);
+        const bool one_line = text.find('\n') == std::string::npos && text.size() <= 120;
+        error(where, key_path,
+              "the value is not valid YAML: " + e.msg +
+                  (one_line ? "\n      " + text + "\n      " +
+                                  std::string(display_width(text.substr(0, std::min(at, text.size()))), ' ') + "^"
+                            : std::string()));
         continue;
       }
       // "planes.plate.path[1].time" -> planes, plate, path, [1], time
@@ -554,7 +681,7 @@ private:
     {
     case KeyType::quantity:
       v.written = node.Scalar();
-      v.number = parse_quantity(v.written, spec.dimension);
+      v.number = parse_quantity(v.written, spec.dimension, BareNumber::refused, typical_value(spec));
       check_range(spec, v.number, v.written);
       break;
     case KeyType::integer:
@@ -624,6 +751,28 @@ private:
     return v;
   }
 
+  // The scale a key's values usually have, for the unit suggested for a bare number: its
+  // default if non-zero, else the middle of a bounded positive range, else 0 (the dimension's
+  // usual scale).
+  static double typical_value(const KeySpec &spec)
+  {
+    if (spec.type == KeyType::quantity && !spec.default_text.empty() && spec.default_text[0] != '<')
+    {
+      try
+      {
+        const double d = parse_quantity(spec.default_text, spec.dimension, BareNumber::si);
+        if (d != 0.0)
+          return d;
+      }
+      catch (const UnitError &)
+      {
+      }
+    }
+    if (spec.min && spec.max && *spec.min > 0.0 && *spec.max > 0.0)
+      return std::sqrt(*spec.min * *spec.max);
+    return 0.0;
+  }
+
   static std::vector<double> point(const YAML::Node &node, size_t n, Dimension d, const std::string &what)
   {
     if (!node.IsSequence() || node.size() != n)
@@ -651,8 +800,6 @@ private:
     const std::string pretty = format_quantity(v, spec.dimension);
     if (spec.dimension != Dimension::dimensionless && spec.type == KeyType::quantity && pretty != written)
       message += " (= " + pretty + ")";
-    if (spec.dimension == Dimension::angle && written.find_first_not_of("0123456789.+-eE ") == std::string::npos)
-      message += "; a bare number is in radians: write e.g. '90 deg'";
     throw UnitError(message);
   }
 
@@ -1078,6 +1225,7 @@ private:
     d.time_step = q(s, "time_step");
     d.time_step_safety = q(s, "time_step_safety");
     d.duration = q(s, "duration");
+    d.leg = flag(s, "leg");
     d.output_interval = q(s, "output_interval");
     d.checkpoint_interval = q(s, "checkpoint_interval");
     d.checkpoint_wall_interval = q(s, "checkpoint_wall_interval");

@@ -361,6 +361,86 @@ void check_dem(const Case &c, std::vector<CaseIssue> &out)
                                               " is shorter than the time step " + T(d.time_step)});
 }
 
+// The averaging windows of the measurements a run makes: each averages its samples from its
+// average_from to the end of the run, dem.duration, so a window that starts at or after the end,
+// or holds less than one sample interval (or, for the developed image, less than one block: an
+// image period of drum travel), would report a mean of nothing. Only the measurements the scene
+// has are checked: the conditions are those of the measurements' applies() in dem/measurements/.
+void check_averaging_windows(const Case &c, std::vector<CaseIssue> &out)
+{
+  const double duration = c.dem.duration;
+  if (!(duration > 0.0) || c.dem.leg)
+    return; // no run, or a first leg: the windows may open after it, in the run that continues it
+  const auto T = [](double t) { return format_quantity(t, Dimension::time); };
+  const bool slab = c.sleeve && c.dem.periodic_length > 0.0;
+  const bool nip = slab && c.drum.present;
+  const bool toner = std::any_of(c.populations.begin(), c.populations.end(),
+                                 [](const Population &p) { return p.kind == ParticleKind::toner; });
+  const bool doctor_blade = std::any_of(c.blades.begin(), c.blades.end(),
+                                        [](const BladeOrGuide &b) { return b.is_doctor_blade; });
+  struct Window
+  {
+    bool applies;
+    const char *section; // "nip": keys nip.average_from, nip.sample_interval
+    const char *what;    // "the nip profiles"
+    double from, interval;
+  };
+  const Window windows[] = {
+      {nip, "nip", "the nip profiles", c.nip.average_from, c.nip.sample_interval},
+      {nip && c.electric.enabled && toner, "development", "the developed toner", c.development.average_from,
+       c.development.sample_interval},
+      {slab && (doctor_blade || c.dma.release_from != c.dma.release_to), "dma", "the developer on the sleeve",
+       c.dma.average_from, c.dma.sample_interval},
+      {c.flow.inflow() || c.flow.outflow(), "flow_report", "the flow report", c.flow.average_from,
+       c.flow.sample_interval},
+  };
+  for (const Window &w : windows)
+  {
+    if (!w.applies)
+      continue;
+    const std::string section = w.section, from_key = section + ".average_from",
+                      interval_key = section + ".sample_interval";
+    const std::string from = from_key + " = " + T(w.from), end = "dem.duration = " + T(duration);
+    if (w.from >= duration)
+      out.push_back({from_key, "the averaging window of " + std::string(w.what) + " starts at or after the end of the run (" +
+                                   from + ", " + end + "): its means would average no sample; set " + from_key +
+                                   " below dem.duration, or run longer (a first leg of a run to be continued: "
+                                   "dem.leg: true)"});
+    else if (duration - w.from < w.interval)
+      out.push_back({from_key, "the averaging window of " + std::string(w.what) + " (" + from + " to " + end + ": " +
+                                   T(duration - w.from) + ") is shorter than one sample interval (" + interval_key +
+                                   " = " + T(w.interval) + "): its means would average at most one sample"});
+  }
+  // The developed image averaged in blocks fixed to the drum (development.average_over:
+  // image_periods): a striped image's blocks are its periods, a uniform image's (solid or dark)
+  // development.block_length. The window must let the drum carry at least one block past the
+  // measuring line, or no whole block is averaged.
+  const LatentImage &image = c.electric.image;
+  const bool striped = image.striped();
+  const double block = striped ? image.period : c.development.block_length;
+  const double drum_speed = std::abs(c.drum.omega()) * c.drum.radius;
+  if (nip && c.electric.enabled && toner && c.development.average_over == "image_periods" && block > 0.0 &&
+      c.development.average_from < duration && drum_speed > 0.0)
+  {
+    const double block_time = block / drum_speed;
+    if (duration - c.development.average_from < block_time)
+      out.push_back({"development.average_from",
+                     "the averaging window (development.average_from = " + T(c.development.average_from) +
+                         " to dem.duration = " + T(duration) + ": " + T(duration - c.development.average_from) +
+                         ") is shorter than one block of the developed image's means (" +
+                         (striped ? "one image period, electric.image.period = " : "development.block_length = ") +
+                         format_quantity(block, Dimension::length) + " of drum surface at " +
+                         format_quantity(drum_speed, Dimension::velocity) + ": " + T(block_time) +
+                         "): no whole block would be averaged"});
+  }
+  // A plate-compression row is the mean of the samples in its window.
+  if (c.scene == "box" && c.compression.average_window < c.compression.sample_interval)
+    out.push_back({"compression.average_window", "the averaging window compression.average_window = " +
+                                                     T(c.compression.average_window) +
+                                                     " is shorter than one sample interval (compression.sample_interval = " +
+                                                     T(c.compression.sample_interval) + "): a row would average at most one sample"});
+}
+
 void check_flow(const Case &c, std::vector<CaseIssue> &out)
 {
   const FlowSettings &f = c.flow;
@@ -456,6 +536,7 @@ std::vector<CaseIssue> validate_case(const Case &c)
   check_populations(c, out);
   check_fields(c, out);
   check_dem(c, out);
+  check_averaging_windows(c, out);
   check_flow(c, out);
   check_measurements(c, out);
   return out;

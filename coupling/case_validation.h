@@ -1,6 +1,7 @@
 // Geometric and physical consistency of a resolved case: the checks a schema cannot express
 // (the drum must not cut the sleeve, a blade must sit outside it, the magnet must fit inside
-// the sleeve, a size distribution must stay positive, toner needs a charge, ...).
+// the sleeve, a size distribution must stay positive, toner needs a charge, every measurement's
+// averaging window lies inside the run, ...).
 #pragma once
 
 #include "coupling/case_model.h"

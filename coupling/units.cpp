@@ -3,6 +3,7 @@
 // and the result is accepted only when its exponents equal those of the expected dimension.
 #include "coupling/units.h"
 
+#include <algorithm>
 #include <array>
 #include <cctype>
 #include <cmath>
@@ -232,13 +233,16 @@ size_t scan_number(const std::string &s)
   return i;
 }
 
+// The message for a refused bare number (defined with the display units below).
+std::string bare_number_message(const std::string &number_text, double number, Dimension d, double typical_si);
+
 } // namespace
 
 std::string dimension_description(Dimension d) { return info(d).description; }
 std::string dimension_example(Dimension d) { return info(d).example; }
 std::string si_unit(Dimension d) { return info(d).si; }
 
-double parse_quantity(const std::string &original, Dimension expected)
+double parse_quantity(const std::string &original, Dimension expected, BareNumber bare, double typical_si)
 {
   const std::string text = normalise_unicode(original);
   size_t begin = text.find_first_not_of(" \t");
@@ -313,7 +317,9 @@ double parse_quantity(const std::string &original, Dimension expected)
   if (pending != 0)
     fail(original, expected, "the unit ends with '" + std::string(1, pending) + "'");
 
-  // A bare number is SI, whatever the expected dimension.
+  // A bare number: a plain number, a zero, or (BareNumber::si) SI; otherwise refused.
+  if (!any_symbol && expected != Dimension::dimensionless && number != 0.0 && bare == BareNumber::refused)
+    throw UnitError(bare_number_message(s, number, expected, typical_si));
   if (any_symbol && exponents != info(expected).exponents)
     fail(original, expected, "that is " + describe_exponents(exponents));
   const double value = number * factor;
@@ -375,7 +381,70 @@ std::string format_number(double x)
   std::snprintf(buffer, sizeof(buffer), "%.6g", x);
   return buffer;
 }
+
+// The units a bare number is weighed against: the display units and a few more that case
+// files use, with the scale a value of this dimension usually has in this code.
+struct UsualUnits
+{
+  std::vector<DisplayUnit> units;
+  double typical; // SI
+};
+
+UsualUnits usual_units(Dimension d)
+{
+  std::vector<DisplayUnit> units = display_units(d).units;
+  const auto add = [&](const char *symbol, double factor) { units.push_back({symbol, factor}); };
+  double typical = 1.0;
+  switch (d)
+  {
+  case Dimension::length: typical = 1e-3; break;
+  case Dimension::time: typical = 1e-3; break;
+  case Dimension::angle: add("rad", 1.0); typical = 0.5; break;
+  case Dimension::angular_velocity: add("rad/s", 1.0); typical = 100.0 * 2.0 * pi / 60.0; break;
+  case Dimension::magnetic_flux_density: typical = 0.1; break;
+  case Dimension::magnetisation: typical = 1e5; break;
+  case Dimension::voltage: typical = 100.0; break;
+  case Dimension::pressure: add("GPa", 1e9); typical = 1e6; break;
+  case Dimension::density: add("g/cm^3", 1e3); typical = 1e3; break;
+  case Dimension::charge_to_mass: add("C/kg", 1.0); typical = 0.03; break;
+  case Dimension::surface_charge: add("C/m^2", 1.0); typical = 1e-4; break;
+  case Dimension::mass: typical = 1e-3; break;
+  case Dimension::frequency: typical = 1e3; break;
+  case Dimension::charge: typical = 1e-15; break;
+  case Dimension::force: typical = 1e-3; break;
+  case Dimension::electric_field: typical = 1e6; break;
+  default: break;
+  }
+  return {units, typical};
+}
+
+std::string bare_number_message(const std::string &number_text, double number, Dimension d, double typical_si)
+{
+  const std::vector<std::string> units = likely_units(number, d, typical_si);
+  const std::string written = shortened(number_text);
+  std::string message = written + " \xE2\x80\x94 " + dimension_description(d) + " needs a unit: ";
+  for (size_t k = 0; k < units.size(); ++k)
+    message += (k ? " or " : "") + written + " " + units[k];
+  return message + "? (a bare number is not read as SI; only 0 may go without a unit)";
+}
 } // namespace
+
+std::vector<std::string> likely_units(double number, Dimension d, double typical_si)
+{
+  const UsualUnits usual = usual_units(d);
+  const double typical = (typical_si != 0.0 && std::isfinite(typical_si)) ? std::abs(typical_si) : usual.typical;
+  const double magnitude = std::abs(number);
+  std::vector<std::pair<double, std::string>> ranked; // log10 distance from the typical scale
+  for (const auto &u : usual.units)
+    ranked.emplace_back(magnitude > 0.0 ? std::abs(std::log10(magnitude * u.factor / typical)) : 0.0, u.symbol);
+  std::stable_sort(ranked.begin(), ranked.end(),
+                   [](const auto &a, const auto &b) { return a.first < b.first; });
+  std::vector<std::string> out{ranked.front().second};
+  // A second unit when the number is nearly as plausible in it (within a factor 10).
+  if (ranked.size() > 1 && ranked[1].first < ranked[0].first + 1.0)
+    out.push_back(ranked[1].second);
+  return out;
+}
 
 std::string format_quantity(double si_value, Dimension d)
 {

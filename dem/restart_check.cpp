@@ -8,7 +8,7 @@ namespace magbrush::dem {
 
 bool is_run_control_key(const std::string &key)
 {
-  static const char *const exact[] = {"dem.duration", "dem.output_interval", "dem.checkpoint_interval",
+  static const char *const exact[] = {"dem.duration", "dem.leg", "dem.output_interval", "dem.checkpoint_interval",
                                       "dem.checkpoint_wall_interval", "dem.threads",
                                       // where the stored fields are: what they hold is checked
                                       // against the case when they are read (their provenance)

@@ -108,7 +108,9 @@ def parse_length_mm(text):
     for unit, f in (("mm", 1.0), ("um", 1e-3), ("m", 1e3)):
         if t.endswith(unit):
             return float(t[: -len(unit)]) * f
-    return float(t) * 1e3  # bare number: SI metres
+    if float(t) == 0.0:
+        return 0.0
+    raise ValueError("--box %s: a length needs a unit: %s mm?" % (text, text))
 
 
 def main():
@@ -128,7 +130,10 @@ def main():
     a = p.parse_args()
 
     out = a.output or os.path.join("results", "compression_study")
-    box = parse_length_mm(a.box)
+    try:
+        box = parse_length_mm(a.box)
+    except ValueError as e:
+        p.error(str(e))
     scale = (box / PAPER_AREA_MM) ** 2
     exe = os.path.join(a.build, "bin", "magbrush-dem")
     runs, rows = [], []

@@ -606,7 +606,14 @@ def key_numbers(summary, nip_series, series, flux, run_summary=None, flow=None):
         v = summary.get(key, (float("nan"), ""))[0]
         return v if isinstance(v, float) else float("nan")
 
-    if summary:
+    samples = val("samples") if summary else float("nan")
+    if summary and not (math.isfinite(samples) and samples > 0):
+        # Nothing was averaged (the run ended before nip.average_from): no number is a mean
+        # of the nip, so none is printed.
+        rows.append(("nip profile", "no samples in the averaging window",
+                     "the run ended before nip.average_from, or within one nip.sample_interval of it",
+                     "no means to report"))
+    elif summary:
         rel = val("relative_surface_speed")
         slip = val("slip_at_gap_centre")
         rows.append(("slip speed at the gap centre", f"{fmt(slip)} m/s (bead spread {fmt(val('slip_std_at_gap_centre'), 2)})",

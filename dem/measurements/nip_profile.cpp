@@ -261,6 +261,8 @@ double NipProfile::sliding_downstream_share() const
 
 double NipProfile::peak_normal_pressure() const
 {
+  if (samples_ == 0)
+    return nan; // no sample in the averaging window: no peak, not 0 Pa
   double peak = 0.0;
   for (const auto &b : bins())
     peak = std::max(peak, b.normal_pressure);
@@ -325,8 +327,9 @@ std::string NipProfile::summary_csv() const
   o << "# Key numbers of the nip profile (magbrush nip profile); NaN: not available\n";
   o << "key,value,unit,meaning\n";
   row("samples", static_cast<double>(samples_), "1", "samples averaged");
-  row("t_from", t_first_, "s", "first averaged sample");
-  row("t_to", t_last_, "s", "last averaged sample");
+  // No sample in the averaging window: no times either (the report says so instead of a window).
+  row("t_from", samples_ > 0 ? t_first_ : nan, "s", "first averaged sample");
+  row("t_to", samples_ > 0 ? t_last_ : nan, "s", "last averaged sample");
   row("relative_surface_speed", frame_.relative_surface_speed(), "m/s", "sleeve minus drum surface speed at the nip");
   row("slip_at_gap_centre", centre.slip, "m/s", "mean slip of the beads touching the drum in the centre bin");
   row("slip_std_at_gap_centre", centre.slip_std, "m/s", "spread of that slip over beads and samples");

@@ -126,7 +126,7 @@ roller:
   shaft_mu_r: 1e12             # ideal iron
   magnet_radius: 9.3 mm
   magnet_mu_r: 1
-  shape_factor: 10
+  shape_factor: 10 rad^-2
   poles:
     - {name: S1, angle: 0 deg, strength: -300 kA/m}
     - {name: N1, angle: 70 deg, strength: 150 kA/m}

@@ -1,6 +1,7 @@
 // The command lines of the built programs: every subcommand's --help exits 0, `magbrush run`
 // offers the stages' options, and an option of another stage is an error where it does not
-// belong (magbrush-dem rejects the field solver's -np like any unknown option).
+// belong (magbrush-dem rejects the field solver's -np like any unknown option), and a mistyped
+// option or subcommand gets a did-you-mean.
 #include "common/child_process.h"
 
 #include <gtest/gtest.h>
@@ -87,6 +88,20 @@ TEST(ProgramCommandLines, TyposGetASuggestion)
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("magbrush run: unknown option '--thraeds' (did you mean '--threads'?)"), std::string::npos)
       << r.output;
+  // A mistyped subcommand gets the nearest one, and the list of commands.
+  const Result command = run({bin + "magbrush", "rnu", nip_case});
+  EXPECT_EQ(command.status, 2) << command.output;
+  EXPECT_NE(command.output.find("magbrush: unknown command 'rnu' (did you mean 'run'?)"), std::string::npos)
+      << command.output;
+  EXPECT_NE(command.output.find("Commands:"), std::string::npos) << command.output;
+  EXPECT_NE(run({bin + "magbrush", "chekc"}).output.find("(did you mean 'check'?)"), std::string::npos);
+  // A case file given without a command gets the command that runs it.
+  const Result file_first = run({bin + "magbrush", nip_case});
+  EXPECT_EQ(file_first.status, 2) << file_first.output;
+  EXPECT_NE(file_first.output.find("a case file comes after the command: magbrush run " + nip_case), std::string::npos)
+      << file_first.output;
+  // Nothing near: no suggestion.
+  EXPECT_EQ(run({bin + "magbrush", "frobnicate"}).output.find("did you mean"), std::string::npos);
 }
 
 } // namespace

@@ -239,6 +239,8 @@ TEST(RestartCheck, RunControlMayDifferTheSceneMayNot)
   // Where the stored fields are is not what they hold (their provenance is checked on reading):
   // a run moved into a sweep's folder, whose fields live per digest, continues.
   EXPECT_TRUE(is_run_control_key("field.output_dir"));
+  // A first leg (dem.leg) is continued without it.
+  EXPECT_TRUE(is_run_control_key("dem.leg"));
 
   // A key the schema gained after the checkpoint was written: at its default it is flagged
   // (the restart goes on), at another value it is a difference of the scene.

@@ -200,7 +200,7 @@ TEST(MeshCommand, UnchangedInputsAreNotRemeshed)
   EXPECT_EQ(fs::last_write_time(dir + "/nip.msh"), written);
 
   // The run-control keys change no mesh.
-  const Result longer = run(args + " --set dem.duration=2ms");
+  const Result longer = run(args + " --set dem.duration=30ms");
   EXPECT_NE(longer.output.find("nip mesh: up to date"), std::string::npos) << longer.output;
 
   const Result gap = run(args + " --set drum.gap=0.45mm");

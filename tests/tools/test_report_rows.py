@@ -1,5 +1,6 @@
 """Rows of the run report (tools/report.py) from synthetic measurement files: the steady-state
-verdict, the particle budget and the closed sump of a fed scene, the nip window's budget. Stdlib only, so any Python 3
+verdict, the particle budget and the closed sump of a fed scene, the nip window's budget, the
+nip's key numbers (none when the averaging window held no sample). Stdlib only, so any Python 3
 runs it."""
 
 import math
@@ -169,6 +170,32 @@ class WindowBudgetRow(unittest.TestCase):
         # 20 beads removed inside the window never crossed its downstream edge.
         row = report.window_budget_row(nip_series([3765, 3891], 3626, 3480))
         self.assertTrue(row[3].startswith("does NOT hold (off by -20)"), row)
+
+
+def nip_summary(samples, t_from, t_to, peak):
+    """nip_summary.csv as report.read_summary returns it: {key: (value, unit)}."""
+    return {"samples": (float(samples), "1"), "t_from": (t_from, "s"), "t_to": (t_to, "s"),
+            "relative_surface_speed": (0.1348, "m/s"), "slip_at_gap_centre": (0.12, "m/s"),
+            "peak_normal_pressure": (peak, "Pa"), "normal_force_per_length": (0.62, "N/m")}
+
+
+class NipRows(unittest.TestCase):
+    """The nip's key numbers: means over the averaging window, or nothing when it held no sample."""
+
+    def test_no_samples_gives_no_numbers(self):
+        # A run shorter than nip.average_from: the engine writes 0 samples and NaN times; the
+        # report must not print "0 kPa averaged over 0 samples, t = nan .. nan ms".
+        rows = report.key_numbers(nip_summary(0, math.nan, math.nan, math.nan), None, None, None)
+        self.assertEqual([r[1] for r in rows], ["no samples in the averaging window"], rows)
+        # What older engines wrote (t = -1 s, a peak of 0 Pa) reads the same.
+        rows = report.key_numbers(nip_summary(0, -1.0, -1.0, 0.0), None, None, None)
+        self.assertEqual([r[1] for r in rows], ["no samples in the averaging window"], rows)
+        self.assertFalse(any("kPa" in r[1] for r in rows), rows)
+
+    def test_samples_give_the_window(self):
+        rows = report.key_numbers(nip_summary(25000, 0.025, 0.075, 360.0), None, None, None)
+        self.assertIn(("averaged over", "25000 samples, t = 25 .. 75 ms", "", ""), rows)
+        self.assertTrue(any(r[0] == "peak normal pressure on the drum" for r in rows), rows)
 
 
 if __name__ == "__main__":

@@ -310,7 +310,7 @@ TEST(CaseParser, DefaultsAgreeWithTheContractStruct)
 
 TEST(CaseParser, OverridesUseTheSameConversionAndNames)
 {
-  const Case c = load_case(minimal, {"drum.gap=0.3mm", "roller.poles.S1.angle=95deg", "roller.poles.[0].strength=1.2e5",
+  const Case c = load_case(minimal, {"drum.gap=0.3mm", "roller.poles.S1.angle=95deg", "roller.poles.[0].strength=1.2e5 A/m",
                                      "sleeve.rpm=-2 rad/s", "electric.bias=-500 V"});
   EXPECT_NEAR(c.drum.gap, 0.3e-3, 1e-18);
   EXPECT_NEAR(c.roller->poles[1].angle, 95 * pi / 180, 1e-15);
@@ -320,6 +320,11 @@ TEST(CaseParser, OverridesUseTheSameConversionAndNames)
   EXPECT_DOUBLE_EQ(c.electric.bias, -500.0);
   // A later override wins.
   EXPECT_NEAR(load_case(minimal, {"drum.gap=1mm", "drum.gap=2mm"}).drum.gap, 2e-3, 1e-18);
+  // A bare number needs its unit in an override as in the file (0 excepted).
+  const std::string bare = error_of(read_file(minimal), {"drum.gap=0.3"});
+  EXPECT_NE(bare.find("--set 'drum.gap=0.3': drum.gap: 0.3 \u2014 a length needs a unit: 0.3 mm?"), std::string::npos)
+      << bare;
+  EXPECT_EQ(load_case(minimal, {"drum.pc_thickness=0"}).drum.pc_thickness, 0.0);
   // Errors name the override, not the file.
   const std::string e = error_of(read_file(minimal), {"roller.poles.S1.angle=-5deg"});
   EXPECT_NE(e.find("--set 'roller.poles.S1.angle=-5deg': roller.poles.S1.angle: expected an angle in [0 deg, 360 deg)"),
@@ -382,6 +387,50 @@ TEST(CaseParser, GeometryNonsenseIsCaughtInProcess)
   // Geometry errors are collected too.
   const std::string two = error_of(base, {"drum.gap=-1mm", "roller.shaft_radius=9.5mm"});
   EXPECT_NE(two.find("(2 errors)"), std::string::npos) << two;
+}
+
+// Every measurement's averaging window lies inside the run and holds more than one sample
+// interval (the developed image in blocks: at least one block of drum travel), or the case is
+// refused naming both keys and their values.
+TEST(CaseParser, AveragingWindowsLieInsideTheRun)
+{
+  const std::string fed = source_dir + "/cases/kawamoto_nip_fed.yaml";
+  const std::string late = error_of(read_file(fed), {"dem.duration=0.5ms"});
+  EXPECT_NE(late.find("nip.average_from: the averaging window of the nip profiles starts at or after the end of the "
+                      "run (nip.average_from = 25 ms, dem.duration = 500 us)"),
+            std::string::npos)
+      << late;
+  EXPECT_NE(late.find("flow_report.average_from"), std::string::npos) << late;
+  EXPECT_NO_THROW(load_case(fed, {"dem.duration=0.5ms", "nip.average_from=0s", "flow_report.average_from=0s"}));
+  // A first leg of a longer run (a sweep's spin-up, a run to be continued) says so.
+  EXPECT_NE(late.find("a first leg of a run to be continued: dem.leg: true"), std::string::npos) << late;
+  EXPECT_NO_THROW(load_case(fed, {"dem.duration=0.5ms", "dem.leg=true"}));
+  const std::string short_window = error_of(read_file(fed), {"dem.duration=25.01ms"});
+  EXPECT_NE(short_window.find("shorter than one sample interval (flow_report.sample_interval = 20 us)"),
+            std::string::npos)
+      << short_window;
+  // The developed image over whole periods: 1 um of drum at ~0.27 m/s is ~3.7 us.
+  const std::string cell = source_dir + "/tests/scenes/development/development_cell.yaml";
+  const std::vector<std::string> periods{"development.average_over=image_periods", "electric.image.period=1um",
+                                         "dem.duration=10us", "nip.average_from=0s"};
+  auto with = [&](std::string o) {
+    auto v = periods;
+    v.push_back(std::move(o));
+    return v;
+  };
+  const std::string block = error_of(read_file(cell), with("development.average_from=9us"));
+  EXPECT_NE(block.find("shorter than one block of the developed image's means (one image period, "
+                       "electric.image.period = 1 um"),
+            std::string::npos)
+      << block;
+  EXPECT_NO_THROW(load_case(cell, with("development.average_from=0s")));
+  // A solid area's blocks are development.block_length of drum.
+  const std::string solid = error_of(read_file(cell), {"development.average_over=image_periods", "electric.image.duty=1",
+                                                       "development.block_length=10um", "dem.duration=10us",
+                                                       "nip.average_from=0s", "development.average_from=9us"});
+  EXPECT_NE(solid.find("(development.block_length = 10 um of drum surface"), std::string::npos) << solid;
+  // A measurement the scene does not have is not checked (no periodic slab: no nip measurement).
+  EXPECT_NO_THROW(load_case(minimal, {"dem.duration=1ms", "nip.average_from=5ms"}));
 }
 
 TEST(CaseParser, GeneratedBladePolygon)

@@ -174,6 +174,7 @@ TEST(ModuleDefaults, DemSettingsOfADefaultCaseAreTheStructDefaults)
   EXPECT_SAME(from_case, built, max_overlap_fraction);
   EXPECT_SAME_EXACT(from_case, built, restitution_model);
   EXPECT_SAME(from_case, built, settle_time);
+  EXPECT_SAME_EXACT(from_case, built, leg);
   EXPECT_SAME(from_case, built, max_kinetic_energy_growth);
   EXPECT_SAME(from_case, built, adhesion_cutoff);
   EXPECT_SAME(from_case, built, adhesion_range_fraction);

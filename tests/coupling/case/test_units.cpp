@@ -1,4 +1,4 @@
-// Units: every unit symbol, SI prefixes, µ/μ/u, exponents, bare numbers, dimension
+// Units: every unit symbol, SI prefixes, µ/μ/u, exponents, bare numbers refused, dimension
 // mismatches, garbage, and format_quantity <-> parse_quantity round trips.
 #include "coupling/units.h"
 
@@ -119,15 +119,45 @@ TEST(Units, Mechanical)
   expect_si("10 rad^-2", Dimension::inverse_angle_squared, 10.0);
 }
 
-TEST(Units, BareNumbersArePlainSI)
+TEST(Units, BareNumbersAreRefusedWithAUnitSuggested)
 {
-  expect_si("0.025", Dimension::length, 0.025);
-  expect_si("1.5", Dimension::angle, 1.5);
-  expect_si("-3", Dimension::voltage, -3.0);
-  expect_si("+2.5e-3", Dimension::time, 2.5e-3);
+  // A dimensional quantity needs its unit: a bare number is an error naming the dimension and
+  // the unit its magnitude suggests.
+  EXPECT_NE(error_of("0.3", Dimension::length).find("0.3 \u2014 a length needs a unit: 0.3 mm?"), std::string::npos)
+      << error_of("0.3", Dimension::length);
+  EXPECT_NE(error_of("300", Dimension::length).find("300 um?"), std::string::npos);
+  EXPECT_NE(error_of("90", Dimension::angle).find("an angle needs a unit: 90 deg?"), std::string::npos);
+  EXPECT_NE(error_of("1.5708", Dimension::angle).find("needs a unit: 1.5708 rad"), std::string::npos);
+  EXPECT_NE(error_of("-600", Dimension::voltage).find("-600 V?"), std::string::npos);
+  EXPECT_NE(error_of("219", Dimension::angular_velocity).find("needs a unit: 219 rpm"), std::string::npos);
+  EXPECT_NE(error_of("+2.5e-3", Dimension::time).find("a time needs a unit"), std::string::npos);
+  EXPECT_NE(error_of("10", Dimension::inverse_angle_squared).find("10 rad^-2?"), std::string::npos);
+  EXPECT_NE(error_of("0.3", Dimension::length).find("a bare number is not read as SI"), std::string::npos);
+  // As plausible in two units: both are offered.
+  EXPECT_NE(error_of("60", Dimension::length).find("60 um or 60 mm?"), std::string::npos) << error_of("60", Dimension::length);
+  // A bare zero is zero in every unit: accepted.
+  expect_si("0", Dimension::length, 0.0);
+  expect_si("0.0", Dimension::angle, 0.0);
+  expect_si("-0", Dimension::voltage, 0.0);
+  expect_si("0e3", Dimension::time, 0.0);
+  // Plain numbers stay bare.
   expect_si(".5", Dimension::dimensionless, 0.5);
   expect_si("7 %", Dimension::dimensionless, 0.07);
-  expect_si("10", Dimension::inverse_angle_squared, 10.0);
+  // Where a caller reads data documented as SI, bare numbers are SI.
+  EXPECT_DOUBLE_EQ(parse_quantity("0.025", Dimension::length, BareNumber::si), 0.025);
+  EXPECT_DOUBLE_EQ(parse_quantity("1.5", Dimension::angle, BareNumber::si), 1.5);
+}
+
+TEST(Units, LikelyUnitsFollowTheTypicalScale)
+{
+  EXPECT_EQ(likely_units(0.3, Dimension::length), std::vector<std::string>{"mm"});
+  EXPECT_EQ(likely_units(300, Dimension::length), std::vector<std::string>{"um"});
+  EXPECT_EQ(likely_units(90, Dimension::angle), std::vector<std::string>{"deg"});
+  // A key's own scale (its default) decides: a time step of 2e-8 is in seconds.
+  EXPECT_EQ(likely_units(2e-8, Dimension::time, 40e-9).front(), "s");
+  EXPECT_EQ(likely_units(40, Dimension::time, 40e-9).front(), "ns");
+  // A Young's modulus written in SI.
+  EXPECT_EQ(likely_units(1e9, Dimension::pressure, 1e9).front(), "Pa");
 }
 
 TEST(Units, DimensionMismatchSaysBoth)

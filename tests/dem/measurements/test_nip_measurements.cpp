@@ -104,6 +104,20 @@ TEST(NipFrame, RelativeSpeedAndCoordinatesOfThePrototype)
   EXPECT_THROW(NipFrame::from_case(no_drum), std::invalid_argument);
 }
 
+// A run that ends before nip.average_from averages nothing: no peak pressure (not 0 Pa) and
+// no averaging times (not -1 s) in nip_summary.csv, so that no report prints a mean of nothing.
+TEST(NipProfile, NoSamplesGiveNoNumbers)
+{
+  const NipProfile profile(nip_case());
+  ASSERT_EQ(profile.samples(), 0);
+  EXPECT_TRUE(std::isnan(profile.peak_normal_pressure()));
+  const std::string summary = profile.summary_csv();
+  EXPECT_NE(summary.find("samples,0,"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("t_from,nan,"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("t_to,nan,"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("peak_normal_pressure,nan,"), std::string::npos) << summary;
+}
+
 TEST(NipProfile, HandPlacedBeadsGiveExactBinValues)
 {
   const Case c = nip_case(0.4);

@@ -36,7 +36,7 @@ fs::path write_true_case(const fs::path &dir)
          "  magnet_radius: 12 mm\n  magnet_mu_r: 1\n  poles:\n";
   for (const Pole &p : true_roller(per_pole_alpha).poles)
     out << "    - {name: " << p.name << ", angle: " << p.angle / deg << " deg, strength: "
-        << p.strength << " A/m, shape_factor: " << p.shape_factor << "}\n";
+        << p.strength << " A/m, shape_factor: " << p.shape_factor << " rad^-2}\n";
   out << "sleeve:\n  radius: " << probe_radius * 1e3 << " mm\n  thickness: 0.3 mm\n"
       << "field:\n  output_dir: " << (dir / "fields").string() << "\n";
   return path;

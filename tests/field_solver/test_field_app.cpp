@@ -1,6 +1,7 @@
 // The production field stage end to end (bin/magbrush-field on a paper case, coarse mesh):
 // the first run stores both fields; an unchanged case is "up to date" and rewrites nothing;
-// moving a pole regenerates only the magnetic field; changing the bias only the electric one.
+// moving a pole regenerates only the magnetic field; changing the bias only the electric one; a
+// solid area is stored as one phase.
 #include "coupling/cartesian_field_interpolator.h"
 #include "coupling/field_grid.h"
 
@@ -21,15 +22,18 @@ namespace {
 
 const std::string out_dir = (magbrush::testing::test_temp_dir("field_app") / "out").string();
 
+// The case with its 1 mm lines (an image that moves with the drum) instead of its solid area.
+const std::string striped = "--set electric.image.period=2mm --set electric.image.duty=0.5 "
+                            "--set development.block_length=0m ";
+
 // The case's own mesh settings: a coarser nip mesh makes the field stage slower, not faster
 // (the continuation into the conductors searches anchors its polygonal cells miss).
-std::string run_field(const std::string &extra, int &rc)
+std::string run_field(const std::string &extra, int &rc, const std::string &lines = striped)
 {
   const std::string log = out_dir + ".log";
   const std::string command =
     std::string(MAGBRUSH_BINARY_DIR) + "/bin/magbrush-field " + MAGBRUSH_SOURCE_DIR +
-    "/cases/kweon_development.yaml --no-vtu --set field.output_dir=" + out_dir +
-    " " + extra + " > " +
+    "/cases/kweon_development.yaml --no-vtu --set field.output_dir=" + out_dir + " " + lines + extra + " > " +
     log + " 2>&1";
   rc = std::system(command.c_str());
   std::ifstream in(log);
@@ -84,6 +88,13 @@ TEST(FieldApp, StoresFieldsAndReusesThemUntilTheirInputsChange)
   ASSERT_EQ(rc, 0) << biased;
   EXPECT_NE(biased.find("magnetic field up to date"), std::string::npos) << biased;
   EXPECT_NE(biased.find("computing the electric field"), std::string::npos) << biased;
+
+  // The case's own solid area is the same at every phase of the drum: one solve, no period.
+  const std::string solid = run_field("--only electric", rc, "");
+  ASSERT_EQ(rc, 0) << solid;
+  const auto s = magbrush::read_electric_grid(electric);
+  EXPECT_EQ(s.grid.phase_samples(), 1);
+  EXPECT_EQ(s.grid.image_period, 0.0);
   fs::remove_all(out_dir);
 }
 

@@ -134,7 +134,10 @@ TEST(LinearAlgebraBackends, GiveTheSameRollerFieldOnTheDevelopmentCell)
 // Φ on the stored window over the nip (field_app.cpp), bias alone and image alone.
 TEST(LinearAlgebraBackends, GiveTheSameNipFieldOnTheDevelopmentCell)
 {
-  const Case c = default_case("kweon_development");
+  // The case's 1 mm lines rather than its solid area: an image that varies along the drum.
+  Case c = default_case("kweon_development");
+  c.electric.image.period = 2e-3;
+  c.electric.image.duty = 0.5;
   ASSERT_TRUE(c.electric.enabled);
   const NipLayout layout = NipLayout::from(c.sleeve->radius, c.drum.radius, c.drum.gap,
                                            c.drum.angle, c.drum.pc_thickness);

@@ -430,6 +430,40 @@ struct PointSetup
   fs::path dir;
 };
 
+// The stored fields go where every run with the same field inputs finds them (named by the
+// digests of those inputs): a study over a blade gap, a bias or a carrier solves the roller
+// field once; two ranks solving the same field at once both write atomically. Returns the
+// override that puts them there.
+std::string fields_override(const SweepPlan &plan, const std::vector<std::string> &overrides)
+{
+  const Case c = load_case(plan.case_path, overrides);
+  return "field.output_dir=" +
+         (plan.sweep_dir / "fields" / (field_hash(c, FieldKind::magnetic) + "_" + field_hash(c, FieldKind::electric)))
+           .string();
+}
+
+// `magbrush run`'s words for one run of the sweep: the case, the stages skipped, the overrides,
+// the stages' own options as the user gave them, and `threads` (> 0) unless the user gave --threads.
+std::vector<std::string> run_words(const SweepPlan &plan, const std::string &skip,
+                                   const std::vector<std::string> &overrides, const cli::ParsedArguments &args,
+                                   int threads)
+{
+  std::vector<std::string> words = {"run", plan.case_path, "--skip", skip};
+  for (const auto &o : overrides)
+  {
+    words.push_back("--set");
+    words.push_back(o);
+  }
+  const auto stage_words = options_for_the_stages(args);
+  words.insert(words.end(), stage_words.begin(), stage_words.end());
+  if (threads > 0 && !args.has("--threads"))
+  {
+    words.push_back("--threads");
+    words.push_back(std::to_string(threads));
+  }
+  return words;
+}
+
 PointSetup set_up_point(const SweepPlan &plan, std::size_t n)
 {
   PointSetup point;
@@ -471,14 +505,7 @@ PointSetup set_up_point(const SweepPlan &plan, std::size_t n)
   }
   point.dir = plan.sweep_dir / point.label;
   point.overrides.push_back("output.directory=" + point.dir.string());
-  // The stored fields go where every point with the same field inputs finds them (named by
-  // the digests of those inputs): a study over a blade gap, a bias or a carrier solves the
-  // roller field once; two ranks solving the same field at once both write atomically.
-  const Case fields_of = load_case(plan.case_path, point.overrides);
-  point.overrides.push_back("field.output_dir=" + (plan.sweep_dir / "fields" /
-                                                   (field_hash(fields_of, FieldKind::magnetic) + "_" +
-                                                    field_hash(fields_of, FieldKind::electric)))
-                                                      .string());
+  point.overrides.push_back(fields_override(plan, point.overrides));
   point.point_case = load_case(plan.case_path, point.overrides);
   return point;
 }
@@ -569,25 +596,13 @@ int run_point(const SweepPlan &plan, std::size_t n, const cli::ParsedArguments &
     std::cout << "\n##### magbrush sweep: point " << n + 1 << "/" << plan.points.size() << ": " << point.label
               << " (" << (point.point_case.populations.empty() ? 0 : point.point_case.populations[0].count)
               << " beads) #####" << std::endl;
-    std::vector<std::string> run_args = {"run", plan.case_path, "--skip", plan.skip};
-    for (const auto &o : point.overrides)
-    {
-      run_args.push_back("--set");
-      run_args.push_back(o);
-    }
-    const auto stage_words = options_for_the_stages(args);
-    run_args.insert(run_args.end(), stage_words.begin(), stage_words.end());
+    std::vector<std::string> run_args = run_words(plan, plan.skip, point.overrides, args, threads);
     // A fork of the spin-up, unless it resumes its own checkpoint.
     const bool resumes_itself = args.has("--resume") && fs::exists(point.dir / "dem" / "checkpoint.bin");
     if (plan.spin_up && !resumes_itself)
     {
       const auto fork = fork_words(*plan.spin_up, point.point_case);
       run_args.insert(run_args.end(), fork.begin(), fork.end());
-    }
-    if (threads > 0 && !args.has("--threads"))
-    {
-      run_args.push_back("--threads");
-      run_args.push_back(std::to_string(threads));
     }
     rc = run_pipeline(run_args);
   }
@@ -629,28 +644,11 @@ int run_spin_up(const SweepPlan &plan, const cli::ParsedArguments &args, int thr
   overrides.push_back(duration);
   overrides.push_back("dem.leg=true"); // the points average after its end
   overrides.push_back("output.directory=" + spin.dir.string());
-  const Case spin_case = load_case(plan.case_path, overrides);
-  overrides.push_back("field.output_dir=" + (plan.sweep_dir / "fields" /
-                                             (field_hash(spin_case, FieldKind::magnetic) + "_" +
-                                              field_hash(spin_case, FieldKind::electric)))
-                                                .string());
+  overrides.push_back(fields_override(plan, overrides));
   std::cout << "\n##### magbrush sweep: the spin-up, to " << spin.duration * 1e3 << " ms, into " << spin.dir.string()
             << "/ #####" << std::endl;
-  std::vector<std::string> run_args = {"run", plan.case_path, "--skip", plan.skip + ",report"};
-  for (const auto &o : overrides)
-  {
-    run_args.push_back("--set");
-    run_args.push_back(o);
-  }
-  const auto stage_words = options_for_the_stages(args);
-  run_args.insert(run_args.end(), stage_words.begin(), stage_words.end());
-  if (threads > 0 && !args.has("--threads"))
-  {
-    run_args.push_back("--threads");
-    run_args.push_back(std::to_string(threads));
-  }
   fs::create_directories(spin.dir);
-  const int rc = run_pipeline(run_args);
+  const int rc = run_pipeline(run_words(plan, plan.skip + ",report", overrides, args, threads));
   if (rc != 0)
   {
     std::cerr << "magbrush sweep: the spin-up failed (exit " << rc << "): no point can fork from it\n";

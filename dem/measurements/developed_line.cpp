@@ -9,11 +9,6 @@
 
 namespace magbrush::dem {
 
-namespace {
-// Mass per area; NaN without an area (the dark area of a solid image, the image of a dark drum).
-double per_area(double mass, double area) { return area > 0.0 ? mass / area : std::nan(""); }
-} // namespace
-
 // Written as raw arrays into checkpoints: no padding byte may reach the file.
 static_assert(sizeof(DevelopedLine::Period) == 8 * sizeof(double) + 2 * sizeof(long));
 static_assert(sizeof(DevelopedLine::Bin) == 3 * sizeof(double) + sizeof(long));
@@ -200,7 +195,7 @@ std::string DevelopedLine::periods_csv() const
     const Period &p = periods_[k];
     const double qm = p.image_mass > 0.0 ? p.image_charge / p.image_mass : std::nan("");
     std::snprintf(line, sizeof line, "%zu,%.9g,%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%ld,%ld,%.9g\n", k + 1, p.t_start,
-                  p.t_end, per_area(p.image_mass, p.image_area), per_area(p.dark_mass, p.dark_area), qm, p.image_area,
+                  p.t_end, p.tma(), p.fog(), qm, p.image_area,
                   p.dark_area,
                   p.image_toner, p.dark_toner, p.s_start);
     o << line;

@@ -25,6 +25,7 @@
 #include "dem/measurements/drum_image.h"
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -59,6 +60,10 @@ public:
     double image_charge = 0;               // [C]
     double dark_mass = 0, dark_area = 0;
     long image_toner = 0, dark_toner = 0;
+    // Toner mass per area on the image (TMA) and on the background (fog); NaN without that area
+    // (the background of a solid area, the image of a dark drum).
+    double tma() const { return image_area > 0.0 ? image_mass / image_area : std::numeric_limits<double>::quiet_NaN(); }
+    double fog() const { return dark_area > 0.0 ? dark_mass / dark_area : std::numeric_limits<double>::quiet_NaN(); }
   };
   const std::vector<Period> &periods() const { return periods_; }
   // A uniform image's block by its place on the drum: blocks of two lines with the same index

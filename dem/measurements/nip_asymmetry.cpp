@@ -114,22 +114,31 @@ std::vector<SummaryValue> NipAsymmetry::summary(std::size_t blocks) const
       out.push_back(r.*member);
     return out;
   };
-  return {
-      value_with_error("pressure_centroid_m", "m", "sum F_n x / sum F_n over the beads touching the drum (0: centred)",
-                       force.centroid, per_block(force_blocks, &Ratios::centroid)),
-      value_with_error("pressure_spread_m", "m", "RMS width of the normal force about its centroid along the nip",
-                       force.spread, per_block(force_blocks, &Ratios::spread)),
-      value_with_error("pressure_upstream_over_downstream", "1",
-                       "normal force on the drum before the gap centre (x < 0) over after it (1: symmetric)",
-                       force.up_over_down, per_block(force_blocks, &Ratios::up_over_down)),
-      value_with_error("touching_centroid_m", "m", "mean x of the beads touching the drum (0: centred)",
-                       count.centroid, per_block(count_blocks, &Ratios::centroid)),
-      value_with_error("touching_spread_m", "m", "RMS width of the touching beads about their centroid",
-                       count.spread, per_block(count_blocks, &Ratios::spread)),
-      value_with_error("touching_upstream_over_downstream", "1",
-                       "beads touching the drum before the gap centre over after it (1: symmetric)",
-                       count.up_over_down, per_block(count_blocks, &Ratios::up_over_down)),
+  // key, unit, meaning, which ratio, of the forces (true) or of the touching beads.
+  struct Entry
+  {
+    const char *key, *unit, *meaning;
+    double Ratios::*ratio;
+    bool force;
   };
+  static const Entry entries[] = {
+      {"pressure_centroid_m", "m", "sum F_n x / sum F_n over the beads touching the drum (0: centred)",
+       &Ratios::centroid, true},
+      {"pressure_spread_m", "m", "RMS width of the normal force about its centroid along the nip", &Ratios::spread,
+       true},
+      {"pressure_upstream_over_downstream", "1",
+       "normal force on the drum before the gap centre (x < 0) over after it (1: symmetric)",
+       &Ratios::up_over_down, true},
+      {"touching_centroid_m", "m", "mean x of the beads touching the drum (0: centred)", &Ratios::centroid, false},
+      {"touching_spread_m", "m", "RMS width of the touching beads about their centroid", &Ratios::spread, false},
+      {"touching_upstream_over_downstream", "1",
+       "beads touching the drum before the gap centre over after it (1: symmetric)", &Ratios::up_over_down, false},
+  };
+  std::vector<SummaryValue> out;
+  for (const Entry &e : entries)
+    out.push_back(value_with_error(e.key, e.unit, e.meaning, (e.force ? force : count).*e.ratio,
+                                   per_block(e.force ? force_blocks : count_blocks, e.ratio)));
+  return out;
 }
 
 void NipAsymmetry::write_state(StateOut &out) const

@@ -347,8 +347,8 @@ std::vector<SummaryValue> TonerDevelopment::period_summary() const
   std::vector<double> tma, fog, q_over_m, ratio, transfer;
   for (const DevelopedLine::Period &p : line_->periods())
   {
-    tma.push_back(p.image_area > 0.0 ? p.image_mass / p.image_area : nan);
-    fog.push_back(p.dark_area > 0.0 ? p.dark_mass / p.dark_area : nan);
+    tma.push_back(p.tma());
+    fog.push_back(p.fog());
     if (p.image_mass > 0.0)
       q_over_m.push_back(p.image_charge / p.image_mass);
     if (eps_layer_over_l_ > 0.0 && contrast_ > 0.0)
@@ -392,8 +392,8 @@ std::vector<SummaryValue> TonerDevelopment::near_line_summary() const
   std::vector<double> tma, fog;
   for (const DevelopedLine::Period &p : near_line_->periods())
   {
-    tma.push_back(p.image_area > 0.0 ? p.image_mass / p.image_area : nan);
-    fog.push_back(p.dark_area > 0.0 ? p.dark_mass / p.dark_area : nan);
+    tma.push_back(p.tma());
+    fog.push_back(p.fog());
   }
   // Element by element (a uniform image's blocks lie on a grid fixed to the drum): what the
   // drum's layer gained (lost: negative) between the two lines, per block of the same elements.
@@ -405,9 +405,7 @@ std::vector<SummaryValue> TonerDevelopment::near_line_summary() const
       for (const DevelopedLine::Period &q : a)
         if (line_->grid_index(p) == near_line_->grid_index(q))
         {
-          const bool dark = !image_.solid();
-          change.push_back(dark ? p.dark_mass / p.dark_area - q.dark_mass / q.dark_area
-                                : p.image_mass / p.image_area - q.image_mass / q.image_area);
+          change.push_back(image_.solid() ? p.tma() - q.tma() : p.fog() - q.fog());
           break;
         }
   }

@@ -291,6 +291,7 @@ std::vector<ResolvedEntry> resolved_entries(const Case &c)
   e.q("dem.adhesion_cutoff", "dem.adhesion_cutoff", d.adhesion_cutoff);
   e.q("dem.adhesion_range_fraction", "dem.adhesion_range_fraction", d.adhesion_range_fraction);
   e.q("dem.toner_stiffness_factor", "dem.toner_stiffness_factor", d.toner_stiffness_factor);
+  e.i("dem.toner_substeps", "dem.toner_substeps", d.toner_substeps);
 
   const FlowSettings &flow = c.flow;
   e.s("inflow.population", "inflow.population", flow.inflow_population);

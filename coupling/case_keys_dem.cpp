@@ -49,6 +49,11 @@ std::vector<KeySpec> dem_keys()
       number("dem.toner_stiffness_factor",
              "Toner contacts use Young's modulus x this (a larger time step; see dem/README.md for its error).")
           .def("1").positive().max(1.0),
+      integer("dem.toner_substeps",
+              "Multiple time stepping: the toner (and every contact it takes part in) advances in this many substeps of "
+              "the step, and the step is this many times the toner's stable step, within the carriers' own stable step "
+              "(0 = as many substeps as that allows; 1 = one step for every particle). See dem/README.md.")
+          .def("1").non_negative().max(64),
   };
 }
 

@@ -265,6 +265,7 @@ struct DemSettings
   double adhesion_cutoff = 0.4e-9;   // z0: the gap is floored here (contact distance) [m]
   double adhesion_range_fraction = 0.01; // the force is cut where it has fallen to this × F0
   double toner_stiffness_factor = 1.0;   // toner contacts use E × this (time step, dem/README.md)
+  int toner_substeps = 1;                // toner in this many substeps of the step (0 = as many as the carriers allow)
 };
 
 // The development-nip measurements (dem/measurements/nip_profile.h, chain_inclination.h,

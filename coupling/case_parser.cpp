@@ -1256,6 +1256,7 @@ private:
     d.adhesion_cutoff = q(s, "adhesion_cutoff");
     d.adhesion_range_fraction = q(s, "adhesion_range_fraction");
     d.toner_stiffness_factor = q(s, "toner_stiffness_factor");
+    d.toner_substeps = static_cast<int>(integer(s, "toner_substeps"));
   }
 };
 

@@ -14,7 +14,7 @@ namespace magbrush::dem {
 namespace fs = std::filesystem;
 
 namespace {
-constexpr char checkpoint_magic[9] = "MBDEMCK5";
+constexpr char checkpoint_magic[9] = "MBDEMCK6";
 constexpr std::size_t trailer_size = sizeof(std::uint64_t) + sizeof(std::uint32_t);
 
 // zlib's crc32 takes 32-bit lengths: feed it in pieces.

@@ -1,7 +1,8 @@
 // The DEM checkpoint's file format: a flat binary file
 //
-//   "MBDEMCK5"                        8-byte magic (3: force-term state; 4: case identity
-//                                     and checksum; 5: toner carried by the carriers)
+//   "MBDEMCK6"                        8-byte magic (3: force-term state; 4: case identity
+//                                     and checksum; 5: toner carried by the carriers;
+//                                     6: the forces of the subcycled contacts)
 //   case identity                     the case hash and the resolved case inputs (key = value
 //                                     lines) of the run that wrote it (CheckpointIdentity)
 //   state                             scalars and length-prefixed arrays in the order the

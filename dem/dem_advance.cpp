@@ -9,7 +9,10 @@
 //   pair contacts       Hertz–Mindlin per listed pair, row sums     dynamic blocks
 //   ── barrier P ──      every pair force is in its slot
 //   column sums         −F of the pairs where the particle is the partner   static share
+//   (toner substeps)    with dem.toner_substeps: the toner's k substeps     one thread
+//   ── its barrier ──
 //   wall contacts       cylinders, planes, prisms                           static share
+//   (fast reaction)     the carriers' share of the toner's contacts         static share
 //   force terms         gravity, drag: inside the team (static share); magnetics, ...:
 //                       inside the team on the steps where they hold their forces
 //                       (shared loops), else a serial call outside the team (they
@@ -228,6 +231,13 @@ DemSystem::Pause DemSystem::run_team(long &steps_left, Resume from)
       }
       if (at != Resume::final_kick)
       {
+        // The toner's substeps (toner_substeps.h): its motion over this step, before the
+        // slow forces at the step's end (one thread works, the others wait).
+        if (substeps_.on())
+        {
+          toner_substeps_phase(mine);
+          clock.charge(times_.substeps);
+        }
         // This step's largest drift, for the terms that hold their forces (read before
         // barrier P: no thread drifts again before every thread has passed it).
         const double step_move = max_step_move_of_team();
@@ -244,6 +254,11 @@ DemSystem::Pause DemSystem::run_team(long &steps_left, Resume from)
         {
           wall_phase(mine);
           clock.charge(times_.wall_contacts);
+        }
+        if (substeps_.on())
+        {
+          add_fast_reaction_phase();
+          clock.charge(times_.substeps);
         }
         for (std::size_t t = 0; t < team_terms_; ++t)
         {

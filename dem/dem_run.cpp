@@ -184,6 +184,14 @@ void DemRun::log_setup() const
                 "  time step %.4g s (%s; stable limit %.4g s set by the %s; Rayleigh %.4g s, Hertz t_c/10 %.4g s)\n",
                 s.time_step(), origin, st.limit, st.limiting.c_str(), st.rayleigh, st.hertz);
   log_ << line;
+  if (const TonerSubsteps &sub = s.toner_substeps(); sub.on())
+  {
+    std::snprintf(line, sizeof line,
+                  "  toner in %d substeps of %.4g s (the step above is the carriers'; their own limit %.4g s, set by "
+                  "the %s)\n",
+                  sub.substeps, sub.substep, sub.carrier_limit, sub.carrier_limiting.c_str());
+    log_ << line;
+  }
   std::snprintf(line, sizeof line, "  Verlet skin %.3g m\n", s.skin());
   log_ << line;
   // The force list of the step, in the order the forces are added.
@@ -269,6 +277,12 @@ void DemRun::log_timings(double wall) const
   row("neighbour list", t.neighbour);
   row("particle contacts", t.particle_contacts);
   row("wall contacts", t.wall_contacts);
+  if (const TonerSubsteps &sub = s.toner_substeps(); sub.on())
+  {
+    row("toner substeps", t.substeps);
+    log_ << "      (" << sub.substeps << " substeps a step; at the end " << sub.movers.size() << " toner particles in "
+         << sub.pair.size() << " listed pairs, " << sub.dragged.size() << " carriers among their partners)\n";
+  }
   for (std::size_t k = 0; k < s.force_terms().size(); ++k)
   {
     row(s.force_terms()[k]->name(), t.terms[k]);
@@ -278,7 +292,7 @@ void DemRun::log_timings(double wall) const
   }
   row("integration", t.integrate);
   row("guards", t.guards);
-  double rest = wall - t.neighbour - t.particle_contacts - t.wall_contacts - t.integrate - t.guards;
+  double rest = wall - t.neighbour - t.particle_contacts - t.wall_contacts - t.integrate - t.guards - t.substeps;
   for (double v : t.terms)
     rest -= v;
   row("output and other", rest);

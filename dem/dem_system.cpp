@@ -106,6 +106,7 @@ void DemSystem::setup_derived()
   stable_ = stable_time_step(all, materials, species_names, table_, walls_.size(),
                              std::max(1.0, 2.0 * walls_.max_surface_speed()));
   dt_ = choose_time_step(case_.dem, stable_);
+  configure_substeps(materials, species_names, all); // may lengthen dt_ to k substeps
 
   const ParticleState &sized = n > 0 ? particles_ : later;
   double mean_d = 0.0, mass = 0.0, sized_count = 0.0;
@@ -148,6 +149,8 @@ void DemSystem::initialize()
     if (walls_.size() > 0)
       wall_phase(mine);
   }
+  if (substeps_.on())
+    initial_fast_forces(thread_flags_[0]);
   raise_alarms(team_alarms());
   for (std::size_t t = 0; t < terms_.size(); ++t)
     terms_[t]->add_forces(particles_, forces_, time_);
@@ -176,6 +179,7 @@ void DemSystem::rebuild_neighbour_list(const std::vector<std::int32_t> *origin)
   z0_ = particles_.z;
   force_rebuild_ = false;
   ++rebuilds_;
+  find_fast_pairs();
 }
 
 void DemSystem::set_particle_exchange(std::unique_ptr<ParticleExchange> exchange)
@@ -273,6 +277,19 @@ inline double DemSystem::drift(std::size_t i, double dt, double &step2)
   return dx * dx + dy * dy + dz * dz;
 }
 
+// A particle in substeps is not moved by the step's kick and drift: its substeps move it
+// later in the step (toner_substeps.cpp). For the list's expiry it counts with its drift so far
+// plus a bound on its motion over the step, dt (2|v| + 1 m/s): the list must stay valid
+// through the substeps, which come after the check.
+inline double DemSystem::substep_drift_bound(std::size_t i, double dt) const
+{
+  const ParticleState &s = particles_;
+  const double v = std::sqrt(s.vx[i] * s.vx[i] + s.vy[i] * s.vy[i] + s.vz[i] * s.vz[i]);
+  const double dx = s.x[i] - x0_[i], dy = s.y[i] - y0_[i], dz = s.z[i] - z0_[i];
+  const double d = std::sqrt(dx * dx + dy * dy + dz * dz) + dt * (2.0 * v + 1.0);
+  return d * d;
+}
+
 // Whether particle i's state is finite (checked after the final kick).
 static inline bool state_is_finite(const ParticleState &s, std::size_t i)
 {
@@ -289,10 +306,16 @@ void DemSystem::kick_and_drift_phase(StepFlags &mine)
   const double h = 0.5 * dt_, dt = dt_;
   ParticleState &s = particles_;
   const ForceBuffers &f = forces_;
+  const bool substeps = substeps_.on();
 #pragma omp for schedule(static) nowait
   for (long k = 0; k < n; ++k)
   {
     const std::size_t i = static_cast<std::size_t>(k);
+    if (substeps && substeps_.fast(s.species[i]))
+    {
+      max_drift2 = std::max(max_drift2, substep_drift_bound(i, dt));
+      continue;
+    }
     half_kick(s, f, i, h);
     max_drift2 = std::max(max_drift2, drift(i, dt, max_step2));
   }
@@ -311,10 +334,13 @@ void DemSystem::final_kick_phase(StepFlags &mine)
   const double h = 0.5 * dt_;
   ParticleState &s = particles_;
   const ForceBuffers &f = forces_;
+  const bool substeps = substeps_.on();
 #pragma omp for schedule(static) nowait
   for (long k = 0; k < n; ++k)
   {
     const std::size_t i = static_cast<std::size_t>(k);
+    if (substeps && substeps_.fast(s.species[i]))
+      continue; // kicked in its substeps
     half_kick(s, f, i, h);
     if (!state_is_finite(s, i) && not_finite.particle < 0)
       not_finite.set(k, s.position(i));
@@ -338,10 +364,16 @@ void DemSystem::final_kick_and_next_drift_phase(StepFlags &mine)
   const double h = 0.5 * dt_, dt = dt_;
   ParticleState &s = particles_;
   const ForceBuffers &f = forces_;
+  const bool substeps = substeps_.on();
 #pragma omp for schedule(static) nowait
   for (long k = 0; k < n; ++k)
   {
     const std::size_t i = static_cast<std::size_t>(k);
+    if (substeps && substeps_.fast(s.species[i]))
+    {
+      max_drift2 = std::max(max_drift2, substep_drift_bound(i, dt));
+      continue;
+    }
     half_kick(s, f, i, h);
     if (!state_is_finite(s, i) && not_finite.particle < 0)
       not_finite.set(k, s.position(i));
@@ -436,7 +468,8 @@ PairKernelData DemSystem::pair_kernel_data()
                         L.force_x.data(), L.force_y.data(), L.force_z.data(), L.torque_j_x.data(),
                         L.torque_j_y.data(), L.torque_j_z.data(), L.touching.data(),
                         coef + 6 * types, coef + 7 * types, coef + 8 * types, table_.adhesion_cutoff(),
-                        table_.adhesion_range(), table_.particles_adhesive()};
+                        table_.adhesion_range(), table_.particles_adhesive(), 0,
+                        substeps_.on() ? substeps_.skip.data() : nullptr};
 }
 
 namespace {
@@ -603,89 +636,108 @@ void DemSystem::raise_worst_pair_overlap() const
 
 // Wall contacts of every particle (static schedule, no barrier; walls_.prepare() has run).
 // Records the largest index of a particle that overlaps a wall beyond the guard (alarm) or
-// touches too many walls (crowded); raise_alarms() turns them into errors.
+// touches too many walls (crowded); raise_alarms() turns them into errors. The toner in
+// substeps is left to its substeps (toner_substeps.cpp).
 void DemSystem::wall_phase(StepFlags &mine)
 {
   long alarm = -1, too_many = -1;
   ParticleState &s = particles_;
   ForceBuffers &f = forces_;
   const long n = static_cast<long>(s.size());
-  const std::size_t W = walls_.size();
-  const double dt = dt_, guard = case_.dem.max_overlap_fraction;
-  // Van der Waals adhesion reaches across a gap (0 without adhesion: only touching walls).
-  const bool adhesive = table_.adhesive();
-  const double range = adhesive ? table_.adhesion_range() : 0.0, z0 = table_.adhesion_cutoff();
-  // This thread's scratch (constructed once, not per particle).
-  WallContactGeometry g[max_wall_contacts + 1];
-  int which[max_wall_contacts + 1];
+  const double dt = dt_;
+  const bool substeps = substeps_.on();
 #pragma omp for schedule(static) nowait
   for (long k = 0; k < n; ++k)
   {
     const std::size_t i = static_cast<std::size_t>(k);
-    const Vector3 p = s.position(i);
-    const double r = s.radius[i];
-  // Pass 1: which walls touch this particle now.
-    int m = 0;
-    for (std::size_t w = 0; w < W; ++w)
-    {
-      if (!walls_.may_touch(w, p, r + range) || !walls_.contact(w, p, r, g[m], range))
-        continue;
-      which[m] = static_cast<int>(w);
-      if (m == max_wall_contacts)
-      {
-        too_many = k;
-        break;
-      }
-      ++m;
-    }
-    // Pass 2: free the slots of walls no longer touched.
-    wall_slots_.release_untouched(i, which, m);
-    // Pass 3: evaluate each contact with its slot's history.
-    for (int c = 0; c < m; ++c)
-    {
-      const std::size_t sl = wall_slots_.slot_for(i, which[c]);
-      if (g[c].overlap > guard * r)
-        alarm = k;
-      ContactKinematics ck;
-      ck.n = g[c].n;
-      ck.overlap = g[c].overlap;
-      ck.lever_i = r - g[c].overlap; // rigid wall: the contact plane is the wall surface
-      ck.lever_j = 0.0;
-      const Vector3 w = s.angular_velocity(i);
-      ck.v_rel = s.velocity(i) + cross(ck.lever_i * w, ck.n) - g[c].surface_velocity;
-      ck.w_rel = w - g[c].angular_velocity;
-      ck.R_star = r;
-      ck.m_star = s.mass[i];
-      ck.radius_i = r;
-      ck.inv_inertia_i = s.inv_inertia[i];
-      Vector3 xi_t = wall_slots_.history(sl);
-      ContactOutcome o;
-      if (ck.overlap > 0.0) // always, without adhesion
-        o = evaluate_contact(table_.particle_wall(s.species[i], which[c]), ck, xi_t, dt);
-      else
-        xi_t = {}; // held across a gap by adhesion only: no contact, no history
-      if (adhesive)
-      {
-        const AdhesionCoefficients &a = table_.adhesion_wall(s.species[i], which[c]);
-        const double R_a = HamakerAdhesion::wall_radius(r, a.asperity_i, a.asperity_j);
-        o.force_i += HamakerAdhesion::force(a.hamaker, R_a, -ck.overlap, z0) * ck.n;
-      }
-      wall_slots_.set_history(sl, xi_t);
-      f.fx[i] += o.force_i.x;
-      f.fy[i] += o.force_i.y;
-      f.fz[i] += o.force_i.z;
-      f.tx[i] += o.torque_i.x;
-      f.ty[i] += o.torque_i.y;
-      f.tz[i] += o.torque_i.z;
-      // Load on the wall: −F at the contact point, torque about the wall's reference point.
-      const Vector3 arm = p + ck.lever_i * ck.n - g[c].torque_origin;
-      wall_slots_.set_load(sl, -o.force_i, cross(arm, -o.force_i));
-    }
+    if (substeps && substeps_.fast(s.species[i]))
+      continue;
+    Vector3 force{f.fx[i], f.fy[i], f.fz[i]}, torque{f.tx[i], f.ty[i], f.tz[i]};
+    particle_wall_contacts(i, dt, force, torque, alarm, too_many);
+    f.fx[i] = force.x;
+    f.fy[i] = force.y;
+    f.fz[i] = force.z;
+    f.tx[i] = torque.x;
+    f.ty[i] = torque.y;
+    f.tz[i] = torque.z;
   }
   if (alarm > mine.wall_overlap.particle)
     mine.wall_overlap.set(alarm, s.position(static_cast<std::size_t>(std::max(0L, alarm))));
   if (too_many > mine.wall_crowded.particle)
     mine.wall_crowded.set(too_many, s.position(static_cast<std::size_t>(std::max(0L, too_many))));
+}
+
+void DemSystem::particle_wall_contacts(std::size_t i, double dt, Vector3 &force, Vector3 &torque, long &alarm,
+                                       long &too_many)
+{
+  ParticleState &s = particles_;
+  const std::size_t W = walls_.size();
+  const double guard = case_.dem.max_overlap_fraction;
+  // Van der Waals adhesion reaches across a gap (0 without adhesion: only touching walls).
+  const bool adhesive = table_.adhesive();
+  const double range = adhesive ? table_.adhesion_range() : 0.0, z0 = table_.adhesion_cutoff();
+  WallContactGeometry g[max_wall_contacts + 1];
+  int which[max_wall_contacts + 1] = {};
+  const long k = static_cast<long>(i);
+  const Vector3 p = s.position(i);
+  const double r = s.radius[i];
+  // Pass 1: which walls touch this particle now.
+  int m = 0;
+  for (std::size_t w = 0; w < W; ++w)
+  {
+    if (!walls_.may_touch(w, p, r + range) || !walls_.contact(w, p, r, g[m], range))
+      continue;
+    which[m] = static_cast<int>(w);
+    if (m == max_wall_contacts)
+    {
+      too_many = k;
+      break;
+    }
+    ++m;
+  }
+  // Pass 2: free the slots of walls no longer touched.
+  wall_slots_.release_untouched(i, which, m);
+  // Pass 3: evaluate each contact with its slot's history.
+  for (int c = 0; c < m; ++c)
+  {
+    const std::size_t sl = wall_slots_.slot_for(i, which[c]);
+    if (g[c].overlap > guard * r)
+      alarm = k;
+    ContactKinematics ck;
+    ck.n = g[c].n;
+    ck.overlap = g[c].overlap;
+    ck.lever_i = r - g[c].overlap; // rigid wall: the contact plane is the wall surface
+    ck.lever_j = 0.0;
+    const Vector3 w = s.angular_velocity(i);
+    ck.v_rel = s.velocity(i) + cross(ck.lever_i * w, ck.n) - g[c].surface_velocity;
+    ck.w_rel = w - g[c].angular_velocity;
+    ck.R_star = r;
+    ck.m_star = s.mass[i];
+    ck.radius_i = r;
+    ck.inv_inertia_i = s.inv_inertia[i];
+    Vector3 xi_t = wall_slots_.history(sl);
+    ContactOutcome o;
+    if (ck.overlap > 0.0) // always, without adhesion
+      o = evaluate_contact(table_.particle_wall(s.species[i], which[c]), ck, xi_t, dt);
+    else
+      xi_t = {}; // held across a gap by adhesion only: no contact, no history
+    if (adhesive)
+    {
+      const AdhesionCoefficients &a = table_.adhesion_wall(s.species[i], which[c]);
+      const double R_a = HamakerAdhesion::wall_radius(r, a.asperity_i, a.asperity_j);
+      o.force_i += HamakerAdhesion::force(a.hamaker, R_a, -ck.overlap, z0) * ck.n;
+    }
+    wall_slots_.set_history(sl, xi_t);
+    force.x += o.force_i.x;
+    force.y += o.force_i.y;
+    force.z += o.force_i.z;
+    torque.x += o.torque_i.x;
+    torque.y += o.torque_i.y;
+    torque.z += o.torque_i.z;
+    // Load on the wall: −F at the contact point, torque about the wall's reference point.
+    const Vector3 arm = p + ck.lever_i * ck.n - g[c].torque_origin;
+    wall_slots_.set_load(sl, -o.force_i, cross(arm, -o.force_i));
+  }
 }
 
 void DemSystem::check_energy()
@@ -769,7 +821,8 @@ template <typename State, typename Forces>
 auto checkpoint_arrays(State &s, Forces &f)
 {
   return std::array{&s.x, &s.y, &s.z, &s.vx, &s.vy, &s.vz, &s.wx, &s.wy, &s.wz, &s.radius, &s.mass,
-                    &s.inv_mass, &s.inv_inertia, &s.charge, &s.carried_mass, &s.carried_charge, &f.fx, &f.fy, &f.fz, &f.tx, &f.ty, &f.tz};
+                    &s.inv_mass, &s.inv_inertia, &s.charge, &s.carried_mass, &s.carried_charge, &f.fx, &f.fy, &f.fz, &f.tx, &f.ty, &f.tz,
+                    &f.fast_fx, &f.fast_fy, &f.fast_fz, &f.fast_tx, &f.fast_ty, &f.fast_tz};
 }
 } // namespace
 

@@ -24,6 +24,7 @@
 #include "dem/particle_state.h"
 #include "dem/stability_guards.h"
 #include "dem/time_step.h"
+#include "dem/toner_substeps.h"
 #include "dem/wall_contact_slots.h"
 #include "dem/wall_contacts.h"
 
@@ -45,6 +46,7 @@ struct CheckpointIdentity;
 struct PhaseTimes
 {
   double neighbour = 0, particle_contacts = 0, wall_contacts = 0, integrate = 0, guards = 0;
+  double substeps = 0; // the toner's substeps (toner_substeps.h)
   std::vector<double> terms; // one per force term
 };
 
@@ -105,6 +107,8 @@ public:
   double time() const { return time_; }
   long step_count() const { return step_; }
   double time_step() const { return dt_; }
+  // The toner's substeps (dem.toner_substeps; toner_substeps.h): on() is false without them.
+  const TonerSubsteps &toner_substeps() const { return substeps_; }
   const StableTimeStep &stable_time_step_info() const { return stable_; }
   const ContactTable &contact_table() const { return table_; }
   const DemWalls &walls() const { return walls_; }
@@ -172,6 +176,7 @@ private:
   double dt_ = 0.0, time_ = 0.0, skin_ = 0.0;
   long step_ = 0, rebuilds_ = 0;
   bool walls_frozen_ = false, force_rebuild_ = true, initialized_ = false;
+  TonerSubsteps substeps_;
   StabilityGuards guards_;
   double energy_floor_ = 0.0;        // the energy guard ignores growth below this
   PhaseTimes times_;
@@ -216,12 +221,32 @@ private:
   int one_thread_pairs_rows_and_columns(PairKernelData D, std::vector<double> &scratch);
   void column_phase();
   void wall_phase(StepFlags &mine);
+  // The wall contacts of particle i with step dt: adds its force and torque to f, t; records
+  // an overlap beyond the guard (alarm = i) or too many walls (too_many = i).
+  void particle_wall_contacts(std::size_t i, double dt, Vector3 &f, Vector3 &t, long &alarm, long &too_many);
+  // The toner's substeps (toner_substeps.h, toner_substeps.cpp): the number of substeps and
+  // the fast species, after the step is known; the fast pairs, after every list build; the
+  // substeps of one step (all threads call it; one works); the fast particles' forces at the
+  // current positions with step dt (their fast pairs' and walls' into forces_.fast_*, the
+  // slow partners' reaction added to `reaction`, when given); the slow particles' average
+  // reaction into their forces (static share, after the slow forces).
+  void configure_substeps(const std::vector<Material> &materials, const std::vector<std::string> &names,
+                          const ParticleState &all);
+  void find_fast_pairs();
+  void toner_substeps_phase(StepFlags &mine);
+  int fast_forces(double dt, StepFlags &mine, bool react);
+  void initial_fast_forces(StepFlags &mine);
+  void gather_fast_history();
+  void scatter_fast_history();
+  void add_fast_reaction_phase();
   void final_kick_phase(StepFlags &mine);
   // final_kick_phase, then the next step's kick_and_drift_phase, in one pass over the
   // particles (dem_advance.cpp: when the team goes straight on to the next step).
   void final_kick_and_next_drift_phase(StepFlags &mine);
   // x += dt v of particle i; its squared drift since the build (and `step2` raised to this drift's)
   double drift(std::size_t i, double dt, double &step2);
+  // A particle in substeps: its squared drift since the build plus a bound on its next step's.
+  double substep_drift_bound(std::size_t i, double dt) const;
   void begin_step(); // the clock and the walls' pose at the new time (one thread)
   // advance(): the team's loop over steps, from `from` until it needs serial work.
   Pause run_team(long &steps_left, Resume from);

@@ -11,7 +11,7 @@ namespace magbrush::dem {
 namespace {
 // The kernel body for pairs [p_begin, p_end). Returns 1 when some pair overlaps by more than
 // the guard fraction of the smaller radius.
-template <bool Uniform, bool Adhesive>
+template <bool Uniform, bool Adhesive, bool Masked = false>
 #if defined(__GNUC__)
 __attribute__((always_inline))
 #endif
@@ -46,10 +46,13 @@ inline int pair_loop(const PairKernelData &D, const RowTorques &T, std::int64_t 
     uniform_k = {E_star[0], G_star[0], mu[0], mu_r[0], alpha_n[0], alpha_t[0]};
   if (Uniform && Adhesive)
     uniform_a = {hamaker[0], asperity_i[0], asperity_j[0]};
+  const std::int32_t *__restrict skip = D.skip;
   int alarm = 0;
 #pragma omp simd reduction(| : alarm)
   for (std::int64_t p = p_begin; p < p_end; ++p)
   {
+    // A skipped pair is computed like any other (branch-free) and its outputs are discarded.
+    const bool computed = Masked ? skip[p] == 0 : true;
     const std::int64_t i = owner[p], j = partner[p];
     const int im = image[p];
     const Vector3 d{x[j] - x[i] + shift_x[im], y[j] - y[i] + shift_y[im], z[j] - z[i] + shift_z[im]};
@@ -66,7 +69,7 @@ inline int pair_loop(const PairKernelData &D, const RowTorques &T, std::int64_t 
     ContactKinematics c;
     c.n = inv_dist * d;
     c.overlap = touch ? reach - dist : 0.0;
-    alarm |= (touch & (c.overlap > guard * std::min(ri, rj))) ? 1 : 0;
+    alarm |= (computed & touch & (c.overlap > guard * std::min(ri, rj))) ? 1 : 0;
     // Distances from the centres to the plane of the contact circle.
     c.lever_i = 0.5 * (dist + (ri * ri - rj * rj) * inv_dist);
     c.lever_j = dist - c.lever_i;
@@ -90,10 +93,19 @@ inline int pair_loop(const PairKernelData &D, const RowTorques &T, std::int64_t 
     Vector3 xi_t{hx[p], hy[p], hz[p]};
     const ContactOutcome o = evaluate_contact(k, c, xi_t, dt);
     // A pair that stopped touching forgets its history.
-    const double keep = touch ? 1.0 : 0.0;
-    hx[p] = touch ? xi_t.x : 0.0;
-    hy[p] = touch ? xi_t.y : 0.0;
-    hz[p] = touch ? xi_t.z : 0.0;
+    const double keep = (touch && computed) ? 1.0 : 0.0;
+    if (Masked)
+    {
+      hx[p] = computed ? (touch ? xi_t.x : 0.0) : hx[p];
+      hy[p] = computed ? (touch ? xi_t.y : 0.0) : hy[p];
+      hz[p] = computed ? (touch ? xi_t.z : 0.0) : hz[p];
+    }
+    else
+    {
+      hx[p] = touch ? xi_t.x : 0.0;
+      hy[p] = touch ? xi_t.y : 0.0;
+      hz[p] = touch ? xi_t.z : 0.0;
+    }
     if (Adhesive)
     {
       AdhesionCoefficients a = uniform_a;
@@ -104,7 +116,7 @@ inline int pair_loop(const PairKernelData &D, const RowTorques &T, std::int64_t 
       }
       // Attraction towards the partner (+n on i), added to the contact force.
       const double R_a = HamakerAdhesion::radius(ri, a.asperity_i, rj, a.asperity_j);
-      const double f_a = near ? HamakerAdhesion::force(a.hamaker, R_a, dist - reach, z0) : 0.0;
+      const double f_a = (near && computed) ? HamakerAdhesion::force(a.hamaker, R_a, dist - reach, z0) : 0.0;
       fx[p] = keep * o.force_i.x + f_a * c.n.x;
       fy[p] = keep * o.force_i.y + f_a * c.n.y;
       fz[p] = keep * o.force_i.z + f_a * c.n.z;
@@ -121,7 +133,10 @@ inline int pair_loop(const PairKernelData &D, const RowTorques &T, std::int64_t 
     tjx[p] = keep * o.torque_j.x;
     tjy[p] = keep * o.torque_j.y;
     tjz[p] = keep * o.torque_j.z;
-    touching[p] = touch ? 1 : 0;
+    if (Masked)
+      touching[p] = computed ? (touch ? 1 : 0) : touching[p];
+    else
+      touching[p] = touch ? 1 : 0;
   }
   return alarm;
 }
@@ -150,10 +165,22 @@ int adhesive_pair_kernel(const PairKernelData &D, const RowTorques &T, std::int6
 {
   return D.uniform ? pair_loop<true, true>(D, T, p_begin, p_end) : pair_loop<false, true>(D, T, p_begin, p_end);
 }
+
+// With some pairs skipped (the toner in substeps): the same kernels, masked. Separate
+// functions, so that the unmasked ones keep their code.
+MAGBRUSH_PAIR_KERNEL_CLONES
+int masked_pair_kernel(const PairKernelData &D, const RowTorques &T, std::int64_t p_begin, std::int64_t p_end)
+{
+  if (D.adhesive)
+    return D.uniform ? pair_loop<true, true, true>(D, T, p_begin, p_end) : pair_loop<false, true, true>(D, T, p_begin, p_end);
+  return D.uniform ? pair_loop<true, false, true>(D, T, p_begin, p_end) : pair_loop<false, false, true>(D, T, p_begin, p_end);
+}
 } // namespace
 
 int particle_pair_kernel(const PairKernelData &D, const RowTorques &T, std::int64_t p_begin, std::int64_t p_end)
 {
+  if (D.skip)
+    return masked_pair_kernel(D, T, p_begin, p_end);
   return D.adhesive ? adhesive_pair_kernel(D, T, p_begin, p_end) : contact_pair_kernel(D, T, p_begin, p_end);
 }
 

@@ -64,6 +64,10 @@ struct PairKernelData
   // they are the list's own per-pair slots (the column phase reads them later), the block's
   // first pair when they are a block's scratch (the one-thread path consumes them at once).
   std::int64_t slot_base = 0;
+  // Pairs left to another pass (the toner's substeps, dem/toner_substeps.h): skip[p] = 1 gives
+  // pair p zero force and torques here and leaves its history and touching flag as they are.
+  // nullptr: every pair is computed (a kernel without these lines: a template parameter).
+  const std::int32_t *skip = nullptr;
 };
 
 // Torque on i of the pairs p_begin + k, k = 0 .. block size (a per-thread buffer).

@@ -81,25 +81,25 @@ void ParticleState::permute(const std::vector<std::int32_t> &order, std::vector<
 
 void ForceBuffers::resize(std::size_t n)
 {
-  for (auto *a : {&fx, &fy, &fz, &tx, &ty, &tz})
+  for (auto *a : {&fx, &fy, &fz, &tx, &ty, &tz, &fast_fx, &fast_fy, &fast_fz, &fast_tx, &fast_ty, &fast_tz})
     a->assign(n, 0.0);
 }
 
 void ForceBuffers::extend(std::size_t n)
 {
-  for (auto *a : {&fx, &fy, &fz, &tx, &ty, &tz})
+  for (auto *a : {&fx, &fy, &fz, &tx, &ty, &tz, &fast_fx, &fast_fy, &fast_fz, &fast_tx, &fast_ty, &fast_tz})
     a->resize(n, 0.0);
 }
 
 void ForceBuffers::clear()
 {
-  for (auto *a : {&fx, &fy, &fz, &tx, &ty, &tz})
+  for (auto *a : {&fx, &fy, &fz, &tx, &ty, &tz, &fast_fx, &fast_fy, &fast_fz, &fast_tx, &fast_ty, &fast_tz})
     std::fill(a->begin(), a->end(), 0.0);
 }
 
 void ForceBuffers::permute(const std::vector<std::int32_t> &order, std::vector<double> &scratch)
 {
-  for (auto *a : {&fx, &fy, &fz, &tx, &ty, &tz})
+  for (auto *a : {&fx, &fy, &fz, &tx, &ty, &tz, &fast_fx, &fast_fy, &fast_fz, &fast_tx, &fast_ty, &fast_tz})
     permute_array(*a, order, scratch);
 }
 

@@ -66,6 +66,13 @@ struct ForceBuffers
 {
   std::vector<double> fx, fy, fz;
   std::vector<double> tx, ty, tz;
+  // With the toner in substeps (dem/toner_substeps.h), the contacts that take a subcycled
+  // particle part, kept apart from the rest: on a subcycled particle, their force and torque
+  // at its last substep (fx … hold the other forces, constant over the substeps); on any
+  // other particle, their average over the last step (added to fx … before its final kick).
+  // Zero, and unused, without substeps.
+  std::vector<double> fast_fx, fast_fy, fast_fz;
+  std::vector<double> fast_tx, fast_ty, fast_tz;
 
   void resize(std::size_t n);
   // Grows to n particles, the new ones at zero (the others keep their values).

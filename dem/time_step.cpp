@@ -19,13 +19,16 @@ double hertz_duration(double m_star, double R_star, double E_star, double v)
 StableTimeStep stable_time_step(const ParticleState &particles,
                                 const std::vector<Material> &species_materials,
                                 const std::vector<std::string> &species_names,
-                                const ContactTable &table, std::size_t n_walls, double impact_speed)
+                                const ContactTable &table, std::size_t n_walls, double impact_speed,
+                                const std::vector<char> *excluded)
 {
   const std::size_t S = species_materials.size();
   std::vector<double> r_min(S, std::numeric_limits<double>::max()), m_min(S, std::numeric_limits<double>::max());
   for (std::size_t i = 0; i < particles.size(); ++i)
   {
     const std::size_t s = static_cast<std::size_t>(particles.species[i]);
+    if (excluded && (*excluded)[s])
+      continue;
     r_min[s] = std::min(r_min[s], particles.radius[i]);
     m_min[s] = std::min(m_min[s], particles.mass[i]);
   }

@@ -34,7 +34,11 @@ struct StableTimeStep
 StableTimeStep stable_time_step(const ParticleState &particles,
                                 const std::vector<Material> &species_materials,
                                 const std::vector<std::string> &species_names,
-                                const ContactTable &table, std::size_t n_walls, double impact_speed);
+                                const ContactTable &table, std::size_t n_walls, double impact_speed,
+                                const std::vector<char> *excluded = nullptr);
+
+// `excluded` (one flag per species, optional): those species and every contact they take part
+// in are left out — the limit of the rest, e.g. the carriers' own when the toner is subcycled.
 
 // The step to use: automatic (time_step = 0) or the user's, refused if above the limit.
 double choose_time_step(const DemSettings &settings, const StableTimeStep &limit);

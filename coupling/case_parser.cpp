@@ -224,6 +224,10 @@ private:
     try
     {
       YAML::Node root = YAML::Load(text);
+      // A quote left open at the end of a value is legal YAML when what follows still parses
+      // (the text then runs on over the next lines): refused, as a case file never means it.
+      if (const size_t quote = unclosed_quote(text, text.size()); quote != std::string::npos)
+        syntax_error(text, mark_at(text, quote), "a quoted value runs on to the next line");
       if (!root.IsMap())
         error(location(root.Mark()), "", "expected the case file to be a YAML section of keys "
                                          "(e.g. 'sleeve:'), found " + node_kind(root));
@@ -259,7 +263,16 @@ private:
     const bool unclosed_map = message.find("end of map flow") != std::string::npos;
     const bool unclosed_list = message.find("end of sequence flow") != std::string::npos;
     bool moved = false;
-    if (unclosed_map || unclosed_list)
+    // A quoted value whose quote is not closed on its line: YAML reads on across the lines
+    // below as one text and fails wherever that text stops making sense, often far below.
+    if (const size_t quote = unclosed_quote(text, at); quote != std::string::npos)
+    {
+      at = quote;
+      moved = true;
+      hint = "this quote is not closed on its line: YAML reads the lines below as part of the same text; close "
+             "it, or drop the quotes";
+    }
+    else if (unclosed_map || unclosed_list)
     {
       const size_t opener = unclosed_bracket(text, at, unclosed_map ? '{' : '[');
       if (opener != std::string::npos)
@@ -301,6 +314,50 @@ private:
     quote(l);
     excerpt += "\n    " + std::string(6, ' ') + " | " + std::string(display_width(text.substr(starts[l], column)), ' ') + "^";
     error(where, "", "YAML syntax error: " + message + excerpt + "\n    hint: " + hint);
+  }
+
+  // The YAML mark (line and column, from 0) of byte offset `at` of `text`.
+  static YAML::Mark mark_at(const std::string &text, size_t at)
+  {
+    YAML::Mark m;
+    m.pos = static_cast<int>(at);
+    m.line = static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(at), '\n'));
+    const size_t line_start = text.rfind('\n', at == 0 ? 0 : at - 1);
+    m.column = static_cast<int>(at - (line_start == std::string::npos || at == 0 ? 0 : line_start + 1));
+    return m;
+  }
+
+  // The opening quote (" or ') of the first line before `end` whose quoted text does not close
+  // on that line, outside comments; npos if every line closes its quotes.
+  static size_t unclosed_quote(const std::string &text, size_t end)
+  {
+    size_t line_start = 0;
+    while (line_start < end && line_start < text.size())
+    {
+      const size_t line_end = std::min(text.find('\n', line_start), text.size());
+      char open = 0;
+      size_t opened_at = std::string::npos;
+      for (size_t i = line_start; i < line_end; ++i)
+      {
+        const char c = text[i];
+        if (open == 0 && c == '#' && (i == line_start || text[i - 1] == ' ' || text[i - 1] == '\t'))
+          break; // a comment
+        if (open == 0 && (c == '"' || c == '\'') &&
+            (i == line_start || std::string(" \t:[{,-").find(text[i - 1]) != std::string::npos))
+        {
+          open = c;
+          opened_at = i;
+        }
+        else if (open == '"' && c == '\\')
+          ++i; // an escaped character inside "..."
+        else if (open != 0 && c == open)
+          open = 0;
+      }
+      if (open != 0)
+        return opened_at;
+      line_start = line_end + 1;
+    }
+    return std::string::npos;
   }
 
   // The last '{' (or '[') before `end` that no '}' (']') closes, outside quotes and comments;

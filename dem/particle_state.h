@@ -107,6 +107,9 @@ struct ForceBuffers
   // Grows to n particles, the new ones at zero (the others keep their values).
   void extend(std::size_t n);
   void clear();
+  // The fast arrays sized like fx and zeroed: for a buffer that never takes substeps (a held
+  // term's store) after fx … were read or carried on their own.
+  void zero_fast();
   void permute(const std::vector<std::int32_t> &order, std::vector<double> &scratch);
 };
 

@@ -68,7 +68,7 @@ profile is written.
     s.positionals = {{"CASE", "the case file"}};
     s.options = {
         {"--measured", {}, "FILE", "the gaussmeter scan"},
-        {"--output", {"-o"}, "DIR", "output directory (default: <output.directory>/<case name>/flux)", false, {},
+        {"--output", {"-o"}, "DIR", "output directory (default: <output.directory>/flux)", false, {},
          /*for_pipeline=*/false},
         cli::set_option("field.probe_radius=10mm"),
         {"--angle-unit", {}, "deg|rad", "unit of the scan's angle column (overrides the header)"},
@@ -602,7 +602,7 @@ private:
     choose_scan_origin();
     ring_options_.harmonics = o_.harmonics;
     ring_.emplace(*case_.roller, ring_options_);
-    dir_ = o_.output_dir.empty() ? case_.output.directory + "/" + case_.name + "/flux" : o_.output_dir;
+    dir_ = o_.output_dir.empty() ? case_.output.directory + "/flux" : o_.output_dir;
     fs::create_directories(dir_);
     std::cout << "magbrush flux: case '" << case_.name << "', probe radius "
               << fixed(probe_radius_ * 1e3, 3) << " mm (magnet "

@@ -56,7 +56,8 @@ struct Option
 // A word that is not an option: the case file, usually.
 struct Positional
 {
-  enum Need { required, optional };
+  // one_or_more: required, and it takes every further word too (only the last positional).
+  enum Need { required, optional, one_or_more };
   std::string name; // "CASE"
   std::string help = {};
   Need need = required;

@@ -115,12 +115,22 @@ class Run:
         self.inputs, self.resolved_path = read_resolved(folder)
         self.overrides = read_variant(folder)
         self.nip = read_columns(os.path.join(folder, "dem", "nip_profile.csv"))
+        nip_summary = read_columns(os.path.join(folder, "dem", "nip_summary.csv"))
+        self.nip_samples = float("nan")
+        if nip_summary and "key" in nip_summary:
+            # read_columns made the key column numbers (nan): read the file's rows by position.
+            with open(os.path.join(folder, "dem", "nip_summary.csv"), newline="") as f:
+                for row in csv.reader(line for line in f if not line.startswith("#")):
+                    if row and row[0] == "samples":
+                        self.nip_samples = number(row[1])
         self.developed = read_columns(os.path.join(folder, "dem", "toner_developed_profile.csv"))
         flux = flux_profile_path(folder, self.inputs)
         self.flux = read_columns(flux) if flux else None
 
-    def label(self):
-        return self.name + (" (" + ", ".join(self.overrides) + ")" if self.overrides else "")
+    def label(self, common=()):
+        """The folder's name and the overrides that tell it from the other runs."""
+        own = [o for o in self.overrides if o not in common]
+        return self.name + (" (" + ", ".join(own) + ")" if own else "")
 
 
 # ------------------------------------------------------------------------------------------
@@ -216,6 +226,8 @@ def plots(runs, out):
     except ImportError:
         return [], "matplotlib is not installed (Debian: python3-matplotlib): the page has the tables only"
     images = []
+    common = set.intersection(*(set(r.overrides) for r in runs)) if runs else set()
+    label = {id(r): r.label(common) for r in runs}
 
     def overlay(name, title, xlabel, ylabel, curves, hline=None, hlabel=None):
         if not curves:
@@ -237,30 +249,34 @@ def plots(runs, out):
         plt.close(fig)
         images.append(name)
 
-    def masked(prof, column, scale=1.0):
-        """A profile column with the bins of fewer than 2 contact samples blanked: a bin
-        averaged over one contact is noise, and it would set the plot's scale."""
-        samples = prof.get("contact_samples")
-        return [v * scale if (samples is None or samples[i] >= 2) else float("nan")
+    def masked(run, column, scale=1.0):
+        """A nip profile column with its sparse bins blanked, as the report leaves them out
+        (tools/report.py sparse_bins): fewer contact samples than a tenth of the window's
+        samples. A bin averaged over one contact is noise, and it would set the plot's scale."""
+        prof = run.nip
+        counts = prof.get("contact_samples")
+        n = run.nip_samples
+        threshold = max(2.0, 0.1 * n) if math.isfinite(n) and n > 0 else 2.0
+        return [v * scale if (counts is None or not (0 < counts[i] < threshold)) else float("nan")
                 for i, v in enumerate(prof[column])]
 
     nip_x = "x along the nip from the gap centre [mm] (positive downstream)"
     with_nip = [r for r in runs if r.nip and "x_mm" in r.nip]
     overlay("compare_nip_slip.png", "Slip of the beads touching the drum (contact points)", nip_x, "slip [m/s]",
-            [(r.label(), r.nip["x_mm"], masked(r.nip, "slip_speed_m_s"), "o-") for r in with_nip
+            [(label[id(r)], r.nip["x_mm"], masked(r, "slip_speed_m_s"), "o-") for r in with_nip
              if "slip_speed_m_s" in r.nip])
     overlay("compare_nip_pressure.png", "Normal pressure on the drum", nip_x, "normal pressure [kPa]",
-            [(r.label(), r.nip["x_mm"], masked(r.nip, "normal_pressure_Pa", 1e-3), "o-") for r in with_nip
+            [(label[id(r)], r.nip["x_mm"], masked(r, "normal_pressure_Pa", 1e-3), "o-") for r in with_nip
              if "normal_pressure_Pa" in r.nip])
     overlay("compare_nip_density.png", "Beads touching the drum", nip_x, "touching beads [1/mm²]",
-            [(r.label(), r.nip["x_mm"], masked(r.nip, "density_per_mm2"), "o-") for r in with_nip
+            [(label[id(r)], r.nip["x_mm"], masked(r, "density_per_mm2"), "o-") for r in with_nip
              if "density_per_mm2" in r.nip])
     overlay("compare_flux.png", "Normal flux density on the sleeve", "angle [deg]", "Bn [mT]",
-            [(r.label(), r.flux["angle_deg"], [v * 1e3 for v in r.flux["Bn_T"]], "-") for r in runs
+            [(label[id(r)], r.flux["angle_deg"], [v * 1e3 for v in r.flux["Bn_T"]], "-") for r in runs
              if r.flux and "angle_deg" in r.flux and "Bn_T" in r.flux])
     overlay("compare_developed_profile.png", "Developed toner across one image period",
             "position from the exposed strip's centre [mm]", "toner mass per area [kg/m²]",
-            [(r.label(), r.developed["position_mm"], r.developed["toner_mass_per_area_kg_per_m2"], "o-")
+            [(label[id(r)], r.developed["position_mm"], r.developed["toner_mass_per_area_kg_per_m2"], "o-")
              for r in runs if r.developed and "position_mm" in r.developed
              and "toner_mass_per_area_kg_per_m2" in r.developed])
     return images, ""
@@ -348,7 +364,8 @@ def build_page(runs, rows, inputs, images, note, out):
         h.append(f"<p>{e(note)}</p>")
         md.append(note)
     if images:
-        h.append("<p>Bins averaged over fewer than two contacts are left out of the nip profiles.</p>")
+        h.append("<p>The nip profiles leave out the bins averaged over fewer contacts than a tenth of the window's "
+                 "samples, as the report does.</p>")
     h += [f"<p><a href='{e(img)}'><img src='{e(img)}' alt='{e(img)}'></a></p>" for img in images]
     md += [f"![{img}]({img})" for img in images]
     h.append("</body></html>")

@@ -43,14 +43,12 @@ into DIR (default: results/compare_<A>_vs_<B>, the folders' names):
     s.positionals = {{"RUN_A", "the reference run folder"},
                      {"RUN_B", "the run folders to compare with it", cli::Positional::one_or_more}};
     s.options = {{"--output", {"-o"}, "DIR", "write the page here", false, {}, /*for_pipeline=*/false}};
-    s.epilog = R"(Example:
-  magbrush run cases/kawamoto_nip_fed.yaml --quick
-  magbrush run cases/kawamoto_nip_fed.yaml --quick --set drum.gap=0.3mm
-  magbrush compare results/kawamoto_nip_fed-171ed7 results/kawamoto_nip_fed-<digest> -o results/compare_gap
-Needs python3 (numbers and tables); the plots also matplotlib. $MAGBRUSH_PYTHON picks the
+    s.epilog = R"(Needs python3 (numbers and tables); the plots also matplotlib. $MAGBRUSH_PYTHON picks the
 interpreter, $MAGBRUSH_TOOLS the folder holding compare.py.
-Exit status: 0 written, 1 a folder without a finished run or a failed script, 2 bad usage.
 )";
+    s.examples = {{"magbrush compare results/kawamoto_nip_fed-171ed7 results/kawamoto_nip_fed-a1c7b3 -o results/compare_gap",
+                   "the quick run against its 0.5 mm gap variant (`magbrush run` prints each run's folder)"}};
+    s.exit_status = "0 written, 1 a folder without a finished run or a failed script, 2 bad usage.";
     return s;
   }();
   return spec;

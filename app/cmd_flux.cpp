@@ -95,8 +95,10 @@ profile is written.
         {"--harmonics", {}, "N", "number of Fourier harmonics (default: from the decay of the series)"}};
     s.epilog = R"(Outputs in DIR: flux_profile.csv (computed, 0.25 deg), flux_residuals.csv, flux_overlay.png,
 and with --fit: flux_fit_residuals.csv, <case>_fitted.yaml, flux_fit.txt.
-Exit status: 0 done, 1 bad input (message says what and how to fix), 2 bad usage.
 )";
+    s.examples = {{"magbrush flux cases/kawamoto_nip.yaml --measured cases/data/sleeve_profile_example.csv --fit",
+                   "compare a gaussmeter scan with the computed flux and fit the poles to it"}};
+    s.exit_status = "0 done, 1 bad input (message says what and how to fix), 2 bad usage.";
     return s;
   }();
   return spec;

@@ -70,10 +70,11 @@ bound: the relative surface speed, the bead-drum friction coefficient, B^2/2mu0.
     s.epilog = R"(Needs the DEM outputs (<output.directory>/dem/: run `magbrush dem CASE` or `magbrush run CASE`
 first) and python3 with matplotlib, numpy and h5py (Debian: python3-matplotlib python3-h5py);
 $MAGBRUSH_PYTHON picks the interpreter, $MAGBRUSH_TOOLS the folder holding report.py.
-Example:
-  magbrush report cases/kawamoto_nip_fed.yaml --set drum.gap=0.5mm   (the report of that variant's run)
-Exit status: 0 done, 1 missing outputs or a failed plot script, 2 bad usage.
 )";
+    s.examples = {{"magbrush report cases/kawamoto_nip_fed.yaml", "the report of the case's run: results/kawamoto_nip_fed/report/"},
+                  {"magbrush report cases/kawamoto_nip_fed.yaml --set drum.gap=0.5mm",
+                   "the report of that variant's run (the same --set list finds its folder)"}};
+    s.exit_status = "0 done, 1 missing outputs or a failed plot script, 2 bad usage.";
     return s;
   }();
   return spec;

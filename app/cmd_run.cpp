@@ -251,13 +251,11 @@ Each stage is announced with the wall time it took in the last run of this case 
 DEM prints its own progress with an ETA. Stage times go to <run folder>/run_times.csv. At
 the end: the time per stage and where every output is.
 )";
-    s.epilog = R"(Examples:
-  magbrush run cases/kawamoto_nip_fed.yaml --quick                          a first look (~1 min)
-  magbrush run cases/kawamoto_nip_fed.yaml --quick --set drum.gap=0.3mm     the same, another gap
-  magbrush compare results/kawamoto_nip_fed-*/                              the two side by side
-Exit status: 0 done, the failing stage's status otherwise (1 an invalid case or a failed stage,
-2 bad usage).
-)";
+    s.examples = {{"magbrush run cases/kawamoto_nip_fed.yaml --quick", "a first look in about a minute"},
+                  {"magbrush run cases/kawamoto_nip_fed.yaml --quick --set drum.gap=0.5mm",
+                   "the same with a wider gap, in its own folder (results/kawamoto_nip_fed-<digest>/)"},
+                  {"magbrush run cases/kawamoto_nip_fed.yaml", "the full run (~10-15 min on 2 cores)"}};
+    s.exit_status = "0 done, else the failing stage's (1 an invalid case or a failed stage, 2 bad usage).";
     s.positionals = {{"CASE", "the case file"}};
     s.options = {cli::set_option(),
                  {"--quick", {}, "",

@@ -162,11 +162,12 @@ run_time_s):
                                          "merge step (--merge) into the sweep's folder", false, {"slurm"}}};
     const auto of_stages = stage_options();
     s.options.insert(s.options.end(), of_stages.begin(), of_stages.end());
-    s.epilog = R"(Examples (Fig. 22-27):
-  magbrush sweep cases/kawamoto_nip.yaml --vary populations.carrier.diameter=42um,50um,60um
-  magbrush sweep cases/kawamoto_nip.yaml --vary populations.carrier.count=9000,12300,15000
-  magbrush sweep cases/kawamoto_nip.yaml --vary drum.gap=0.3mm,0.4mm,0.5mm
-)";
+    s.examples = {{"magbrush sweep cases/kawamoto_nip.yaml --vary populations.carrier.diameter=42um,50um,60um",
+                   "Kawamoto Fig. 22-23: the carrier diameter"},
+                  {"magbrush sweep cases/kawamoto_nip.yaml --vary populations.carrier.count=9000,12300,15000",
+                   "Fig. 24-25: the amount of developer"},
+                  {"magbrush sweep cases/kawamoto_nip.yaml --vary drum.gap=0.3mm,0.4mm,0.5mm", "Fig. 26-27: the gap"}};
+    s.exit_status = "0 every point done, 1 an invalid case or a failed point, 2 bad usage.";
     return s;
   }();
   return spec;

@@ -351,6 +351,14 @@ std::string help_text(const CommandSpec &spec)
   write_two_columns(out, options);
   if (!spec.epilog.empty())
     out << "\n" << spec.epilog;
+  if (!spec.examples.empty())
+  {
+    out << "\nExample" << (spec.examples.size() > 1 ? "s" : "") << ":\n";
+    for (const auto &e : spec.examples)
+      out << "  " << e.command << "\n" << (e.what.empty() ? "" : "      " + e.what + "\n");
+  }
+  if (!spec.exit_status.empty())
+    out << "\nExit status: " << spec.exit_status << "\n";
   return out.str();
 }
 

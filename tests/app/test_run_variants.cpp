@@ -145,3 +145,21 @@ TEST(RunQuick, AWindowBeyondTheRunIsStillRefused)
   EXPECT_NE(o.text.find("nip.average_from"), std::string::npos) << o.text;
   EXPECT_NE(o.text.find("dem.duration"), std::string::npos) << o.text;
 }
+
+TEST(RunQuick, TheFoldersTheReadmeNamesAreTheOnesTheRunsWriteTo)
+{
+  // README's first hour compares two quick runs by their folders: the digests of the quick
+  // preset's overrides (and a 0.5 mm gap). A change of the preset or the digest changes them.
+  std::vector<std::string> quick;
+  for (const auto &q : quick_preset(load_case(fed_case)))
+    quick.push_back(q.override_text());
+  std::vector<std::string> gap = quick;
+  gap.push_back("drum.gap=0.5mm");
+  const std::string base = load_case(fed_case, quick).output.directory, wide = load_case(fed_case, gap).output.directory;
+  std::ifstream in(std::string(MAGBRUSH_SOURCE_DIR) + "/README.md");
+  std::ostringstream readme;
+  readme << in.rdbuf();
+  EXPECT_NE(readme.str().find("magbrush compare " + base + " " + wide), std::string::npos)
+      << "README's compare line should read: magbrush compare " << base << " " << wide;
+  EXPECT_NE(readme.str().find(base + "/report/index.html"), std::string::npos) << base;
+}

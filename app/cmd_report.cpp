@@ -20,6 +20,7 @@
 #include "coupling/case_format.h"
 #include "coupling/case_parser.h"
 #include "coupling/field_files.h"
+#include "coupling/run_folder.h"
 
 #include <cmath>
 #include <cstdio>
@@ -169,6 +170,10 @@ int report(const cli::ParsedArguments &args)
   fs::create_directories(report_dir);
   write_text_atomically((report_dir / "case_resolved.txt").string(),
                         "# case " + c.name + " as resolved for this report (" + case_path + ")\n" + format_case(c));
+  // A folder named by the digest of its overrides says which they are, even when its stages
+  // were run one by one rather than by `magbrush run` (which writes it first).
+  if (c.output.automatic && !fs::exists(results / "variant.txt"))
+    write_text_atomically((results / "variant.txt").string(), variant_text(case_path, c.output.overrides));
   const std::string scan = normalised_scan(c, report_dir);
 
   const std::string script = find_report_script();

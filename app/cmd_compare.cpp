@@ -33,7 +33,9 @@ into DIR (default: results/compare_<A>_vs_<B>, the folders' names):
   index.html, index.md   every key number of each run's dem/summary.csv as value ± standard
                          error, the difference of each run from the first and whether it is
                          beyond the combined error (|b - a| > 2 sqrt(se_a^2 + se_b^2)); the
-                         inputs that differ (from each run's case_resolved.txt); the plots
+                         inputs that differ (from each run's case_resolved.txt); each pole's
+                         sleeve-flux peak in the first run and how far it moved in the
+                         others (angle, Bn): a pole moved or made stronger; the plots
   compare.csv            the same numbers, one row per key and run
   compare_nip_slip.png, compare_nip_pressure.png, compare_nip_density.png   the nip profiles
   compare_flux.png       the sleeve's normal flux of each run's stored field

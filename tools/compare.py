@@ -14,7 +14,8 @@ fields. It writes into DIR:
     index.html, index.md   the key numbers of each run as value ± standard error; for each run
                            after the first, its difference from the first and whether that is
                            beyond the combined error, |b - a| > 2 sqrt(se_a^2 + se_b^2); the
-                           inputs that differ; the overlaid profiles
+                           inputs that differ; the shift of each pole's sleeve-flux peak (angle
+                           and Bn); the overlaid profiles
     compare.csv            the same numbers, one row per key and run (what the tests read)
     compare_*.png          the nip's slip, pressures and touching density, the sleeve flux and
                            the developed toner profile, each run one curve (needs matplotlib;
@@ -190,6 +191,41 @@ def differing_inputs(runs):
     return out
 
 
+def flux_peaks(flux, share=0.2):
+    """The poles of a sleeve-flux profile: [(angle_deg, Bn_T)] at each local extremum of Bn
+    whose size is at least `share` of the largest (the profile is periodic in angle)."""
+    if not flux or "angle_deg" not in flux or "Bn_T" not in flux:
+        return []
+    a, b = flux["angle_deg"], flux["Bn_T"]
+    n = len(b)
+    top = max((abs(v) for v in b if math.isfinite(v)), default=0.0)
+    peaks = []
+    for i in range(n):
+        prev, nxt = b[i - 1], b[(i + 1) % n]
+        if abs(b[i]) >= share * top and (b[i] > 0 and b[i] >= prev and b[i] > nxt or
+                                         b[i] < 0 and b[i] <= prev and b[i] < nxt):
+            peaks.append((a[i], b[i]))
+    return peaks
+
+
+def peak_shifts(runs):
+    """Each pole of the first run's sleeve flux and, per other run, the peak of the same sign
+    nearest in angle: [(angle_a, Bn_a, [(d_angle, d_Bn) or None per other run])]."""
+    reference = flux_peaks(runs[0].flux)
+    rows = []
+    for angle, value in reference:
+        shifts = []
+        for r in runs[1:]:
+            same = [(x, v) for x, v in flux_peaks(r.flux) if (v > 0) == (value > 0)]
+            if not same:
+                shifts.append(None)
+                continue
+            x, v = min(same, key=lambda p: abs((p[0] - angle + 180.0) % 360.0 - 180.0))
+            shifts.append(((x - angle + 180.0) % 360.0 - 180.0, v - value))
+        rows.append((angle, value, shifts))
+    return rows
+
+
 def write_text(path, text):
     tmp = path + ".tmp"
     with open(tmp, "w") as f:
@@ -357,6 +393,22 @@ def build_page(runs, rows, inputs, images, note, out):
         h.append(f"<p>{e(none)}</p>")
         md.append(none)
     md.append("")
+
+    shifts = peak_shifts(runs) if runs[0].flux else []
+    if shifts and any(r.flux for r in runs[1:]):
+        h += ["<h2>Sleeve flux: the poles' peaks</h2>",
+              "<table><tr><th>pole peak in A</th>" +
+              "".join(f"<th>{chr(ord('A') + i)} − A</th>" for i in range(1, len(runs))) + "</tr>"]
+        md += ["## Sleeve flux: the poles' peaks", "",
+               "| pole peak in A | " + " | ".join(f"{chr(ord('A') + i)} − A" for i in range(1, len(runs))) + " |",
+               "|---" * len(runs) + "|"]
+        for angle, value, others in shifts:
+            cells = ["—" if o is None else f"{o[0]:+.2f} deg, {o[1] * 1e3:+.2f} mT" for o in others]
+            first = f"{angle:.2f} deg, {value * 1e3:.2f} mT"
+            h.append(f"<tr><td>{e(first)}</td>" + "".join(f"<td>{e(c)}</td>" for c in cells) + "</tr>")
+            md.append(f"| {first} | " + " | ".join(cells) + " |")
+        h.append("</table>")
+        md.append("")
 
     h.append("<h2>Profiles</h2>")
     md += ["## Profiles", ""]

@@ -107,6 +107,28 @@ class CompareTwoRuns(unittest.TestCase):
         os.makedirs(empty)
         self.assertEqual(compare.main(["--out", self.out, self.a, empty]), 2)
 
+    def test_a_moved_pole_shows_as_the_shift_of_its_flux_peak(self):
+        def profile(run, name, shift_deg):
+            folder = os.path.join(run, "fields")
+            os.makedirs(folder, exist_ok=True)
+            with open(os.path.join(folder, name + "_profile_sleeve.csv"), "w") as f:
+                f.write("# synthetic\nangle_deg,Bn_T,Bt_T\n")
+                for k in range(1440):
+                    a = 0.25 * k
+                    d1 = (a - shift_deg + 180.0) % 360.0 - 180.0  # the moved south pole near 0 deg
+                    d2 = (a - 180.0 + 180.0) % 360.0 - 180.0      # a north pole at 180 deg, not moved
+                    f.write(f"{a},{-0.1 * math.exp(-(d1 / 10) ** 2) + 0.07 * math.exp(-(d2 / 10) ** 2)},0\n")
+        profile(self.a, "nip", 0.0)
+        profile(self.b, "nip", 3.0)
+        rows = compare.peak_shifts([compare.Run(self.a), compare.Run(self.b)])
+        self.assertEqual(len(rows), 2, rows)
+        by_angle = {round(angle): others[0] for angle, _, others in rows}
+        self.assertAlmostEqual(by_angle[0][0], 3.0, places=6)  # the south pole moved 3 deg
+        self.assertAlmostEqual(by_angle[180][0], 0.0, places=6)
+        self.assertEqual(compare.main(["--out", self.out, self.a, self.b]), 0)
+        with open(os.path.join(self.out, "index.md")) as f:
+            self.assertIn("+3.00 deg", f.read())
+
     @unittest.skipIf(MAGBRUSH is None and len(sys.argv) < 2, "no magbrush binary given")
     def test_the_subcommand(self):
         binary = MAGBRUSH

@@ -1,8 +1,11 @@
-// `magbrush run CASE`: the whole pipeline — validate, mesh, fields, DEM, report — each stage
-// skipped when its outputs are up to date (the stages themselves decide that), with progress
-// and an ETA at every stage, the wall time of every stage, and at the end a summary of where
-// every output is.
+// `magbrush run CASE`: the whole pipeline — validate, fields, DEM, report (the Gmsh meshes
+// only when --only names them: no later stage reads them) — each stage skipped when its
+// outputs are up to date (the stages themselves decide that), with progress and an ETA at
+// every stage, the wall time of every stage, and at the end a summary of where every output is.
 //
+//   --quick: the case's duration and every window scaled (app/quick_preset.h), as overrides
+//   check: quietly; then the case in ten lines (app/case_at_a_glance.h), the resolved case and
+//   the overrides written into the run folder (coupling/run_folder.h names it)
 //   for each stage: announce it (with the time it took last time: its ETA) → run it; the DEM's
 //   output is also kept in <output.directory>/dem/dem.log (the report reads its timing table)
 //   → record the stage's wall time in <output.directory>/run_times.csv
@@ -449,7 +452,8 @@ int run_pipeline(const std::vector<std::string> &args)
 
 namespace {
 const bool registered = register_subcommand(
-    {"run", "the whole pipeline: check, mesh, field, dem, report", run_pipeline, run_command_line, 90});
+    {"run", "the whole pipeline: check, field, dem, report (mesh on request); --quick for a first look", run_pipeline,
+     run_command_line, 90});
 } // namespace
 
 } // namespace magbrush

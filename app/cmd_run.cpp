@@ -302,7 +302,7 @@ int run_stages(const cli::ParsedArguments &args)
     {
       std::cout << "magbrush run --quick: a first look, every time of the run scaled by "
                 << changes.front().to / changes.front().from << " (results are not steady-state figures):\n"
-                << describe(changes);
+                << describe(changes) << quick_caveats(*resolved, changes);
       for (const auto &q : changes)
         added.push_back(q.override_text());
       overrides.insert(overrides.end(), added.begin(), added.end());

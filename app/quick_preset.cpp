@@ -54,4 +54,17 @@ std::string describe(const std::vector<QuickChange> &changes)
   return text;
 }
 
+std::string quick_caveats(const Case &c, const std::vector<QuickChange> &changes)
+{
+  if (changes.empty())
+    return "";
+  const double end = changes.front().to; // dem.duration comes first
+  std::string text;
+  for (const auto &p : c.planes)
+    if (!p.path.empty() && p.path.back().first > end)
+      text += "  note: the path of wall '" + p.name + "' runs to " + ms(p.path.back().first) +
+              " and is not scaled: the quick run stops part-way through it\n";
+  return text;
+}
+
 } // namespace magbrush

@@ -35,4 +35,8 @@ std::vector<QuickChange> quick_preset(const Case &c);
 // One line per change, for the terminal: "  dem.duration 75 ms -> 5 ms (x 0.0667)".
 std::string describe(const std::vector<QuickChange> &changes);
 
+// What the preset leaves as it is and the user should know: a wall's prescribed path (a
+// plate's protocol) keeps its times, so a shortened run stops part-way through it. "" if none.
+std::string quick_caveats(const Case &c, const std::vector<QuickChange> &changes);
+
 } // namespace magbrush

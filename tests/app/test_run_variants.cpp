@@ -135,6 +135,15 @@ TEST(RunQuick, ScalesTheDurationAndEveryWindowTogetherAndSaysSo)
   EXPECT_NE(quick.output.directory, c.output.directory);
 }
 
+TEST(RunQuick, SaysThatAPlatesProtocolIsNotScaled)
+{
+  const Case c = load_case(std::string(MAGBRUSH_SOURCE_DIR) + "/cases/kawamoto_brush_compression.yaml");
+  const auto changes = quick_preset(c);
+  ASSERT_FALSE(changes.empty());
+  EXPECT_NE(quick_caveats(c, changes).find("is not scaled"), std::string::npos) << quick_caveats(c, changes);
+  EXPECT_EQ(quick_caveats(load_case(fed_case), quick_preset(load_case(fed_case))), "");
+}
+
 TEST(RunQuick, AWindowBeyondTheRunIsStillRefused)
 {
   // Without --quick a short duration leaves the case's windows beyond the run: `run` stops at

@@ -8,6 +8,8 @@
 // The walk only descends where the schema has keys, so YAML alias cycles and absurd nesting
 // are never followed.
 #include "coupling/case_parser.h"
+#include "coupling/case_format.h"
+#include "coupling/run_folder.h"
 
 #include "coupling/case_schema.h"
 #include "coupling/case_validation.h"
@@ -100,6 +102,7 @@ private:
   std::vector<std::string> overrides;
   std::vector<std::string> errors;
   std::map<std::string, std::string> override_origin; // display path -> "--set ..."
+  std::map<std::string, std::string> override_path;   // "key=value" as given -> its display path
   std::map<std::string, std::string> locations;       // display path -> "file:l:c"
   std::map<std::string, Value> values;                // display path -> leaf value
   std::set<std::string> present;                      // display paths of given containers
@@ -518,6 +521,7 @@ private:
                 current.remove(other);
           current[part] = value;
           override_origin[display] = where;
+          override_path[o] = display;
         }
         else
         {
@@ -925,6 +929,32 @@ private:
     return r ? q(s, "radius") : 0.5 * q(s, "diameter");
   }
 
+  // The overrides that change a stored field or mesh: those whose key (or a key under it) the
+  // schema marks as a field input (coupling/case_schema.h, the `affects` mark).
+  std::vector<std::string> field_overrides(const Case &c) const
+  {
+    const std::vector<ResolvedEntry> entries = resolved_entries(c);
+    std::vector<std::string> out;
+    for (const auto &o : overrides)
+    {
+      const auto at = override_path.find(o);
+      if (at == override_path.end())
+        continue;
+      const std::string &p = at->second;
+      for (const auto &e : entries)
+      {
+        const KeySpec *spec = find_key_spec(e.pattern);
+        const bool under = e.path == p || e.path.rfind(p + ".", 0) == 0 || e.path.rfind(p + "[", 0) == 0;
+        if (under && spec && spec->affects != Affects::none)
+        {
+          out.push_back(o);
+          break;
+        }
+      }
+    }
+    return normalised_overrides(out);
+  }
+
   Case build()
   {
     Case c;
@@ -1002,9 +1032,20 @@ private:
     c.output.directory = str(o, "directory");
     c.output.vtu = flag(o, "vtu");
     c.output.xdmf = flag(o, "xdmf");
+    c.output.overrides = normalised_overrides(overrides);
     // The stored fields belong to the run's results unless the case puts them elsewhere: two
     // runs of one case into two folders (two biases, two tests side by side) then never
     // replace each other's field while the other reads it.
+    if (c.output.directory.empty())
+    {
+      // Named after the case and its overrides (coupling/run_folder.h); the fields after the
+      // overrides that change a field only, so that a DEM-only variant finds its baseline's.
+      c.output.automatic = true;
+      c.output.directory = automatic_run_folder(c.name, c.output.overrides);
+      if (c.field.output_dir.empty())
+        c.field.output_dir =
+            (std::filesystem::path(automatic_run_folder(c.name, field_overrides(c))) / "fields").string();
+    }
     if (c.field.output_dir.empty())
       c.field.output_dir = (std::filesystem::path(c.output.directory) / "fields").string();
     return c;

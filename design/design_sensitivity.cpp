@@ -1,6 +1,8 @@
 // The requirement-against-pole sensitivity table (see design_sensitivity.h).
 #include "design/design_sensitivity.h"
 
+#include "design/text_columns.h"
+
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -68,8 +70,7 @@ std::string format_sensitivities(const SensitivityTable &t)
   out << "\n";
   for (size_t k = 0; k < t.requirements.size(); ++k)
   {
-    std::snprintf(buf, sizeof buf, "  %-42.42s", t.requirements[k].c_str());
-    out << buf;
+    out << "  " << padded(t.requirements[k], 42);
     for (long j = 0; j < t.d.cols(); ++j)
     {
       std::snprintf(buf, sizeof buf, " %+9.2f", t.d(k, j));

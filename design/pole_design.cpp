@@ -187,7 +187,8 @@ std::vector<std::string> binding_constraints(const DesignFunctor &problem, const
 {
   std::vector<std::pair<double, std::string>> found; // (cost fall per unit move, words)
   const double c0 = sum_of_squares(problem.requirement_residuals(r.poles));
-  const double negligible = 1e-3 * std::max(c0, 1e-9); // per degree or per 10 kA/m
+  // per degree or per 10 kA/m; a cost of 1 is one requirement at the edge of its tolerance
+  const double negligible = std::max(1e-3 * c0, 1e-3);
   auto cost_moved = [&](size_t pole, bool angle, double by) {
     auto p = r.poles;
     DesignFunctor::set(p, {pole, angle}, DesignFunctor::get(p, {pole, angle}) + by);

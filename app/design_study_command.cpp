@@ -50,9 +50,17 @@ std::string table_path(const cli::ParsedArguments &args)
   return fs::exists(dir / "sweep_mean.csv") ? (dir / "sweep_mean.csv").string() : (dir / "sweep_summary.csv").string();
 }
 
+// A gap in mm to 0.1 um, a bias in V to 0.1 V, anything else to 5 significant digits.
 std::string shown(double si, Dimension d)
 {
-  return d == Dimension::dimensionless ? std::to_string(si) : format_quantity(si, d);
+  char buf[64];
+  if (d == Dimension::length)
+    std::snprintf(buf, sizeof buf, "%.4f mm", si * 1e3);
+  else if (d == Dimension::voltage)
+    std::snprintf(buf, sizeof buf, "%.1f V", si);
+  else
+    std::snprintf(buf, sizeof buf, "%.5g", si);
+  return buf;
 }
 
 } // namespace
@@ -73,8 +81,8 @@ int run_design_study(const cli::ParsedArguments &args, const std::string &mode)
                                      m == "line"        ? StudyAnswer::Method::line
                                      : m == "piecewise" ? StudyAnswer::Method::piecewise
                                                         : StudyAnswer::Method::automatic);
-  std::cout << "magbrush design " << mode << ": " << kind.key << " for " << kind.quantity << " = " << target
-            << " from " << path << " (" << table.points.size() << " points)\n";
+  std::cout << "magbrush design " << mode << ": " << kind.key << " for " << kind.quantity << " = "
+            << args.value("--target") << " from " << path << " (" << table.points.size() << " points)\n";
   char buf[256];
   for (const auto &p : table.points)
   {
@@ -100,7 +108,7 @@ int run_design_study(const cli::ParsedArguments &args, const std::string &mode)
       std::cout << "\nThe 95 % interval (± " << shown(1.96 * a.se, kind.x_dimension) << ") is wider than the tolerance ± "
                 << shown(tolerance, kind.x_dimension) << ": the point that narrows it most is the answer itself:\n"
                 << "  magbrush sweep " << (table.case_path.empty() ? "CASE" : table.case_path) << " --vary " << kind.key
-                << "=" << shown(a.x, kind.x_dimension) << "\n(then merge its row into the table and ask again)\n";
+                << "=" << std::regex_replace(shown(a.x, kind.x_dimension), std::regex(" "), "") << "\n(then merge its row into the table and ask again)\n";
     else
       std::cout << "\nThe 95 % interval is within the tolerance ± " << shown(tolerance, kind.x_dimension) << ".\n";
   }

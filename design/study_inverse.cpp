@@ -74,9 +74,9 @@ struct Line
 };
 
 // y = a + b x weighted by 1/σ² (equal weights when any point lacks a standard error).
-Line weighted_line(const std::vector<StudyPoint> &p)
+Line weighted_line(const std::vector<StudySample> &p)
 {
-  const bool weighted = std::all_of(p.begin(), p.end(), [](const StudyPoint &q) { return q.se > 0; });
+  const bool weighted = std::all_of(p.begin(), p.end(), [](const StudySample &q) { return q.se > 0; });
   Eigen::MatrixXd X(p.size(), 2);
   Eigen::VectorXd y(p.size()), w(p.size());
   for (size_t k = 0; k < p.size(); ++k)
@@ -102,7 +102,7 @@ Line weighted_line(const std::vector<StudyPoint> &p)
   return l;
 }
 
-bool strictly_monotone(const std::vector<StudyPoint> &p)
+bool strictly_monotone(const std::vector<StudySample> &p)
 {
   bool up = true, down = true;
   for (size_t k = 1; k < p.size(); ++k)
@@ -158,7 +158,7 @@ StudyTable read_study_table(const std::string &path, const std::string &x_key, c
     if (line.empty() || line[0] == '#')
       continue;
     const auto c = split(line);
-    StudyPoint p;
+    StudySample p;
     p.label = label >= 0 && label < int(c.size()) ? c[label] : "row";
     if (status >= 0 && status < int(c.size()) && c[status] != "ok")
     {
@@ -177,7 +177,7 @@ StudyTable read_study_table(const std::string &path, const std::string &x_key, c
     }
     t.points.push_back(p);
   }
-  std::sort(t.points.begin(), t.points.end(), [](const StudyPoint &a, const StudyPoint &b) { return a.x < b.x; });
+  std::sort(t.points.begin(), t.points.end(), [](const StudySample &a, const StudySample &b) { return a.x < b.x; });
   if (t.points.size() < 2)
     throw std::invalid_argument(path + ": " + std::to_string(t.points.size()) +
                                 " usable point(s); the inverse needs at least two");
@@ -193,7 +193,7 @@ StudyAnswer invert_study(const StudyTable &table, double target, StudyAnswer::Me
   a.slope = line.b;
   a.slope_se = std::sqrt(line.cov(1, 1));
   a.chi2_per_dof = line.chi2_per_dof;
-  const auto [lo, hi] = std::minmax_element(p.begin(), p.end(), [](const StudyPoint &u, const StudyPoint &v) { return u.y < v.y; });
+  const auto [lo, hi] = std::minmax_element(p.begin(), p.end(), [](const StudySample &u, const StudySample &v) { return u.y < v.y; });
   a.inside = target >= lo->y && target <= hi->y;
   const bool piecewise = method == StudyAnswer::Method::piecewise ||
                          (method == StudyAnswer::Method::automatic && a.monotone);

@@ -23,7 +23,7 @@
 
 namespace magbrush {
 
-struct StudyPoint
+struct StudySample
 {
   std::string label;
   double x = 0, y = 0, se = 0; // varied value [SI], quantity, its standard error (0: none)
@@ -34,7 +34,7 @@ struct StudyTable
   std::string source;
   std::string case_path;       // from the table's "# magbrush sweep of CASE" line, if any
   std::string x_key, y_key;
-  std::vector<StudyPoint> points; // sorted by x
+  std::vector<StudySample> points; // sorted by x
   std::vector<std::string> notes; // rows skipped and why
 };
 

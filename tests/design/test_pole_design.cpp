@@ -1,21 +1,24 @@
 // Verification of the pole design (design/pole_design.h):
 //  * a known layout recovered: the profile of a case's roller as the target, every pole of the
 //    starting layout perturbed (±5°, ±20 %), the design recovers the original to the accuracy
-//    of a fit on noise-free data — on two rollers (the development case's, and the nip case's,
-//    which no pole-fit test uses), with the time it takes;
+//    of a fit on noise-free data — on two rollers (the development case's, and an irregular
+//    six-pole roller with its own shape factors that no case or fit test uses), with the time;
 //  * a specification (peaks, a low-field arc, spacing) met by the designed layout, judged by
 //    an independent evaluation of the exact ring (MultipoleRing);
 //  * an infeasible specification reported as such, with the bound that binds;
-//  * a fixed pole left where it is.
 #include "coupling/case_parser.h"
 #include "coupling/multipole_ring.h"
 #include "design/pole_design.h"
+#include "tests/cli_run.h"
+#include "tests/test_temp_dir.h"
 
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 
 using namespace magbrush;
 
@@ -181,6 +184,59 @@ TEST(PoleDesign, LeavesAFixedPoleWhereItIs)
   for (const auto &b : d.binding)
     says_fixed |= b.find("S1 is fixed") != std::string::npos;
   EXPECT_TRUE(says_fixed);
+}
+
+// The seconds the command printed on its "Time:" line ("total S s").
+double total_seconds(const std::string &output)
+{
+  const auto at = output.find("total ");
+  return at == std::string::npos ? 1e9 : std::atof(output.c_str() + at + 6);
+}
+
+TEST(DesignCommand, SpecificationMetAndCheckedByFemWithinBudget)
+{
+  const auto dir = magbrush::testing::test_temp_dir("design_spec");
+  const std::string src = MAGBRUSH_SOURCE_DIR;
+  const auto r = magbrush::testing::run_program(
+      "magbrush", "design poles " + src + "/cases/kweon_development.yaml --target " + src +
+                      "/cases/data/kweon_development_spec.yaml --set field.output_dir=" + (dir / "fields").string() +
+                      " --no-plot -o " + dir.string());
+  std::printf("%s\n", r.output.substr(r.output.find("Time:")).c_str());
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("Every requirement is met."), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("The FEM of the designed layout meets every requirement."), std::string::npos) << r.output;
+  EXPECT_LT(total_seconds(r.output), 30.0) << r.output;
+  const Case designed = load_case((dir / "kweon_development_designed.yaml").string());
+  EXPECT_EQ(designed.roller->poles.size(), 5u);
+  for (const char *f : {"design_report.txt", "design_profile.csv", "design_requirements.csv", "design_sensitivity.csv"})
+    EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
+}
+
+TEST(DesignCommand, RecoversTheCaseFromItsOwnProfile)
+{
+  const auto dir = magbrush::testing::test_temp_dir("design_profile");
+  const std::string case_file = std::string(MAGBRUSH_SOURCE_DIR) + "/cases/kweon_development.yaml";
+  const auto flux = magbrush::testing::run_program(
+      "magbrush", "flux " + case_file + " --source ring --no-plot -o " + (dir / "own").string());
+  ASSERT_EQ(flux.code, 0) << flux.output;
+  // Every pole 5° off and 20 % stronger or weaker; the FEM check is the other test's.
+  const auto r = magbrush::testing::run_program(
+      "magbrush", "design poles " + case_file + " --target " + (dir / "own" / "flux_profile.csv").string() +
+                      " --set roller.poles.S1.angle=5deg --set roller.poles.N1.angle=67deg"
+                      " --set roller.poles.S2.angle=149deg --set roller.poles.S3.angle=211deg"
+                      " --set roller.poles.N2.angle=293deg --set roller.poles.S1.strength=396kA/m"
+                      " --set roller.poles.N1.strength=137.6kA/m --set roller.poles.S2.strength=240kA/m"
+                      " --set roller.poles.S3.strength=204kA/m --set roller.poles.N2.strength=113.6kA/m"
+                      " --no-fem-check --no-plot -o " + dir.string());
+  EXPECT_EQ(r.code, 0) << r.output;
+  const Roller truth = case_roller("kweon_development.yaml");
+  const Case designed = load_case((dir / "kweon_development_designed.yaml").string());
+  for (size_t i = 0; i < truth.poles.size(); ++i)
+  {
+    // The file's 4 decimals of a degree and 3 of a kA/m.
+    EXPECT_NEAR(std::remainder(designed.roller->poles[i].angle - truth.poles[i].angle, 2 * M_PI) / deg, 0.0, 1e-4);
+    EXPECT_NEAR(designed.roller->poles[i].strength, truth.poles[i].strength, 1.0);
+  }
 }
 
 } // namespace

@@ -3,6 +3,7 @@
 // `design gap` and `design bias` read a finished study and give the blade gap or the bias
 // that reaches a target DMA or TMA, with its interval (design_study_command.h).
 #include "app/design_poles_command.h"
+#include "app/design_release_command.h"
 #include "app/design_study_command.h"
 #include "app/subcommand.h"
 
@@ -16,7 +17,8 @@ const cli::CommandSpec &design_command_line()
     s.program = "magbrush design";
     s.usage = "magbrush design poles CASE --target FILE [--constraints FILE] [--fix POLE,...] [options]\n"
               "       magbrush design gap  --target 0.40kg/m2 STUDY_DIR [options]\n"
-              "       magbrush design bias --target 0.5mg/cm2 STUDY_DIR [options]";
+              "       magbrush design bias --target 0.5mg/cm2 STUDY_DIR [options]\n"
+              "       magbrush design release CASE [--vary key=v1,v2,...] [--window FROM,TO]";
     s.description = R"(The inverse of the analysis: what to build for a wanted result.
 
 design poles: the pole layout (each pole's angle and strength; signs and shape factors stay
@@ -35,6 +37,12 @@ against the varied value (blades.doctor.gap, electric.bias) — piecewise linear
 means are monotone, a weighted straight line otherwise — and gives the value for the target
 with its standard error propagated from the points'. A target outside the study's range is
 reported as such (with the line's extrapolation, marked).
+
+design release: the field criterion for release, from the exact ring in seconds: the outward
+acceleration of a carrier bead at the sleeve, magnetic (3β/(2μ0ρ) ∂B²/∂r) plus centrifugal plus
+gravity; held where it is negative. For the case's layout or each --vary value, ranked by the
+largest net outward acceleration in the release window (dma.release_from → release_to, or
+--window), with the arcs where a bead is no longer held.
 )";
     s.positionals = {{"MODE", "poles, gap or bias"}, {"CASE|STUDY_DIR", "the case (poles) or the study folder (gap, bias)"}};
     s.options = {
@@ -54,6 +62,8 @@ reported as such (with the line's extrapolation, marked).
         {"--quantity", {}, "KEY", "gap, bias: the study's column (default dma_kg_per_m2 / tma_kg_per_m2)"},
         {"--key", {}, "KEY", "gap, bias: the varied column (default blades.doctor.gap / electric.bias)"},
         {"--table", {}, "FILE", "gap, bias: the study table to read (default: from STUDY_DIR)"},
+        {"--vary", {}, "KEY=V1,V2", "release: one layout per value, ranked (e.g. roller.poles.S2.angle=144deg,165deg)"},
+        {"--window", {}, "FROM,TO", "release: the window judged (default dma.release_from,release_to)"},
         {"--method", {}, "auto|piecewise|line", "gap, bias: interpolation (auto: piecewise where monotone)", false,
          {"auto", "piecewise", "line"}}};
     s.epilog = R"(Outputs of design poles in DIR: design_report.txt, <case>_designed.yaml, design_profile.csv
@@ -75,17 +85,19 @@ int run_design(const std::vector<std::string> &args)
                             const std::string mode = parsed.positional(0);
                             if (parsed.positional(1).empty())
                               throw cli::UsageError("design " + mode + " needs " +
-                                                    (mode == "poles" ? "a case file" : "a study folder"));
+                                                    (mode == "gap" || mode == "bias" ? "a study folder" : "a case file"));
                             if (mode == "poles")
                               return run_design_poles(parsed);
                             if (mode == "gap" || mode == "bias")
                               return run_design_study(parsed, mode);
-                            throw cli::UsageError("unknown mode '" + mode + "' (poles, gap or bias)");
+                            if (mode == "release")
+                              return run_design_release(parsed);
+                            throw cli::UsageError("unknown mode '" + mode + "' (poles, gap, bias or release)");
                           });
 }
 
 const bool registered = register_subcommand(
-    {"design", "the inverse: pole layout, blade gap or bias that meets a target", run_design,
+    {"design", "the inverse: pole layout, blade gap or bias that meets a target; release criterion", run_design,
      design_command_line, 55});
 
 } // namespace

@@ -12,6 +12,7 @@
 //      encoder offset, the fitted case file (which records that offset as the scan's angular
 //      origin), and "the FEM as the final check" when magbrush-field is available.
 #include "app/subcommand.h"
+#include "app/flux_tools.h"
 
 #include "calibration/flux_compare.h"
 #include "calibration/flux_scan.h"
@@ -156,117 +157,6 @@ FluxOptions flux_options(const cli::ParsedArguments &args)
 
 // ---------------------------------------------------------------------------------------
 
-std::string fixed(double v, int digits)
-{
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
-  return buf;
-}
-
-std::string scientific(double v)
-{
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.1e", v);
-  return buf;
-}
-
-double probe_radius_of(const Case &c)
-{
-  if (!c.roller)
-    throw std::invalid_argument("the case has no roller; magbrush flux needs roller.poles");
-  double r = c.field.probe_radius;
-  if (r == 0.0)
-  {
-    if (!c.sleeve)
-      throw std::invalid_argument("field.probe_radius is 0 (= the sleeve radius) but the case has "
-                                  "no sleeve; set field.probe_radius");
-    r = c.sleeve->radius;
-  }
-  if (r < c.roller->magnet_radius)
-    throw std::invalid_argument("the probe radius " + fixed(r * 1e3, 3) +
-                                " mm lies inside the magnet (outer radius " +
-                                fixed(c.roller->magnet_radius * 1e3, 3) +
-                                " mm); a gaussmeter scans outside it: set field.probe_radius to a "
-                                "radius ≥ the magnet radius (0 = the sleeve radius)");
-  return r;
-}
-
-// The FEM profile at this radius, if magbrush-field wrote one for the case as it is now:
-// the profile's "# ... radius R mm." line must match the probe radius, and the stored magnetic
-// field it came from (<case>_magnetic.h5) must carry the case's current field hash.
-std::string fem_profile_path(const Case &c, double probe_radius, std::string &why_not)
-{
-  const std::string path = field::field_file(c, "profile_probe.csv");
-  std::ifstream in(path);
-  if (!in)
-  {
-    why_not = "no finite-element profile " + path + " (run `magbrush field` first to compare the FEM)";
-    return "";
-  }
-  std::string line;
-  while (std::getline(in, line) && !line.empty() && line[0] == '#')
-  {
-    const auto at = line.find("radius ");
-    if (at == std::string::npos)
-      continue;
-    const double r = std::atof(line.c_str() + at + 7) * 1e-3;
-    if (std::abs(r - probe_radius) > 1e-7) // the file prints 6 significant digits
-    {
-      why_not = path + " is at radius " + fixed(r * 1e3, 3) + " mm, not the probe radius " +
-                fixed(probe_radius * 1e3, 3) + " mm";
-      return "";
-    }
-    break;
-  }
-  const std::string grid = field::magnetic_grid_path(c);
-  if (fs::exists(grid))
-  {
-    try
-    {
-      const GridFileInfo info = read_grid_info(grid);
-      const std::string difference =
-          provenance_difference(info, case_provenance(c, FieldKind::magnetic).case_inputs);
-      if (!difference.empty())
-      {
-        why_not = path + " is stale: " + difference;
-        return "";
-      }
-    }
-    catch (const std::exception &e)
-    {
-      why_not = "cannot check that " + path + " belongs to this case (" + e.what() + ")";
-      return "";
-    }
-  }
-  return path;
-}
-
-struct ComputedProfile
-{
-  std::string source; // words
-  std::vector<double> Bn, Bt;
-};
-
-ComputedProfile computed_at(const std::vector<double> &angles, const MultipoleRing &ring,
-                            double probe_radius, const std::string &fem_path)
-{
-  ComputedProfile p;
-  if (!fem_path.empty())
-  {
-    ScanReadOptions o;
-    o.min_points = 16;
-    const FluxScan fem = read_flux_scan(fem_path, o);
-    p.Bn = interpolate_periodic(fem.angle, fem.Bn, angles);
-    p.Bt = fem.has_tangential() ? interpolate_periodic(fem.angle, fem.Bt, angles)
-                                : std::vector<double>(angles.size(), 0.0);
-    p.source = "finite-element field (" + fem_path + ")";
-    return p;
-  }
-  ring.profile(probe_radius, angles, p.Bn, p.Bt);
-  p.source = "exact multipole ring (" + std::to_string(ring.harmonic_count()) + " harmonics)";
-  return p;
-}
-
 void write_profile_csv(const std::string &path, const Case &c, double r,
                        const ComputedProfile &p, const std::vector<double> &angles)
 {
@@ -285,65 +175,6 @@ void write_profile_csv(const std::string &path, const Case &c, double r,
   write_text_atomically(path, out.str());
 }
 
-// tools/plot_flux.py (app/subcommand.h find_tool_script).
-std::string find_plot_script() { return find_tool_script("plot_flux.py"); }
-
-void plot(const std::string &residuals, const std::string &fitted, const std::string &png,
-          const std::string &title, const std::string &label)
-{
-  const std::string script = find_plot_script();
-  if (script.empty())
-  {
-    std::cout << "warning: tools/plot_flux.py not found (set MAGBRUSH_TOOLS to the tools "
-                 "directory); no plot written\n";
-    return;
-  }
-  std::vector<std::string> arguments = {script, "--residuals", residuals};
-  if (!fitted.empty())
-    arguments.insert(arguments.end(), {"--fitted", fitted});
-  arguments.insert(arguments.end(), {"--title", title, "--label", label, "-o", png});
-  // The first interpreter that has matplotlib: $MAGBRUSH_PYTHON, python3 on the PATH, then the
-  // system's (a pyenv or venv python3 on the PATH often lacks the Debian matplotlib).
-  // $MAGBRUSH_PYTHON, when set, is the only one tried.
-  std::vector<std::string> interpreters;
-  if (const char *env = std::getenv("MAGBRUSH_PYTHON"))
-    interpreters.push_back(env);
-  else
-  {
-    interpreters.push_back("python3");
-    if (fs::exists("/usr/bin/python3"))
-      interpreters.push_back("/usr/bin/python3");
-  }
-  // The script exits with 3 when matplotlib is missing; 127 stands for "could not start".
-  int status = 127;
-  ChildOutput quiet;
-  quiet.stderr_path = "/dev/null";
-  for (const auto &python : interpreters)
-  {
-    std::vector<std::string> command = {python};
-    command.insert(command.end(), arguments.begin(), arguments.end());
-    try
-    {
-      status = run_program(command, quiet);
-    }
-    catch (const ChildProcessError &)
-    {
-      status = 127;
-    }
-    if (status != 3 && status != 127)
-      break;
-  }
-  if (status == 0)
-    std::cout << "  plot        " << png << "\n";
-  else if (status == 127)
-    std::cout << "warning: python3 not found; no plot written (install python3 and "
-                 "python3-matplotlib)\n";
-  else if (status == 3)
-    std::cout << "warning: matplotlib is missing; no plot written (install python3-matplotlib)\n";
-  else
-    std::cout << "warning: the plot script failed (status " << status << "); no plot written\n";
-}
-
 void print_comparison(const FluxComparison &c, const std::string &title)
 {
   std::cout << title << "\n" << format_errors(c) << "\n" << format_peaks(c) << "\n";
@@ -351,54 +182,6 @@ void print_comparison(const FluxComparison &c, const std::string &title)
 
 // ---------------------------------------------------------------------------------------
 // The fitted case file: the user's YAML with roller.poles replaced (comments are lost).
-
-// Apply "a.b.c=value" overrides to the YAML tree (lists addressed by element name or [index]),
-// so that the fitted file describes the case that was actually fitted.
-void apply_override(YAML::Node root, const std::string &override_text)
-{
-  const auto eq = override_text.find('=');
-  if (eq == std::string::npos)
-    return;
-  std::vector<std::string> keys;
-  std::stringstream ks(override_text.substr(0, eq));
-  for (std::string k; std::getline(ks, k, '.');)
-    keys.push_back(k);
-  YAML::Node node = root;
-  for (size_t i = 0; i < keys.size(); ++i)
-  {
-    std::string key = keys[i];
-    const bool last = i + 1 == keys.size();
-    if (node.IsSequence())
-    {
-      YAML::Node next;
-      if (key.size() > 2 && key.front() == '[' && key.back() == ']')
-      {
-        const size_t index = std::stoul(key.substr(1, key.size() - 2));
-        if (index < node.size())
-          next.reset(node[index]);
-      }
-      else
-        for (const auto &element : node)
-          if (element.IsMap() && element["name"] && element["name"].as<std::string>() == key)
-            next.reset(element);
-      // Not addressable, or a whole list element: leave the file's text (the loaded case
-      // itself had the override applied by the parser).
-      if (!next.IsDefined() || next.IsNull() || last)
-        return;
-      node.reset(next);
-      continue;
-    }
-    if (last)
-    {
-      node[key] = override_text.substr(eq + 1);
-      return;
-    }
-    if (!node[key])
-      node[key] = YAML::Node(YAML::NodeType::Map);
-    YAML::Node next = node[key];
-    node.reset(next);
-  }
-}
 
 std::string fitted_case_text(const Case &c, const FluxOptions &o, const PoleFitResult &fit,
                              double scan_origin, const std::string &scan_path,
@@ -409,21 +192,10 @@ std::string fitted_case_text(const Case &c, const FluxOptions &o, const PoleFitR
     apply_override(root, ov);
   root["name"] = fitted_name;
   root["measured_flux_file"] = fs::absolute(scan_path).lexically_normal().string();
-  YAML::Node poles(YAML::NodeType::Sequence);
+  std::vector<Pole> fitted;
   for (const auto &p : fit.poles)
-  {
-    YAML::Node n(YAML::NodeType::Map);
-    n.SetStyle(YAML::EmitterStyle::Flow);
-    n["name"] = p.pole.name;
-    // In [0, 360) also after rounding (359.99996 would print as 360.0000, out of range).
-    double angle_deg = std::round(p.pole.angle * to_deg * 1e4) / 1e4;
-    if (angle_deg >= 360.0)
-      angle_deg -= 360.0;
-    n["angle"] = fixed(angle_deg, 4) + " deg";
-    n["strength"] = fixed(p.pole.strength * 1e-3, 3) + " kA/m";
-    n["shape_factor"] = fixed(p.pole.shape_factor, 4) + " rad^-2";
-    poles.push_back(n);
-  }
+    fitted.push_back(p.pole);
+  const YAML::Node poles = poles_yaml(fitted);
   root["roller"]["poles"] = poles;
   if (fit.shape == PoleFitOptions::Shape::shared)
     root["roller"]["shape_factor"] = fixed(fit.poles[0].pole.shape_factor, 4) + " rad^-2";
@@ -508,23 +280,10 @@ void fem_check(const std::string &fitted_case, const FluxScan &scan, const std::
   }
   std::cout << "FEM check: running magbrush-field on " << fitted_case << " ...\n" << std::flush;
   const std::string log = dir + "/flux_fem_check.log";
-  ChildOutput to_log;
-  to_log.stdout_path = log;
-  to_log.stderr_to_stdout = true;
-  std::string failure;
-  try
-  {
-    const int status = run_program({field_exe.string(), fitted_case, "--only", "magnetic", "--no-vtu"}, to_log);
-    if (status != 0)
-      failure = "magbrush-field exited with status " + std::to_string(status);
-  }
-  catch (const ChildProcessError &e)
-  {
-    failure = e.what();
-  }
+  const std::string failure = run_magnetic_field_solver(fitted_case, log);
   if (!failure.empty())
   {
-    std::cout << "FEM check failed: " << failure << " (see " << log << ")\n";
+    std::cout << "FEM check failed: " << failure << "\n";
     return;
   }
   const Case fitted = load_case(fitted_case);
@@ -745,8 +504,12 @@ private:
       return;
     const std::string title = "Case '" + case_.name + "'" + (fit_ ? " and its fitted poles" : "") +
                               " against " + scan_path_;
-    plot(residuals_, fit_ ? fit_residuals_ : "", dir_ + "/flux_overlay.png", title,
-         fem_path_.empty() ? "exact ring" : "FEM");
+    std::vector<std::string> arguments = {"--residuals", residuals_};
+    if (fit_)
+      arguments.insert(arguments.end(), {"--fitted", fit_residuals_});
+    arguments.insert(arguments.end(), {"--title", title, "--label",
+                                       fem_path_.empty() ? "exact ring" : "FEM", "-o", dir_ + "/flux_overlay.png"});
+    run_plot_script("plot_flux.py", arguments, dir_ + "/flux_overlay.png");
   }
 
   // 7. "The FEM as the final check".

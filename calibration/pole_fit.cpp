@@ -83,12 +83,23 @@ PoleProfileModel::PoleProfileModel(const RingGeometry &geometry, double probe_ra
   samples_ = GaussianPoleSpectrum::default_samples(harmonics);
 }
 
+GaussianPoleSpectrum PoleProfileModel::spectrum(double alpha) const
+{
+  return GaussianPoleSpectrum::compute(alpha, harmonics(), samples_);
+}
+
 PoleProfileModel::PoleTerms PoleProfileModel::terms(double alpha, double angle,
                                                     const std::vector<double> &theta,
                                                     bool derivatives) const
 {
+  return terms(spectrum(alpha), angle, theta, derivatives);
+}
+
+PoleProfileModel::PoleTerms PoleProfileModel::terms(const GaussianPoleSpectrum &spectrum,
+                                                    double angle, const std::vector<double> &theta,
+                                                    bool derivatives) const
+{
   const int N = harmonics();
-  const auto spectrum = GaussianPoleSpectrum::compute(alpha, N, samples_);
   std::vector<double> w(N + 1), wa(N + 1);
   for (int n = 1; n <= N; ++n)
   {

@@ -107,6 +107,11 @@ public:
   };
   PoleTerms terms(double alpha, double angle, const std::vector<double> &theta,
                   bool derivatives) const;
+  // The same from a precomputed spectrum of the pole's shape (spectrum(α)): a caller that holds
+  // α fixed (the pole design) computes it once instead of at every evaluation.
+  PoleTerms terms(const GaussianPoleSpectrum &spectrum, double angle,
+                  const std::vector<double> &theta, bool derivatives) const;
+  GaussianPoleSpectrum spectrum(double alpha) const;
   void profile(const std::vector<Pole> &poles, const std::vector<double> &theta,
                std::vector<double> &Bn, std::vector<double> &Bt) const;
 

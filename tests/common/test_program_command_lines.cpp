@@ -41,7 +41,7 @@ const std::string nip_case = std::string(MAGBRUSH_SOURCE_DIR) + "/cases/kawamoto
 
 TEST(ProgramCommandLines, EverySubcommandHelpExitsZero)
 {
-  for (const char *command : {"check", "mesh", "field", "flux", "dem", "report", "compare", "run", "sweep"})
+  for (const char *command : {"check", "mesh", "field", "flux", "design", "dem", "report", "compare", "run", "sweep"})
   {
     const Result r = run({bin + "magbrush", command, "--help"});
     EXPECT_EQ(r.status, 0) << command << "\n" << r.output;

@@ -675,8 +675,8 @@ void DemSystem::particle_wall_contacts(std::size_t i, double dt, const ForceArra
   // Van der Waals adhesion reaches across a gap (0 without adhesion: only touching walls).
   const bool adhesive = table_.adhesive();
   const double range = adhesive ? table_.adhesion_range() : 0.0, z0 = table_.adhesion_cutoff();
-  WallContactGeometry g[max_wall_contacts + 1];
-  int which[max_wall_contacts + 1] = {};
+  WallContactGeometry *g = my_flags().wall_geometry.data(); // filled by contact() below
+  int which[max_wall_contacts + 1];
   const long k = static_cast<long>(i);
   const Vector3 p = s.position(i);
   const double r = s.radius[i];

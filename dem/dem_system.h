@@ -191,6 +191,9 @@ private:
     double max_drift2 = 0.0;   // largest squared displacement since the list build
     double max_step2 = 0.0;    // largest squared displacement in this step's drift
     std::vector<double> row_torques; // scratch of the pair phase (kept: no allocation per step)
+    // Scratch of a particle's wall contacts: kept here because an array of these on the stack
+    // is zeroed at every call (their members have initialisers), a third of the wall phase.
+    std::array<WallContactGeometry, max_wall_contacts + 1> wall_geometry;
   };
   std::vector<StepFlags> thread_flags_; // one per thread of the team
   std::size_t team_terms_ = 0;           // leading force terms that run inside the team

@@ -69,10 +69,16 @@ largest net outward acceleration in the release window (dma.release_from → rel
     s.epilog = R"(Outputs of design poles in DIR: design_report.txt, <case>_designed.yaml, design_profile.csv
 (the designed profile, and the FEM's), design_requirements.csv, design_sensitivity.csv,
 design_bands.csv, design_profile.png.
-Exit status: 0 done (poles: every requirement met; gap/bias: target within the study), 3 the
-target cannot be met (poles: infeasible, nearest layout written) or lies outside the study,
-1 bad input, 2 bad usage.
 )";
+    s.examples = {{"magbrush design poles cases/kweon_development.yaml --target cases/data/kweon_development_spec.yaml",
+                   "the pole layout for a specification, checked by the finite-element solver"},
+                  {"magbrush design gap --target 0.40kg/m2 results/sweep_gap",
+                   "the doctor-blade gap for a DMA, read off a finished `magbrush sweep ... --name gap`"},
+                  {"magbrush design release cases/kweon_release.yaml --vary roller.poles.S2.angle=144deg,165deg",
+                   "which S2 angle lets the developer go at release"}};
+    s.exit_status = "0 done (poles: every requirement met; gap/bias: target within the study), 3 the\n"
+                    "target cannot be met (poles: infeasible, nearest layout written) or lies outside the study,\n"
+                    "1 bad input, 2 bad usage.";
     return s;
   }();
   return spec;

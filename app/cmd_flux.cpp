@@ -11,7 +11,10 @@
 //      noise estimated from the scan, the comparison with the scan rotated by the fitted
 //      encoder offset, the fitted case file (which records that offset as the scan's angular
 //      origin), and "the FEM as the final check" when magbrush-field is available.
+// With --compare OTHER_CASE there is no scan: two cases' profiles are overlaid and each pole's
+// peak shift tabulated instead (app/flux_case_comparison.h).
 #include "app/subcommand.h"
+#include "app/flux_case_comparison.h"
 #include "app/flux_tools.h"
 
 #include "calibration/flux_compare.h"
@@ -52,7 +55,8 @@ const cli::CommandSpec &flux_command_line()
   static const cli::CommandSpec spec = [] {
     cli::CommandSpec s;
     s.program = "magbrush flux";
-    s.usage = "magbrush flux CASE [--measured SCAN.csv] [-o DIR] [--set key=value ...] [options]";
+    s.usage = "magbrush flux CASE [--measured SCAN.csv] [-o DIR] [--set key=value ...] [options]\n"
+              "       magbrush flux CASE --compare OTHER_CASE [--compare-set key=value ...] [--set ...] [-o DIR]";
     s.description = R"(Compares the sleeve flux profile of a case with a gaussmeter scan, and with --fit calibrates
 the Gaussian pole model (strengths, angles, shape factors, encoder offset) to it.
 
@@ -65,6 +69,12 @@ Scan (CSV): columns angle, Bn[, Bt] in any order (names like angle_deg/theta, Bn
 Bt/B_t/Btheta), units in the header (angle_deg, Bn_mT, "Bn [G]") or given below, '#' comments.
 Without --measured the case's measured_flux_file is used; without either only the computed
 profile is written.
+
+With --compare OTHER_CASE: no scan; the profiles of the two cases overlaid instead, each pole's
+peak in both (poles matched by name) and how far it moved (angle, Bn), B = OTHER_CASE against
+A = CASE. --set applies to both, --compare-set to OTHER_CASE only, so a variant of one case is
+`--compare CASE --compare-set key=value`. Both profiles come from the same source: the FEM's
+when `magbrush field` has stored one for each case as it is now, else the exact ring for both.
 )";
     s.positionals = {{"CASE", "the case file"}};
     s.options = {
@@ -93,12 +103,22 @@ profile is written.
         {"--no-fem-check", {}, "", "skip running magbrush-field on the fitted case"},
         {"--no-plot", {}, "",
          "do not call tools/plot_flux.py (the plot needs python3 with\nmatplotlib; $MAGBRUSH_PYTHON picks the interpreter)"},
-        {"--harmonics", {}, "N", "number of Fourier harmonics (default: from the decay of the series)"}};
+        {"--harmonics", {}, "N", "number of Fourier harmonics (default: from the decay of the series)"},
+        {"--compare", {}, "OTHER_CASE", "overlay this case's sleeve flux on CASE's, with each pole's peak shift",
+         false, {}, /*for_pipeline=*/false},
+        {"--compare-set", {}, "key=value",
+         "override a key of OTHER_CASE only (repeatable), e.g.\n--compare-set roller.poles.S1.angle=5deg",
+         /*repeatable=*/true, {}, /*for_pipeline=*/false}};
     s.epilog = R"(Outputs in DIR: flux_profile.csv (computed, 0.25 deg), flux_residuals.csv, flux_overlay.png,
 and with --fit: flux_fit_residuals.csv, <case>_fitted.yaml, flux_fit.txt.
+With --compare (DIR default: <CASE's run folder>/flux/compare_<OTHER's run folder>):
+flux_compare.csv (both profiles and B - A), flux_compare_peaks.csv, flux_compare.png.
 )";
     s.examples = {{"magbrush flux cases/kawamoto_nip.yaml --measured cases/data/sleeve_profile_example.csv --fit",
-                   "compare a gaussmeter scan with the computed flux and fit the poles to it"}};
+                   "compare a gaussmeter scan with the computed flux and fit the poles to it"},
+                  {"magbrush flux cases/kawamoto_nip_fed.yaml --compare cases/kawamoto_nip_fed.yaml "
+                   "--compare-set roller.poles.S1.angle=5deg",
+                   "the development pole moved 5 deg downstream: both profiles and every pole's peak shift"}};
     s.exit_status = "0 done, 1 bad input (message says what and how to fix), 2 bad usage.";
     return s;
   }();
@@ -522,10 +542,40 @@ private:
   }
 };
 
+// --compare: two cases' profiles instead of a case against a scan (app/flux_case_comparison.h).
+int compare_two_cases(const cli::ParsedArguments &args)
+{
+  for (const char *scan_option : {"--measured", "--fit", "--fit-shape", "--no-offset", "--bn-only", "--no-fem-check",
+                                  "--angle-offset", "--angle-unit", "--field-unit", "--clockwise", "--flip-bt"})
+    if (args.has(scan_option))
+      throw cli::UsageError(std::string(scan_option) +
+                            " is for a gaussmeter scan; --compare overlays two cases' computed profiles: give one or "
+                            "the other");
+  FluxCaseComparisonOptions o;
+  o.case_path = args.positional(0);
+  o.other_path = args.value("--compare");
+  o.overrides = args.values("--set");
+  o.other_overrides = args.values("--compare-set");
+  o.output_dir = args.value("--output");
+  o.source = args.value("--source", "auto");
+  o.harmonics = static_cast<int>(args.whole_number("--harmonics", 0, 1, 4096));
+  o.no_plot = args.has("--no-plot");
+  return compare_case_fluxes(o);
+}
+
+int flux(const cli::ParsedArguments &args)
+{
+  if (args.has("--compare"))
+    return compare_two_cases(args);
+  if (args.has("--compare-set"))
+    throw cli::UsageError("--compare-set changes the case given with --compare: add --compare OTHER_CASE (it may "
+                          "be CASE itself)");
+  return FluxCommand(flux_options(args)).run();
+}
+
 int run_flux(const std::vector<std::string> &args)
 {
-  return cli::run_command(flux_command_line(), {args.begin() + 1, args.end()},
-                          [](const cli::ParsedArguments &parsed) { return FluxCommand(flux_options(parsed)).run(); });
+  return cli::run_command(flux_command_line(), {args.begin() + 1, args.end()}, flux);
 }
 
 const bool registered = register_subcommand(

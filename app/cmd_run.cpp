@@ -20,6 +20,7 @@
 #include "coupling/run_folder.h"
 #include "common/atomic_file.h"
 #include "coupling/field_files.h"
+#include "coupling/units.h"
 
 #include <algorithm>
 #include <chrono>
@@ -143,6 +144,70 @@ std::map<std::string, double> read_run_times(const fs::path &path)
   return times;
 }
 
+// The simulated time a run folder's resolved case gives (dem.duration), 0 when unreadable.
+double simulated_duration(const fs::path &folder)
+{
+  std::ifstream in(folder / "case_resolved.txt");
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind("dem.duration ", 0) == 0 && line.find('=') != std::string::npos)
+    {
+      try
+      {
+        return parse_quantity(line.substr(line.find('=') + 1), Dimension::time);
+      }
+      catch (const std::exception &)
+      {
+        return 0.0;
+      }
+    }
+  return 0.0;
+}
+
+// Stage times to announce as ETAs when this run folder has none yet (a variant's first run):
+// those of the newest other run of the same case beside it (its baseline or another variant),
+// the DEM's scaled by the simulated time, which its cost follows nearly in proportion. `from`
+// names that folder; empty when there is none.
+struct StageEstimates
+{
+  std::map<std::string, double> seconds;
+  std::string from;
+};
+
+StageEstimates estimates_from_a_sibling(const Case &c)
+{
+  StageEstimates e;
+  const fs::path folder = c.output.directory;
+  const fs::path parent = folder.parent_path().empty() ? fs::path(".") : folder.parent_path();
+  std::error_code ec;
+  fs::file_time_type newest{};
+  fs::path best;
+  for (const auto &entry : fs::directory_iterator(parent, ec))
+  {
+    const std::string n = entry.path().filename().string();
+    if (entry.path().filename() == folder.filename() || (n != c.name && n.rfind(c.name + "-", 0) != 0))
+      continue;
+    const fs::path times = entry.path() / "run_times.csv";
+    if (fs::exists(times, ec) && (best.empty() || fs::last_write_time(times, ec) > newest))
+    {
+      best = entry.path();
+      newest = fs::last_write_time(times, ec);
+    }
+  }
+  if (best.empty())
+    return e;
+  e.seconds = read_run_times(best / "run_times.csv");
+  const double theirs = simulated_duration(best);
+  if (e.seconds.count("dem"))
+  {
+    if (theirs > 0.0 && c.dem.duration > 0.0)
+      e.seconds["dem"] *= c.dem.duration / theirs;
+    else
+      e.seconds.erase("dem");
+  }
+  e.from = best.string();
+  return e;
+}
+
 void write_run_times(const fs::path &path, const std::vector<std::pair<std::string, double>> &timings)
 {
   fs::create_directories(path.parent_path());
@@ -250,8 +315,9 @@ the overrides listed in its variant.txt: variants of a case land side by side (c
 with `magbrush compare`), and a variant that changes no field reads its baseline's fields.
 --set goes to every stage (e.g. --set drum.gap=0.3mm); every other option only to the stages
 that declare it, named in brackets below (e.g. -np 2 to the field solver, --threads 4 to the DEM).
-Each stage is announced with the wall time it took in the last run of this case (its ETA); the
-DEM prints its own progress with an ETA. Stage times go to <run folder>/run_times.csv. At
+Each stage is announced with the wall time it took in the last run of this folder (its ETA) or,
+on a first run, in the newest run of the same case beside it (the DEM's scaled by the simulated
+time); the DEM prints its own progress with an ETA. Stage times go to <run folder>/run_times.csv. At
 the end: the time per stage and where every output is.
 )";
     s.examples = {{"magbrush run cases/kawamoto_nip_fed.yaml --quick", "a first look in about a minute"},
@@ -318,6 +384,7 @@ int run_stages(const cli::ParsedArguments &args)
   }
   const fs::path times_file = resolved ? fs::path(resolved->output.directory) / "run_times.csv" : fs::path();
   const auto last_times = resolved ? read_run_times(times_file) : std::map<std::string, double>{};
+  const StageEstimates sibling = resolved && last_times.empty() ? estimates_from_a_sibling(*resolved) : StageEstimates{};
 
   const std::vector<std::string> &pipeline = pipeline_stages();
   std::vector<std::pair<std::string, double>> timings;
@@ -347,6 +414,10 @@ int run_stages(const cli::ParsedArguments &args)
     std::ostringstream eta;
     if (last_times.count(name))
       eta << ", ETA ~" << static_cast<long>(last_times.at(name) + 0.5) << " s (last run)";
+    // A variant may solve its own fields or none; the check takes no time worth announcing.
+    else if (sibling.seconds.count(name) && name != "field" && name != "check")
+      eta << ", ETA ~" << static_cast<long>(sibling.seconds.at(name) + 0.5) << " s (from " << sibling.from
+          << (name == "dem" ? ", scaled by the simulated time)" : ")");
     std::cout << "\n== magbrush run: stage " << k + 1 << "/" << pipeline.size() << ": " << name << " (at "
               << static_cast<long>(elapsed) << " s" << eta.str() << ") ==" << std::endl;
     if (name == "dem" && resolved && resolved->dem.settle_time > 0.0)

@@ -158,7 +158,8 @@ TEST(RunQuick, AWindowBeyondTheRunIsStillRefused)
 TEST(RunQuick, TheFoldersTheReadmeNamesAreTheOnesTheRunsWriteTo)
 {
   // README's first hour compares two quick runs by their folders: the digests of the quick
-  // preset's overrides (and a 0.5 mm gap). A change of the preset or the digest changes them.
+  // preset's overrides (and a 0.5 mm gap), and a moved pole's flux by the folder named after
+  // its variant. A change of the preset or the digest changes them.
   std::vector<std::string> quick;
   for (const auto &q : quick_preset(load_case(fed_case)))
     quick.push_back(q.override_text());
@@ -171,4 +172,9 @@ TEST(RunQuick, TheFoldersTheReadmeNamesAreTheOnesTheRunsWriteTo)
   EXPECT_NE(readme.str().find("magbrush compare " + base + " " + wide), std::string::npos)
       << "README's compare line should read: magbrush compare " << base << " " << wide;
   EXPECT_NE(readme.str().find(base + "/report/index.html"), std::string::npos) << base;
+  // And the folder `flux --compare` writes the moved pole's comparison into.
+  const Case moved = load_case(fed_case, {"roller.poles.S1.angle=5deg"});
+  const std::string flux = load_case(fed_case).output.directory + "/flux/compare_" +
+                           fs::path(moved.output.directory).filename().string() + "/";
+  EXPECT_NE(readme.str().find(flux), std::string::npos) << "README should name " << flux;
 }

@@ -26,7 +26,8 @@ the case's) that meets a target, by bounded least squares on the exact multipole
 several starts. The target is a sleeve profile in the scan format of `magbrush flux` (angle,
 Bn[, Bt]; optional columns weight and tolerance, e.g. tolerance_mT) or a specification in YAML
 (per pole: peak |Bn| and its angle with tolerances; arcs where |B| must stay below a level;
-a minimum spacing; constraints: per-pole bounds, fixed poles, the remanence limit); see
+an arc where the release criterion must let a carrier bead go; a minimum spacing;
+constraints: per-pole bounds, fixed poles, the remanence limit); see
 docs/design_tools.md. Prints the best layout, every requirement met or missed and by how much,
 a sensitivity table (requirement per 1 deg / 10 kA/m of each pole), the binding constraints
 when the target is infeasible, and checks the winner with the finite-element solver.

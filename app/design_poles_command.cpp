@@ -212,6 +212,8 @@ private:
     if (args_.has("--angle-range"))
       constraints_.angle_range = parse_quantity(args_.value("--angle-range"), Dimension::angle);
     options_.starts = int(args_.whole_number("--starts", 8, 1, 1000));
+    if (target_.release)
+      target_.release_inputs = ReleaseInputs::from(case_);
     probe_radius_ = target_.probe_radius > 0 ? target_.probe_radius : probe_radius_of(case_);
     dir_ = args_.value("--output", case_.output.directory + "/" + case_.name + "/design");
     fs::create_directories(dir_);
@@ -221,6 +223,7 @@ private:
         (target_.peaks.empty() ? "" : ", " + std::to_string(target_.peaks.size()) + " pole peaks") +
         (target_.ceilings.empty() ? "" : ", " + std::to_string(target_.ceilings.size()) + " low-field arcs") +
         (target_.min_spacing > 0 ? ", minimum spacing " + fixed(target_.min_spacing * to_deg, 1) + " deg" : "") +
+        (target_.release ? ", a release arc" : "") +
         "), probe radius " + fixed(probe_radius_ * 1e3, 3) + " mm\n");
   }
 
@@ -256,7 +259,7 @@ private:
         s << "  " << b << "\n";
     }
     const RingProfile ring(*case_.roller, probe_radius_);
-    const RequirementSet set(target_, case_.roller->poles);
+    const RequirementSet set(target_, *case_.roller);
     const SensitivityTable t = sensitivities(set, ring, design_.poles);
     s << "\nSensitivity: change of each requirement's value per +1 deg of a pole's angle (1 deg = "
       << fixed(case_.roller->magnet_radius * 1e3 * M_PI / 180.0, 3)
@@ -351,7 +354,7 @@ private:
       write_text_atomically(dir_ + "/design_requirements.csv", requirements_csv(design_.requirements, nullptr));
       return;
     }
-    const RequirementSet set(target_, case_.roller->poles);
+    const RequirementSet set(target_, *case_.roller);
     fem_requirements_ = set.evaluate(design_.poles, profile_from_file(fem_path_));
     bool all_met = true;
     for (const auto &r : fem_requirements_)

@@ -37,7 +37,11 @@ const magbrush::cli::CommandSpec &check_command_line()
         {"--explain", {}, "", "print every key of the case schema: type, default, range, meaning",
          false, {}, /*for_pipeline=*/false},
         {"--markdown", {}, "", "with --explain: Markdown table (docs/case_reference.md)", false, {}, false}};
-    s.epilog = "Exit status: 0 valid, 1 invalid case (errors on stderr), 2 usage error.\n";
+    s.examples = {{"magbrush check cases/kawamoto_nip_fed.yaml", "validate the case and print it resolved, with units"},
+                  {"magbrush check cases/kawamoto_nip_fed.yaml --set drum.gap=0.5mm --quiet",
+                   "validate a variant; print only errors"},
+                  {"magbrush check --explain", "every key of a case file: type, default, range, meaning"}};
+    s.exit_status = "0 valid, 1 invalid case (errors on stderr), 2 usage error.";
     return s;
   }();
   return spec;

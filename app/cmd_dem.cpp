@@ -17,7 +17,15 @@ namespace {
 
 const cli::CommandSpec &dem_command_line()
 {
-  static const cli::CommandSpec spec = dem::engine_command_line("magbrush dem");
+  static const cli::CommandSpec spec = [] {
+    cli::CommandSpec s = dem::engine_command_line("magbrush dem");
+    s.examples = {{"magbrush dem cases/kawamoto_nip_fed.yaml --threads 2",
+                   "the particles on the stored fields (run `magbrush field` first)"},
+                  {"magbrush dem cases/kawamoto_nip_fed.yaml --resume",
+                   "continue a stopped run from its checkpoint"}};
+    s.exit_status = "0 done, 1 invalid case or missing fields, 2 bad usage, 3 an unstable run stopped.";
+    return s;
+  }();
   return spec;
 }
 

@@ -31,6 +31,11 @@ const cli::CommandSpec &field_command_line()
     s.usage = "magbrush field CASE [--set key=value ...] [-np N] [--only magnetic|electric]\n"
               "                      [--force] [--no-vtu]";
     s.options.push_back({"--np", {"-np"}, "N", "run the solver on N MPI processes (mpirun -np N magbrush-field ...)"});
+    s.examples = {{"magbrush field cases/kawamoto_nip_fed.yaml",
+                   "solve and store the fields (reused when their inputs are unchanged)"},
+                  {"magbrush field cases/kweon_development.yaml -np 2 --only electric",
+                   "the electric field on 2 MPI processes"}};
+    s.exit_status = "0 solved or up to date, 1 invalid case or solver failure, 2 bad usage.";
     return s;
   }();
   return spec;

@@ -69,7 +69,7 @@ profile is written.
     s.positionals = {{"CASE", "the case file"}};
     s.options = {
         {"--measured", {}, "FILE", "the gaussmeter scan"},
-        {"--output", {"-o"}, "DIR", "output directory (default: <output.directory>/<case name>/flux)", false, {},
+        {"--output", {"-o"}, "DIR", "output directory (default: <output.directory>/flux)", false, {},
          /*for_pipeline=*/false},
         cli::set_option("field.probe_radius=10mm"),
         {"--angle-unit", {}, "deg|rad", "unit of the scan's angle column (overrides the header)"},
@@ -96,8 +96,10 @@ profile is written.
         {"--harmonics", {}, "N", "number of Fourier harmonics (default: from the decay of the series)"}};
     s.epilog = R"(Outputs in DIR: flux_profile.csv (computed, 0.25 deg), flux_residuals.csv, flux_overlay.png,
 and with --fit: flux_fit_residuals.csv, <case>_fitted.yaml, flux_fit.txt.
-Exit status: 0 done, 1 bad input (message says what and how to fix), 2 bad usage.
 )";
+    s.examples = {{"magbrush flux cases/kawamoto_nip.yaml --measured cases/data/sleeve_profile_example.csv --fit",
+                   "compare a gaussmeter scan with the computed flux and fit the poles to it"}};
+    s.exit_status = "0 done, 1 bad input (message says what and how to fix), 2 bad usage.";
     return s;
   }();
   return spec;
@@ -361,7 +363,7 @@ private:
     choose_scan_origin();
     ring_options_.harmonics = o_.harmonics;
     ring_.emplace(*case_.roller, ring_options_);
-    dir_ = o_.output_dir.empty() ? case_.output.directory + "/" + case_.name + "/flux" : o_.output_dir;
+    dir_ = o_.output_dir.empty() ? case_.output.directory + "/flux" : o_.output_dir;
     fs::create_directories(dir_);
     std::cout << "magbrush flux: case '" << case_.name << "', probe radius "
               << fixed(probe_radius_ * 1e3, 3) << " mm (magnet "

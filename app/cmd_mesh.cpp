@@ -59,7 +59,8 @@ const magbrush::cli::CommandSpec &mesh_command_line()
     s.usage = "magbrush mesh CASE.yaml [--set key=value ...] [-o DIR] [--only roller|nip] [--force]\n"
               "                    [--verbose] [--gui-free]";
     s.description =
-        "Writes the quadrilateral meshes the field solver reads (MSH 2.2 ASCII, written atomically):\n"
+        "Writes the quadrilateral meshes of the field solver's geometry for inspection in Gmsh (MSH 2.2\n"
+        "ASCII, written atomically; the solver builds the same meshes itself, so no stage reads these):\n"
         "  DIR/roller.msh  shaft, magnet, sleeve wall, air, magnetic blades, open-boundary shell\n"
         "                  (needs roller and sleeve)\n"
         "  DIR/nip.msh     air, photoconductor layer, shell; sleeve, drum substrate and outer\n"
@@ -78,7 +79,10 @@ const magbrush::cli::CommandSpec &mesh_command_line()
         {"--verbose", {"-v"}, "", "show Gmsh's progress messages"},
         {"--force", {}, "", "remesh even when the stored mesh is up to date"},
         {"--gui-free", {}, "", "accepted for scripts; magbrush never opens the Gmsh GUI"}};
-    s.epilog = "Exit status: 0 written, 1 invalid case or meshing failure, 2 usage error.\n";
+    s.examples = {{"magbrush mesh cases/kawamoto_nip_fed.yaml", "write meshes/kawamoto_nip_fed/{roller,nip}.msh"},
+                  {"magbrush mesh cases/kawamoto_nip_fed.yaml --only roller --set field.mesh_size_sleeve=0.2mm",
+                   "the roller's mesh only, finer at the sleeve"}};
+    s.exit_status = "0 written, 1 invalid case or meshing failure, 2 usage error.";
     return s;
   }();
   return spec;

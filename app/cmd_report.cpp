@@ -20,6 +20,7 @@
 #include "coupling/case_format.h"
 #include "coupling/case_parser.h"
 #include "coupling/field_files.h"
+#include "coupling/run_folder.h"
 
 #include <cmath>
 #include <cstdio>
@@ -53,10 +54,15 @@ const cli::CommandSpec &report_command_line()
   toner_development.png   TMA and fog against time, the averaging window with its mean, its
                           halves (the steady-state test) and the neutralisation bound, when the
                           run measures toner development
-  index.md, index.html    the key numbers (slip at the gap centre against the relative surface
-                          speed, peak normal pressure against B^2/2mu0, tangential/normal,
-                          touching density, beads in/out, run times per stage and force term)
-                          with the plots and links to the ParaView files
+  index.md, index.html    the key numbers with their standard errors (slip at the gap centre
+                          against the relative surface speed, peak normal pressure against
+                          B^2/2mu0, tangential/normal, touching density, beads in/out), every
+                          key number of dem/summary.csv with ± and its bound, the inputs (the
+                          main keys, the overrides, case_resolved.txt linked), run times per
+                          stage and force term, the plots and links to the ParaView files
+The time series shade each averaging window; the nip profiles leave out the bins averaged over
+fewer contacts than a tenth of the window's samples (marked on the axis) and draw each plot's
+bound: the relative surface speed, the bead-drum friction coefficient, B^2/2mu0.
 )";
     s.positionals = {{"CASE", "the case file of the run"}};
     s.options = {cli::set_option(),
@@ -65,8 +71,11 @@ const cli::CommandSpec &report_command_line()
     s.epilog = R"(Needs the DEM outputs (<output.directory>/dem/: run `magbrush dem CASE` or `magbrush run CASE`
 first) and python3 with matplotlib, numpy and h5py (Debian: python3-matplotlib python3-h5py);
 $MAGBRUSH_PYTHON picks the interpreter, $MAGBRUSH_TOOLS the folder holding report.py.
-Exit status: 0 done, 1 missing outputs or a failed plot script, 2 bad usage.
 )";
+    s.examples = {{"magbrush report cases/kawamoto_nip_fed.yaml", "the report of the case's run: results/kawamoto_nip_fed/report/"},
+                  {"magbrush report cases/kawamoto_nip_fed.yaml --set drum.gap=0.5mm",
+                   "the report of that variant's run (the same --set list finds its folder)"}};
+    s.exit_status = "0 done, 1 missing outputs or a failed plot script, 2 bad usage.";
     return s;
   }();
   return spec;
@@ -161,6 +170,10 @@ int report(const cli::ParsedArguments &args)
   fs::create_directories(report_dir);
   write_text_atomically((report_dir / "case_resolved.txt").string(),
                         "# case " + c.name + " as resolved for this report (" + case_path + ")\n" + format_case(c));
+  // A folder named by the digest of its overrides says which they are, even when its stages
+  // were run one by one rather than by `magbrush run` (which writes it first).
+  if (c.output.automatic && !fs::exists(results / "variant.txt"))
+    write_text_atomically((results / "variant.txt").string(), variant_text(case_path, c.output.overrides));
   const std::string scan = normalised_scan(c, report_dir);
 
   const std::string script = find_report_script();

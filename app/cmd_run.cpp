@@ -1,20 +1,29 @@
-// `magbrush run CASE`: the whole pipeline — validate, mesh, fields, DEM, report — each stage
-// skipped when its outputs are up to date (the stages themselves decide that), with progress
-// and an ETA at every stage, the wall time of every stage, and at the end a summary of where
-// every output is.
+// `magbrush run CASE`: the whole pipeline — validate, fields, DEM, report (the Gmsh meshes
+// only when --only names them: no later stage reads them) — each stage skipped when its
+// outputs are up to date (the stages themselves decide that), with progress and an ETA at
+// every stage, the wall time of every stage, and at the end a summary of where every output is.
 //
+//   --quick: the case's duration and every window scaled (app/quick_preset.h), as overrides
+//   check: quietly; then the case in ten lines (app/case_at_a_glance.h), the resolved case and
+//   the overrides written into the run folder (coupling/run_folder.h names it)
 //   for each stage: announce it (with the time it took last time: its ETA) → run it; the DEM's
 //   output is also kept in <output.directory>/dem/dem.log (the report reads its timing table)
 //   → record the stage's wall time in <output.directory>/run_times.csv
 //   then: the table of times, and the list of outputs with their paths.
+#include "app/case_at_a_glance.h"
+#include "app/quick_preset.h"
 #include "app/run_pipeline.h"
 #include "app/subcommand.h"
 
+#include "coupling/case_format.h"
 #include "coupling/case_parser.h"
+#include "coupling/run_folder.h"
 #include "common/atomic_file.h"
 #include "coupling/field_files.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -149,6 +158,8 @@ void print_outputs(const Case &c)
 {
   const fs::path results = c.output.directory;
   std::vector<std::pair<std::string, fs::path>> items = {
+      {"resolved case", results / "case_resolved.txt"},
+      {"overrides of this variant", results / "variant.txt"},
       {"meshes (Gmsh)", fs::path("meshes") / c.name},
       {"magnetic field grid (HDF5)", field::magnetic_grid_path(c)},
       {"magnetic field (ParaView)", field::field_file(c, "magnetic_0.pvtu")},
@@ -170,6 +181,19 @@ void print_outputs(const Case &c)
       std::printf("  %-28s %s\n", what.c_str(), path.string().c_str());
 }
 
+// After a valid check: the whole resolved case and the variant's overrides written into the
+// run folder, and the case in ten lines on the terminal.
+std::string describe_the_run_folder(const Case &c, const std::string &case_path)
+{
+  const fs::path folder = c.output.directory;
+  fs::create_directories(folder);
+  const fs::path resolved_file = folder / "case_resolved.txt";
+  write_text_atomically(resolved_file.string(),
+                        "# case " + c.name + " as resolved for this run (" + case_path + ")\n" + format_case(c));
+  write_text_atomically((folder / "variant.txt").string(), variant_text(case_path, c.output.overrides));
+  return case_at_a_glance(c, resolved_file.string());
+}
+
 // Stage names from --only / --skip ("field,dem"), each checked against the pipeline.
 std::vector<std::string> stage_list(const cli::ParsedArguments &args, const std::string &option)
 {
@@ -187,12 +211,20 @@ std::vector<std::string> stage_list(const cli::ParsedArguments &args, const std:
   return names;
 }
 
-// The words a stage is run with: its name, the case, and the options it declares.
-std::vector<std::string> stage_arguments(const Subcommand &stage, const cli::ParsedArguments &args)
+// The words a stage is run with: its name, the case, the options it declares, and the
+// overrides `run` adds itself (--quick's), after the user's.
+std::vector<std::string> stage_arguments(const Subcommand &stage, const cli::ParsedArguments &args,
+                                         const std::vector<std::string> &added_overrides)
 {
   std::vector<std::string> words = {stage.name, args.positional(0)};
   const auto options = cli::forward_options(args, stage.command_line());
   words.insert(words.end(), options.begin(), options.end());
+  if (stage.command_line().find("--set"))
+    for (const auto &o : added_overrides)
+    {
+      words.push_back("--set");
+      words.push_back(o);
+    }
   return words;
 }
 
@@ -201,23 +233,40 @@ const cli::CommandSpec &run_command_line()
   static const cli::CommandSpec spec = [] {
     cli::CommandSpec s;
     s.program = "magbrush run";
-    s.usage = "magbrush run CASE [--set key=value ...] [--only STAGE[,STAGE]] [--skip STAGE[,STAGE]]\n"
+    s.usage = "magbrush run CASE [--set key=value ...] [--quick] [--only STAGE[,STAGE]] [--skip STAGE[,STAGE]]\n"
               "                    [options of the stages]";
     s.description = R"(Runs the whole pipeline on one case, in order:
-  check   validate the case (file, line, key, unit, range)
-  mesh    write the Gmsh meshes of the roller and the nip
+  check   validate the case (file, line, key, unit, range); prints the case in ten lines and
+          writes the whole resolved case to <run folder>/case_resolved.txt
+  mesh    the Gmsh meshes of the roller and the nip, for inspection: no later stage reads them
+          (the field solver meshes the case itself), so `run` skips it unless --only names it
   field   solve the magnetic and electric fields, store them as grids (reused when
           the field-relevant inputs are unchanged)
-  dem     run the particles on the stored fields (its log is kept in <output.directory>/dem/dem.log)
-  report  plots, key numbers and ParaView links: <output.directory>/report/index.html
+  dem     run the particles on the stored fields (its log is kept in <run folder>/dem/dem.log)
+  report  plots, key numbers and ParaView links: <run folder>/report/index.html
+The run folder is output.directory when the case or a --set names it, else results/<case> and,
+for a run with --set overrides, results/<case>-<6 hex digits of the sorted overrides> with
+the overrides listed in its variant.txt: variants of a case land side by side (compare them
+with `magbrush compare`), and a variant that changes no field reads its baseline's fields.
 --set goes to every stage (e.g. --set drum.gap=0.3mm); every other option only to the stages
 that declare it, named in brackets below (e.g. -np 2 to the field solver, --threads 4 to the DEM).
 Each stage is announced with the wall time it took in the last run of this case (its ETA); the
-DEM prints its own progress with an ETA. Stage times go to <output.directory>/run_times.csv. At
+DEM prints its own progress with an ETA. Stage times go to <run folder>/run_times.csv. At
 the end: the time per stage and where every output is.
 )";
+    s.examples = {{"magbrush run cases/kawamoto_nip_fed.yaml --quick", "a first look in about a minute"},
+                  {"magbrush run cases/kawamoto_nip_fed.yaml --quick --set drum.gap=0.5mm",
+                   "the same with a wider gap, in its own folder (results/kawamoto_nip_fed-<digest>/)"},
+                  {"magbrush run cases/kawamoto_nip_fed.yaml", "the full run (~10-15 min on 2 cores)"}};
+    s.exit_status = "0 done, else the failing stage's (1 an invalid case or a failed stage, 2 bad usage).";
     s.positionals = {{"CASE", "the case file"}};
     s.options = {cli::set_option(),
+                 {"--quick", {}, "",
+                  "a first look in about a minute: dem.duration cut to " + std::to_string(std::lround(quick_duration * 1e3)) +
+                      " ms and every averaging window\n"
+                      "and spin-up scaled by the same factor (printed; they are --set overrides, so the\n"
+                      "run has its own folder)",
+                  false, {}, /*for_pipeline=*/false},
                  {"--only", {}, "STAGE[,STAGE]", "run only these stages"},
                  {"--skip", {}, "STAGE[,STAGE]", "skip these stages"}};
     const auto of_stages = stage_options();
@@ -230,7 +279,7 @@ the end: the time per stage and where every output is.
 int run_stages(const cli::ParsedArguments &args)
 {
   const std::vector<std::string> only = stage_list(args, "--only"), skip = stage_list(args, "--skip");
-  const std::vector<std::string> overrides = args.values("--set");
+  std::vector<std::string> overrides = args.values("--set");
   // The resolved case tells where the outputs go (a bad case is reported by `check` below).
   std::optional<Case> resolved;
   try
@@ -239,6 +288,33 @@ int run_stages(const cli::ParsedArguments &args)
   }
   catch (const std::exception &)
   {
+  }
+  // --quick: the case's own times scaled, as overrides after the user's (a user's --set of a
+  // window is scaled like the file's value, since it is read from the resolved case).
+  std::vector<std::string> added;
+  if (args.has("--quick") && resolved)
+  {
+    const auto changes = quick_preset(*resolved);
+    if (changes.empty())
+      std::cout << "magbrush run --quick: dem.duration is already " << resolved->dem.duration * 1e3
+                << " ms: nothing to shorten\n";
+    else
+    {
+      std::cout << "magbrush run --quick: a first look, every time of the run scaled by "
+                << changes.front().to / changes.front().from << " (results are not steady-state figures):\n"
+                << describe(changes) << quick_caveats(*resolved, changes);
+      for (const auto &q : changes)
+        added.push_back(q.override_text());
+      overrides.insert(overrides.end(), added.begin(), added.end());
+      try
+      {
+        resolved = load_case(args.positional(0), overrides);
+      }
+      catch (const std::exception &)
+      {
+        resolved.reset();
+      }
+    }
   }
   const fs::path times_file = resolved ? fs::path(resolved->output.directory) / "run_times.csv" : fs::path();
   const auto last_times = resolved ? read_run_times(times_file) : std::map<std::string, double>{};
@@ -252,6 +328,15 @@ int run_stages(const cli::ParsedArguments &args)
     const std::string &name = pipeline[k];
     if ((!only.empty() && !contains(only, name)) || contains(skip, name))
       continue;
+    // The Gmsh meshes are for inspection: no later stage reads them (the field solver meshes
+    // the case itself, a magnetic blade's mesh included), so they cost ~20 s for nothing.
+    if (name == "mesh" && !contains(only, name))
+    {
+      std::cout << "\n== magbrush run: stage " << k + 1 << "/" << pipeline.size()
+                << ": mesh skipped: no later stage reads the Gmsh meshes (the field solver meshes the case "
+                   "itself); `magbrush mesh CASE` or --only mesh writes them ==" << std::endl;
+      continue;
+    }
     const Subcommand *stage = find_subcommand(name);
     if (!stage)
     {
@@ -267,7 +352,10 @@ int run_stages(const cli::ParsedArguments &args)
     if (name == "dem" && resolved && resolved->dem.settle_time > 0.0)
       std::cout << "(the engine settles the beads for " << resolved->dem.settle_time * 1e3
                 << " ms with the walls at rest before its progress lines start)" << std::endl;
-    const std::vector<std::string> a = stage_arguments(*stage, args);
+    std::vector<std::string> a = stage_arguments(*stage, args, added);
+    // `check` validates quietly: its errors still print, the resolved case goes to a file.
+    if (name == "check" && stage->command_line().find("--quiet"))
+      a.push_back("--quiet");
     const auto t0 = std::chrono::steady_clock::now();
     int rc = 0;
     if (name == "dem" && resolved)
@@ -291,6 +379,8 @@ int run_stages(const cli::ParsedArguments &args)
                 << "); later stages not run. Outputs of earlier stages are kept.\n";
       return rc;
     }
+    if (name == "check" && resolved)
+      std::cout << describe_the_run_folder(*resolved, args.positional(0));
   }
 
   const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
@@ -362,7 +452,8 @@ int run_pipeline(const std::vector<std::string> &args)
 
 namespace {
 const bool registered = register_subcommand(
-    {"run", "the whole pipeline: check, mesh, field, dem, report", run_pipeline, run_command_line, 90});
+    {"run", "the whole pipeline: check, field, dem, report (mesh on request); --quick for a first look", run_pipeline,
+     run_command_line, 90});
 } // namespace
 
 } // namespace magbrush

@@ -27,6 +27,7 @@
 #include "coupling/case_hash.h"
 #include "coupling/case_parser.h"
 #include "coupling/case_schema.h"
+#include "coupling/run_folder.h"
 #include "coupling/units.h"
 #include "common/atomic_file.h"
 #include "common/child_process.h"
@@ -67,9 +68,10 @@ const cli::CommandSpec &sweep_command_line()
               "                      [--point INDEX | --merge | --emit slurm]\n"
               "       mpirun -np K magbrush sweep CASE --vary ...";
     s.description = R"(Runs the pipeline (check, field, dem, report; the Gmsh meshes are not needed per point) once
-for every combination of the --vary values, each point in
-<output.directory>/sweep_<NAME>/<point>/ (its dem/ and report/; the stored fields in
-sweep_<NAME>/fields/<digests of the field inputs>/, solved once for the points that share them),
+for every combination of the --vary values, each point in results/sweep_<NAME>/<point>/
+(<output.directory>/sweep_<NAME>/<point>/ when the case names a folder; the point's dem/ and
+report/; the stored fields in sweep_<NAME>/fields/<digests of the field inputs>/, solved once
+for the points that share them),
 then compares the nip profiles of all points:
   sweep_summary.csv    one row per point: the varied values (as given and in SI), the bead
                        count, every key number the point's measurements report (dem/summary.csv:
@@ -160,11 +162,12 @@ run_time_s):
                                          "merge step (--merge) into the sweep's folder", false, {"slurm"}}};
     const auto of_stages = stage_options();
     s.options.insert(s.options.end(), of_stages.begin(), of_stages.end());
-    s.epilog = R"(Examples (Fig. 22-27):
-  magbrush sweep cases/kawamoto_nip.yaml --vary populations.carrier.diameter=42um,50um,60um
-  magbrush sweep cases/kawamoto_nip.yaml --vary populations.carrier.count=9000,12300,15000
-  magbrush sweep cases/kawamoto_nip.yaml --vary drum.gap=0.3mm,0.4mm,0.5mm
-)";
+    s.examples = {{"magbrush sweep cases/kawamoto_nip.yaml --vary populations.carrier.diameter=42um,50um,60um",
+                   "Kawamoto Fig. 22-23: the carrier diameter"},
+                  {"magbrush sweep cases/kawamoto_nip.yaml --vary populations.carrier.count=9000,12300,15000",
+                   "Fig. 24-25: the amount of developer"},
+                  {"magbrush sweep cases/kawamoto_nip.yaml --vary drum.gap=0.3mm,0.4mm,0.5mm", "Fig. 26-27: the gap"}};
+    s.exit_status = "0 every point done, 1 an invalid case or a failed point, 2 bad usage.";
     return s;
   }();
   return spec;
@@ -387,7 +390,10 @@ SweepPlan plan_sweep(const cli::ParsedArguments &args)
   if (plan.name.empty())
     for (const auto &v : plan.vary)
       plan.name += (plan.name.empty() ? "" : "_") + v.key.substr(v.key.find_last_of('.') + 1);
-  plan.sweep_dir = fs::path(plan.base.output.directory) / ("sweep_" + plan.name);
+  // A sweep's folder holds its points' run folders itself: under results/ when the case names
+  // no folder (not under the automatic run folder of its base), else under the named one.
+  plan.sweep_dir = fs::path(plan.base.output.automatic ? results_root_directory : plan.base.output.directory) /
+                   ("sweep_" + plan.name);
   plan.repeats = repeats_of(args);
   if (args.has("--spin-up") && args.has("--restart"))
     throw cli::UsageError("--spin-up gives every point its restart: do not also give --restart");

@@ -192,6 +192,12 @@ private:
   void take_positional(const std::string &word)
   {
     const std::size_t index = result_.positionals_.size();
+    if (index >= spec_.positionals.size() && !spec_.positionals.empty() &&
+        spec_.positionals.back().need == Positional::one_or_more)
+    {
+      result_.positionals_.push_back(word);
+      return;
+    }
     if (index >= spec_.positionals.size())
     {
       if (spec_.positionals.empty())
@@ -207,7 +213,7 @@ private:
   void check_required_positionals()
   {
     for (std::size_t k = result_.positionals_.size(); k < spec_.positionals.size(); ++k)
-      if (spec_.positionals[k].need == Positional::required)
+      if (spec_.positionals[k].need != Positional::optional)
       {
         const Positional &p = spec_.positionals[k];
         fail("missing " + p.name + (p.help.empty() ? "" : " (" + p.help + ")"));
@@ -329,7 +335,9 @@ std::string help_text(const CommandSpec &spec)
   std::vector<std::pair<std::string, std::string>> arguments;
   for (const Positional &p : spec.positionals)
     if (!p.help.empty())
-      arguments.emplace_back(p.name, p.help + (p.need == Positional::optional ? " (optional)" : ""));
+      arguments.emplace_back(p.name, p.help + (p.need == Positional::optional      ? " (optional)"
+                                               : p.need == Positional::one_or_more ? " (one or more)"
+                                                                                   : ""));
   if (!arguments.empty())
   {
     out << "\nArguments:\n";
@@ -343,6 +351,14 @@ std::string help_text(const CommandSpec &spec)
   write_two_columns(out, options);
   if (!spec.epilog.empty())
     out << "\n" << spec.epilog;
+  if (!spec.examples.empty())
+  {
+    out << "\nExample" << (spec.examples.size() > 1 ? "s" : "") << ":\n";
+    for (const auto &e : spec.examples)
+      out << "  " << e.command << "\n" << (e.what.empty() ? "" : "      " + e.what + "\n");
+  }
+  if (!spec.exit_status.empty())
+    out << "\nExit status: " << spec.exit_status << "\n";
   return out.str();
 }
 

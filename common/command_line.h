@@ -56,7 +56,8 @@ struct Option
 // A word that is not an option: the case file, usually.
 struct Positional
 {
-  enum Need { required, optional };
+  // one_or_more: required, and it takes every further word too (only the last positional).
+  enum Need { required, optional, one_or_more };
   std::string name; // "CASE"
   std::string help = {};
   Need need = required;
@@ -70,7 +71,16 @@ struct CommandSpec
   std::string description;   // paragraphs between the usage and the options
   std::vector<Positional> positionals;
   std::vector<Option> options;
-  std::string epilog;        // after the options (exit status, examples)
+  std::string epilog;        // after the options: notes
+  // Every magbrush command ends its help the same way: its examples (a command line and what
+  // it does), then its exit status.
+  struct Example
+  {
+    std::string command; // "magbrush run cases/kawamoto_nip_fed.yaml --quick"
+    std::string what;    // "a first look in about a minute"
+  };
+  std::vector<Example> examples;
+  std::string exit_status;   // "0 done, 1 ..., 2 bad usage"
 
   const Option *find(const std::string &spelling) const;
 };

@@ -9,7 +9,10 @@ std::vector<KeySpec> output_keys()
 {
   return {
       section("output", "Results."),
-      text("output.directory", "Results directory.").def("results"),
+      text("output.directory",
+           "Results directory (empty: results/<name>, and results/<name>-<6 hex digits> for a run with --set "
+           "overrides: the digest of the sorted overrides, listed in its variant.txt).")
+          .def(""),
       boolean("output.vtu", "Also write VTK XML particle snapshots (snapshots/*.vtu, index particles.pvd).").def("false"),
       boolean("output.xdmf", "Write HDF5 particle snapshots with their XDMF index (particles.xdmf).").def("true"),
   };

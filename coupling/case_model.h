@@ -373,7 +373,11 @@ struct FlowSettings
 
 struct OutputSettings
 {
+  // The run's folder. The key empty (the default): results/<name>[-<digest of the overrides>],
+  // automatic = true (coupling/run_folder.h).
   std::string directory = "results";
+  bool automatic = false;
+  std::vector<std::string> overrides; // the --set overrides, normalised (run_folder.h): variant.txt
   bool vtu = false;
   bool xdmf = true;
 };

@@ -8,6 +8,8 @@
 // The walk only descends where the schema has keys, so YAML alias cycles and absurd nesting
 // are never followed.
 #include "coupling/case_parser.h"
+#include "coupling/case_format.h"
+#include "coupling/run_folder.h"
 
 #include "coupling/case_schema.h"
 #include "coupling/case_validation.h"
@@ -100,6 +102,7 @@ private:
   std::vector<std::string> overrides;
   std::vector<std::string> errors;
   std::map<std::string, std::string> override_origin; // display path -> "--set ..."
+  std::map<std::string, std::string> override_path;   // "key=value" as given -> its display path
   std::map<std::string, std::string> locations;       // display path -> "file:l:c"
   std::map<std::string, Value> values;                // display path -> leaf value
   std::set<std::string> present;                      // display paths of given containers
@@ -224,6 +227,10 @@ private:
     try
     {
       YAML::Node root = YAML::Load(text);
+      // A quote left open at the end of a value is legal YAML when what follows still parses
+      // (the text then runs on over the next lines): refused, as a case file never means it.
+      if (const size_t quote = unclosed_quote(text, text.size()); quote != std::string::npos)
+        syntax_error(text, mark_at(text, quote), "a quoted value runs on to the next line");
       if (!root.IsMap())
         error(location(root.Mark()), "", "expected the case file to be a YAML section of keys "
                                          "(e.g. 'sleeve:'), found " + node_kind(root));
@@ -259,7 +266,16 @@ private:
     const bool unclosed_map = message.find("end of map flow") != std::string::npos;
     const bool unclosed_list = message.find("end of sequence flow") != std::string::npos;
     bool moved = false;
-    if (unclosed_map || unclosed_list)
+    // A quoted value whose quote is not closed on its line: YAML reads on across the lines
+    // below as one text and fails wherever that text stops making sense, often far below.
+    if (const size_t quote = unclosed_quote(text, at); quote != std::string::npos)
+    {
+      at = quote;
+      moved = true;
+      hint = "this quote is not closed on its line: YAML reads the lines below as part of the same text; close "
+             "it, or drop the quotes";
+    }
+    else if (unclosed_map || unclosed_list)
     {
       const size_t opener = unclosed_bracket(text, at, unclosed_map ? '{' : '[');
       if (opener != std::string::npos)
@@ -301,6 +317,50 @@ private:
     quote(l);
     excerpt += "\n    " + std::string(6, ' ') + " | " + std::string(display_width(text.substr(starts[l], column)), ' ') + "^";
     error(where, "", "YAML syntax error: " + message + excerpt + "\n    hint: " + hint);
+  }
+
+  // The YAML mark (line and column, from 0) of byte offset `at` of `text`.
+  static YAML::Mark mark_at(const std::string &text, size_t at)
+  {
+    YAML::Mark m;
+    m.pos = static_cast<int>(at);
+    m.line = static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(at), '\n'));
+    const size_t line_start = text.rfind('\n', at == 0 ? 0 : at - 1);
+    m.column = static_cast<int>(at - (line_start == std::string::npos || at == 0 ? 0 : line_start + 1));
+    return m;
+  }
+
+  // The opening quote (" or ') of the first line before `end` whose quoted text does not close
+  // on that line, outside comments; npos if every line closes its quotes.
+  static size_t unclosed_quote(const std::string &text, size_t end)
+  {
+    size_t line_start = 0;
+    while (line_start < end && line_start < text.size())
+    {
+      const size_t line_end = std::min(text.find('\n', line_start), text.size());
+      char open = 0;
+      size_t opened_at = std::string::npos;
+      for (size_t i = line_start; i < line_end; ++i)
+      {
+        const char c = text[i];
+        if (open == 0 && c == '#' && (i == line_start || text[i - 1] == ' ' || text[i - 1] == '\t'))
+          break; // a comment
+        if (open == 0 && (c == '"' || c == '\'') &&
+            (i == line_start || std::string(" \t:[{,-").find(text[i - 1]) != std::string::npos))
+        {
+          open = c;
+          opened_at = i;
+        }
+        else if (open == '"' && c == '\\')
+          ++i; // an escaped character inside "..."
+        else if (open != 0 && c == open)
+          open = 0;
+      }
+      if (open != 0)
+        return opened_at;
+      line_start = line_end + 1;
+    }
+    return std::string::npos;
   }
 
   // The last '{' (or '[') before `end` that no '}' (']') closes, outside quotes and comments;
@@ -461,6 +521,7 @@ private:
                 current.remove(other);
           current[part] = value;
           override_origin[display] = where;
+          override_path[o] = display;
         }
         else
         {
@@ -868,6 +929,32 @@ private:
     return r ? q(s, "radius") : 0.5 * q(s, "diameter");
   }
 
+  // The overrides that change a stored field or mesh: those whose key (or a key under it) the
+  // schema marks as a field input (coupling/case_schema.h, the `affects` mark).
+  std::vector<std::string> field_overrides(const Case &c) const
+  {
+    const std::vector<ResolvedEntry> entries = resolved_entries(c);
+    std::vector<std::string> out;
+    for (const auto &o : overrides)
+    {
+      const auto at = override_path.find(o);
+      if (at == override_path.end())
+        continue;
+      const std::string &p = at->second;
+      for (const auto &e : entries)
+      {
+        const KeySpec *spec = find_key_spec(e.pattern);
+        const bool under = e.path == p || e.path.rfind(p + ".", 0) == 0 || e.path.rfind(p + "[", 0) == 0;
+        if (under && spec && spec->affects != Affects::none)
+        {
+          out.push_back(o);
+          break;
+        }
+      }
+    }
+    return normalised_overrides(out);
+  }
+
   Case build()
   {
     Case c;
@@ -945,9 +1032,20 @@ private:
     c.output.directory = str(o, "directory");
     c.output.vtu = flag(o, "vtu");
     c.output.xdmf = flag(o, "xdmf");
+    c.output.overrides = normalised_overrides(overrides);
     // The stored fields belong to the run's results unless the case puts them elsewhere: two
     // runs of one case into two folders (two biases, two tests side by side) then never
     // replace each other's field while the other reads it.
+    if (c.output.directory.empty())
+    {
+      // Named after the case and its overrides (coupling/run_folder.h); the fields after the
+      // overrides that change a field only, so that a DEM-only variant finds its baseline's.
+      c.output.automatic = true;
+      c.output.directory = automatic_run_folder(c.name, c.output.overrides);
+      if (c.field.output_dir.empty())
+        c.field.output_dir =
+            (std::filesystem::path(automatic_run_folder(c.name, field_overrides(c))) / "fields").string();
+    }
     if (c.field.output_dir.empty())
       c.field.output_dir = (std::filesystem::path(c.output.directory) / "fields").string();
     return c;

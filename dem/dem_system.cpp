@@ -642,7 +642,7 @@ void DemSystem::wall_phase(StepFlags &mine)
 {
   long alarm = -1, too_many = -1;
   ParticleState &s = particles_;
-  ForceBuffers &f = forces_;
+  const ForceArrays out = forces_.main();
   const long n = static_cast<long>(s.size());
   const double dt = dt_;
   const bool substeps = substeps_.on();
@@ -652,22 +652,21 @@ void DemSystem::wall_phase(StepFlags &mine)
     const std::size_t i = static_cast<std::size_t>(k);
     if (substeps && substeps_.fast(s.species[i]))
       continue;
-    Vector3 force{f.fx[i], f.fy[i], f.fz[i]}, torque{f.tx[i], f.ty[i], f.tz[i]};
-    particle_wall_contacts(i, dt, force, torque, alarm, too_many);
-    f.fx[i] = force.x;
-    f.fy[i] = force.y;
-    f.fz[i] = force.z;
-    f.tx[i] = torque.x;
-    f.ty[i] = torque.y;
-    f.tz[i] = torque.z;
+    particle_wall_contacts(i, dt, out, alarm, too_many);
   }
+  record_wall_alarms(mine, alarm, too_many);
+}
+
+void DemSystem::record_wall_alarms(StepFlags &mine, long alarm, long too_many) const
+{
+  const ParticleState &s = particles_;
   if (alarm > mine.wall_overlap.particle)
     mine.wall_overlap.set(alarm, s.position(static_cast<std::size_t>(std::max(0L, alarm))));
   if (too_many > mine.wall_crowded.particle)
     mine.wall_crowded.set(too_many, s.position(static_cast<std::size_t>(std::max(0L, too_many))));
 }
 
-void DemSystem::particle_wall_contacts(std::size_t i, double dt, Vector3 &force, Vector3 &torque, long &alarm,
+void DemSystem::particle_wall_contacts(std::size_t i, double dt, const ForceArrays &out, long &alarm,
                                        long &too_many)
 {
   ParticleState &s = particles_;
@@ -728,12 +727,8 @@ void DemSystem::particle_wall_contacts(std::size_t i, double dt, Vector3 &force,
       o.force_i += HamakerAdhesion::force(a.hamaker, R_a, -ck.overlap, z0) * ck.n;
     }
     wall_slots_.set_history(sl, xi_t);
-    force.x += o.force_i.x;
-    force.y += o.force_i.y;
-    force.z += o.force_i.z;
-    torque.x += o.torque_i.x;
-    torque.y += o.torque_i.y;
-    torque.z += o.torque_i.z;
+    const double force[3] = {o.force_i.x, o.force_i.y, o.force_i.z}, torque[3] = {o.torque_i.x, o.torque_i.y, o.torque_i.z};
+    out.add(i, force, torque);
     // Load on the wall: −F at the contact point, torque about the wall's reference point.
     const Vector3 arm = p + ck.lever_i * ck.n - g[c].torque_origin;
     wall_slots_.set_load(sl, -o.force_i, cross(arm, -o.force_i));

@@ -221,9 +221,11 @@ private:
   int one_thread_pairs_rows_and_columns(PairKernelData D, std::vector<double> &scratch);
   void column_phase();
   void wall_phase(StepFlags &mine);
-  // The wall contacts of particle i with step dt: adds its force and torque to f, t; records
+  // The wall contacts of particle i with step dt: adds its force and torque to `out`; records
   // an overlap beyond the guard (alarm = i) or too many walls (too_many = i).
-  void particle_wall_contacts(std::size_t i, double dt, Vector3 &f, Vector3 &t, long &alarm, long &too_many);
+  void particle_wall_contacts(std::size_t i, double dt, const ForceArrays &out, long &alarm, long &too_many);
+  // Those records into this thread's flags (the largest index of each kind).
+  void record_wall_alarms(StepFlags &mine, long alarm, long too_many) const;
   // The toner's substeps (toner_substeps.h, toner_substeps.cpp): the number of substeps and
   // the fast species, after the step is known; the fast pairs, after every list build; the
   // substeps of one step (all threads call it; one works); the fast particles' forces at the
@@ -236,8 +238,7 @@ private:
   void toner_substeps_phase(StepFlags &mine);
   int fast_forces(double dt, StepFlags &mine, bool react);
   void initial_fast_forces(StepFlags &mine);
-  void gather_fast_history();
-  void scatter_fast_history();
+  void copy_fast_history(bool into_list); // the list's slots <-> the substeps' compact copy
   void add_fast_reaction_phase();
   void final_kick_phase(StepFlags &mine);
   // final_kick_phase, then the next step's kick_and_drift_phase, in one pass over the

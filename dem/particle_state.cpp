@@ -97,6 +97,12 @@ void ForceBuffers::clear()
     std::fill(a->begin(), a->end(), 0.0);
 }
 
+void ForceBuffers::zero_fast()
+{
+  for (auto *a : {&fast_fx, &fast_fy, &fast_fz, &fast_tx, &fast_ty, &fast_tz})
+    a->assign(fx.size(), 0.0);
+}
+
 void ForceBuffers::permute(const std::vector<std::int32_t> &order, std::vector<double> &scratch)
 {
   for (auto *a : {&fx, &fy, &fz, &tx, &ty, &tz, &fast_fx, &fast_fy, &fast_fz, &fast_tx, &fast_ty, &fast_tz})

@@ -61,6 +61,22 @@ struct ParticleState
   std::int32_t id_bound() const;
 };
 
+// Six per-particle arrays a contact adds its force and torque to (ForceBuffers::main / fast).
+struct ForceArrays
+{
+  double *fx, *fy, *fz, *tx, *ty, *tz;
+  void add(std::size_t i, const double f[3], const double t[3]) const
+  {
+    fx[i] += f[0];
+    fy[i] += f[1];
+    fz[i] += f[2];
+    tx[i] += t[0];
+    ty[i] += t[1];
+    tz[i] += t[2];
+  }
+  void zero(std::size_t i) const { fx[i] = fy[i] = fz[i] = tx[i] = ty[i] = tz[i] = 0.0; }
+};
+
 // Forces and torques [N, N m] accumulated during one step. Force terms ADD to these.
 struct ForceBuffers
 {
@@ -74,10 +90,26 @@ struct ForceBuffers
   std::vector<double> fast_fx, fast_fy, fast_fz;
   std::vector<double> fast_tx, fast_ty, fast_tz;
 
+  ForceArrays main() { return {fx.data(), fy.data(), fz.data(), tx.data(), ty.data(), tz.data()}; }
+  ForceArrays fast() { return {fast_fx.data(), fast_fy.data(), fast_fz.data(), fast_tx.data(), fast_ty.data(), fast_tz.data()}; }
+  // Particle i's fast force and torque added to its force and torque.
+  void add_fast_to_main(std::size_t i)
+  {
+    fx[i] += fast_fx[i];
+    fy[i] += fast_fy[i];
+    fz[i] += fast_fz[i];
+    tx[i] += fast_tx[i];
+    ty[i] += fast_ty[i];
+    tz[i] += fast_tz[i];
+  }
+
   void resize(std::size_t n);
   // Grows to n particles, the new ones at zero (the others keep their values).
   void extend(std::size_t n);
   void clear();
+  // The fast arrays sized like fx and zeroed: for a buffer that never takes substeps (a held
+  // term's store) after fx … were read or carried on their own.
+  void zero_fast();
   void permute(const std::vector<std::int32_t> &order, std::vector<double> &scratch);
 };
 

@@ -109,8 +109,7 @@ void DemSystem::find_fast_pairs()
     }
     if (S.mark[i])
       S.dragged.push_back(static_cast<std::int32_t>(i));
-    f.fast_fx[i] = f.fast_fy[i] = f.fast_fz[i] = 0.0;
-    f.fast_tx[i] = f.fast_ty[i] = f.fast_tz[i] = 0.0;
+    f.fast().zero(i);
   }
   const std::size_t m = S.pair.size();
   for (auto *a : {&S.hx, &S.hy, &S.hz, &S.fx, &S.fy, &S.fz, &S.tix, &S.tiy, &S.tiz, &S.tjx, &S.tjy, &S.tjz})
@@ -124,29 +123,17 @@ void DemSystem::find_fast_pairs()
 
 // The fast pairs' history and touching flags between the list's slots (where the rebuild,
 // the checkpoint and the diagnostics find them) and the substeps' compact copy.
-void DemSystem::gather_fast_history()
+void DemSystem::copy_fast_history(bool into_list)
 {
   TonerSubsteps &S = substeps_;
   for (std::size_t q = 0; q < S.pair.size(); ++q)
   {
     const std::size_t p = U(S.pair[q]);
-    S.hx[q] = list_.hist_x[p];
-    S.hy[q] = list_.hist_y[p];
-    S.hz[q] = list_.hist_z[p];
-    S.touching[q] = list_.touching[p];
-  }
-}
-
-void DemSystem::scatter_fast_history()
-{
-  const TonerSubsteps &S = substeps_;
-  for (std::size_t q = 0; q < S.pair.size(); ++q)
-  {
-    const std::size_t p = U(S.pair[q]);
-    list_.hist_x[p] = S.hx[q];
-    list_.hist_y[p] = S.hy[q];
-    list_.hist_z[p] = S.hz[q];
-    list_.touching[p] = S.touching[q];
+    double *list[3] = {&list_.hist_x[p], &list_.hist_y[p], &list_.hist_z[p]};
+    double *compact[3] = {&S.hx[q], &S.hy[q], &S.hz[q]};
+    for (int d = 0; d < 3; ++d)
+      (into_list ? *list[d] : *compact[d]) = (into_list ? *compact[d] : *list[d]);
+    (into_list ? list_.touching[p] : S.touching[q]) = (into_list ? S.touching[q] : list_.touching[p]);
   }
 }
 
@@ -162,8 +149,7 @@ int DemSystem::fast_forces(double dt, StepFlags &mine, bool react)
   for (const std::int32_t i : S.movers)
   {
     const std::size_t iu = U(i);
-    f.fast_fx[iu] = f.fast_fy[iu] = f.fast_fz[iu] = 0.0;
-    f.fast_tx[iu] = f.fast_ty[iu] = f.fast_tz[iu] = 0.0;
+    f.fast().zero(iu);
   }
   int alarm = 0;
   const std::size_t m = S.pair.size();
@@ -188,48 +174,25 @@ int DemSystem::fast_forces(double dt, StepFlags &mine, bool react)
     D.skip = nullptr;
     const RowTorques T{S.tix.data(), S.tiy.data(), S.tiz.data()};
     alarm = particle_pair_kernel(D, T, 0, static_cast<std::int64_t>(m));
+    const ForceArrays fast = f.fast();
     for (std::size_t q = 0; q < m; ++q)
     {
       const std::size_t i = U(S.owner[q]), j = U(S.partner[q]);
+      const double on_i[3] = {S.fx[q], S.fy[q], S.fz[q]}, torque_i[3] = {S.tix[q], S.tiy[q], S.tiz[q]};
+      const double on_j[3] = {-S.fx[q], -S.fy[q], -S.fz[q]}, torque_j[3] = {S.tjx[q], S.tjy[q], S.tjz[q]};
       if (react || S.fast(s.species[i]))
-      {
-        f.fast_fx[i] += S.fx[q];
-        f.fast_fy[i] += S.fy[q];
-        f.fast_fz[i] += S.fz[q];
-        f.fast_tx[i] += S.tix[q];
-        f.fast_ty[i] += S.tiy[q];
-        f.fast_tz[i] += S.tiz[q];
-      }
+        fast.add(i, on_i, torque_i);
       if (react || S.fast(s.species[j]))
-      {
-        f.fast_fx[j] -= S.fx[q];
-        f.fast_fy[j] -= S.fy[q];
-        f.fast_fz[j] -= S.fz[q];
-        f.fast_tx[j] += S.tjx[q];
-        f.fast_ty[j] += S.tjy[q];
-        f.fast_tz[j] += S.tjz[q];
-      }
+        fast.add(j, on_j, torque_j);
     }
   }
   if (walls_.size() > 0)
   {
     long wall_alarm = -1, too_many = -1;
+    const ForceArrays fast = f.fast();
     for (const std::int32_t i : S.movers)
-    {
-      const std::size_t iu = U(i);
-      Vector3 force{f.fast_fx[iu], f.fast_fy[iu], f.fast_fz[iu]}, torque{f.fast_tx[iu], f.fast_ty[iu], f.fast_tz[iu]};
-      particle_wall_contacts(iu, dt, force, torque, wall_alarm, too_many);
-      f.fast_fx[iu] = force.x;
-      f.fast_fy[iu] = force.y;
-      f.fast_fz[iu] = force.z;
-      f.fast_tx[iu] = torque.x;
-      f.fast_ty[iu] = torque.y;
-      f.fast_tz[iu] = torque.z;
-    }
-    if (wall_alarm > mine.wall_overlap.particle)
-      mine.wall_overlap.set(wall_alarm, s.position(U(static_cast<std::int32_t>(wall_alarm))));
-    if (too_many > mine.wall_crowded.particle)
-      mine.wall_crowded.set(too_many, s.position(U(static_cast<std::int32_t>(too_many))));
+      particle_wall_contacts(U(i), dt, fast, wall_alarm, too_many);
+    record_wall_alarms(mine, wall_alarm, too_many);
   }
   return alarm;
 }
@@ -244,21 +207,15 @@ void DemSystem::initial_fast_forces(StepFlags &mine)
   for (const std::int32_t d : S.dragged)
   {
     const std::size_t du = U(d);
-    f.fast_fx[du] = f.fast_fy[du] = f.fast_fz[du] = 0.0;
-    f.fast_tx[du] = f.fast_ty[du] = f.fast_tz[du] = 0.0;
+    f.fast().zero(du);
   }
-  gather_fast_history();
+  copy_fast_history(false);
   mine.overlap_alarm |= fast_forces(S.substep, mine, true);
-  scatter_fast_history();
+  copy_fast_history(true);
   for (const std::int32_t d : S.dragged)
   {
     const std::size_t du = U(d);
-    f.fx[du] += f.fast_fx[du];
-    f.fy[du] += f.fast_fy[du];
-    f.fz[du] += f.fast_fz[du];
-    f.tx[du] += f.fast_tx[du];
-    f.ty[du] += f.fast_ty[du];
-    f.tz[du] += f.fast_tz[du];
+    f.add_fast_to_main(du);
   }
 }
 
@@ -281,8 +238,7 @@ void DemSystem::toner_substeps_phase(StepFlags &mine)
       S.end_x[n] = s.x[d];
       S.end_y[n] = s.y[d];
       S.end_z[n] = s.z[d];
-      f.fast_fx[d] = f.fast_fy[d] = f.fast_fz[d] = 0.0;
-      f.fast_tx[d] = f.fast_ty[d] = f.fast_tz[d] = 0.0;
+      f.fast().zero(d);
     }
     for (std::size_t n = 0; n < S.movers.size(); ++n)
     {
@@ -291,7 +247,7 @@ void DemSystem::toner_substeps_phase(StepFlags &mine)
       S.start_y[n] = s.y[i];
       S.start_z[n] = s.z[i];
     }
-    gather_fast_history();
+    copy_fast_history(false);
     // A fast particle's kick: the held force of the step plus its fast force.
     auto kick = [&](std::size_t i) {
       const double im = s.inv_mass[i], iI = s.inv_inertia[i];
@@ -341,7 +297,7 @@ void DemSystem::toner_substeps_phase(StepFlags &mine)
       f.fast_ty[d] *= inv_k;
       f.fast_tz[d] *= inv_k;
     }
-    scatter_fast_history();
+    copy_fast_history(true);
     mine.overlap_alarm |= alarm;
     // This step's largest move (the held force terms renew by it) and the fast particles' state.
     double step2 = 0.0;
@@ -372,12 +328,7 @@ void DemSystem::add_fast_reaction_phase()
     const std::size_t i = static_cast<std::size_t>(k);
     if (substeps_.fast(s.species[i]))
       continue;
-    f.fx[i] += f.fast_fx[i];
-    f.fy[i] += f.fast_fy[i];
-    f.fz[i] += f.fast_fz[i];
-    f.tx[i] += f.fast_tx[i];
-    f.ty[i] += f.fast_ty[i];
-    f.tz[i] += f.fast_tz[i];
+    f.add_fast_to_main(i);
   }
 }
 

@@ -163,7 +163,10 @@ def magbrush(args, cwd, log):
 
 
 def set_args(overrides):
-    out = []
+    # Every setting runs in a folder of its own: its results go to that folder's results/, not
+    # to the run folder named by the overrides' digest, so that a DEM setting finds the fields
+    # its field folder solved whatever the overrides of either.
+    out = ["--set", "output.directory=results"]
     for k, v in overrides.items():
         out += ["--set", "%s=%s" % (k, v)]
     return out

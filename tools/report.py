@@ -10,7 +10,11 @@ Called by `magbrush report CASE` (which checks the inputs and finds this script)
 Reads (what exists): dem/nip_profile.csv, nip_summary.csv, chain_inclination.csv,
 nip_time_series.csv (the nip measurements), time_series.csv, the last snapshot in
 dem/snapshots/, dem/dem.log (time per phase and force term, written by `magbrush run`),
-<field-prefix>profile_sleeve.csv. Writes every file atomically (tmp + rename). Needs numpy,
+<field-prefix>profile_sleeve.csv, dem/summary.csv (every key number with its standard error and
+bound), <out>/case_resolved.txt and the run folder's variant.txt (the inputs and overrides).
+The page is meant to decide from: every key number with ± its standard error, the inputs with
+the resolved case linked, the averaging windows shaded on the time series, the nip bins of too
+few contacts left out of the profiles (sparse_bins), the physical bound of each plot drawn. Writes every file atomically (tmp + rename). Needs numpy,
 matplotlib (Agg) and h5py; exit status 3 when one is missing, 2 for unreadable inputs.
 """
 import argparse
@@ -205,6 +209,37 @@ def read_log_line(log_path, prefix):
     return found
 
 
+def drum_friction(log_path):
+    """The carrier-drum friction coefficient the engine used (its log's contact table:
+    "carrier–wall:drum ... mu 0.35"); None when the log does not state it."""
+    line = read_log_line(log_path, "  carrier–wall:drum")
+    m = re.search(r"\bmu ([0-9.eE+-]+)", line or "")
+    return float(m.group(1)) if m else None
+
+
+TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6, "ns": 1e-9}
+
+
+def averaging_windows(dem_dir, resolved_path):
+    """[(label, t_from [s])] of the averaging windows of the measurements this run made (their
+    files exist), from the resolved case (case_resolved.txt: "nip.average_from = 25 ms")."""
+    starts = {}
+    if resolved_path and os.path.exists(resolved_path):
+        with open(resolved_path) as f:
+            for line in f:
+                m = re.match(r"(\w+)\.average_from\s+=\s+([0-9.eE+-]+)\s*(\S+)", line)
+                if m and m.group(3) in TIME_UNITS:
+                    starts[m.group(1)] = float(m.group(2)) * TIME_UNITS[m.group(3)]
+    windows = []
+    for label, section, files in (("nip", "nip", ("nip_profile.csv",)),
+                                  ("toner development", "development", ("toner_development.csv",)),
+                                  ("DMA", "dma", ("developer_mass_per_area.csv",)),
+                                  ("flow report", "flow_report", ("flow_report.csv",))):
+        if section in starts and any(os.path.exists(os.path.join(dem_dir, f)) for f in files):
+            windows.append((label, starts[section]))
+    return windows
+
+
 def last_snapshot(dem_dir):
     files = sorted(glob.glob(os.path.join(dem_dir, "snapshots", "particles_*.h5")))
     return files[-1] if files else None
@@ -235,15 +270,41 @@ def fmt(v, digits=4):
 # ------------------------------------------------------------------------------------------
 # Plots
 
-def nip_plots(plt, profile, out, relative_speed):
-    """Kawamoto Fig. 17-20 from nip_profile.csv; returns the PNG names written."""
+def sparse_bins(profile, samples):
+    """The bins of the nip profile averaged over too few contacts to plot as a mean: fewer
+    contact samples than a tenth of the window's samples (less than one touching bead every ten
+    samples). An edge bin touched once holds one bead's force — 175 uN where the profile's
+    beads carry 1-10 uN — and would set the plot's scale. [bool per bin]; none without counts."""
+    counts = profile.get("contact_samples")
+    if not counts:
+        return [False] * len(profile["x_mm"])
+    threshold = max(2.0, 0.1 * samples) if samples == samples and samples > 0 else 2.0
+    return [0 < c < threshold for c in counts]
+
+
+def nip_plots(plt, profile, out, relative_speed, samples=float("nan"), friction=None, magnetic_pressure=None):
+    """Kawamoto Fig. 17-20 from nip_profile.csv; returns the PNG names written. Bins with too
+    few contacts (sparse_bins) are drawn as grey crosses, out of the curves and the scale; the
+    physical bound or scale of each plot is drawn as a dashed line: the relative surface speed
+    (slip), the Coulomb bound of the bead-drum friction coefficient (tangential/normal: no
+    contact holds more), B^2/2mu0 at the gap centre (pressure)."""
     x = profile["x_mm"]
     written = []
+    sparse = sparse_bins(profile, samples)
+    threshold = max(2.0, 0.1 * samples) if samples == samples and samples > 0 else 2.0
 
     def one(name, ylabel, series, title, hline=None, hlabel=None):
         fig, ax = plt.subplots(figsize=(7, 4))
+        marked = False
         for label, y, style in series:
-            ax.plot(x, y, style, label=label)
+            kept = [v if not sp else float("nan") for v, sp in zip(y, sparse)]
+            ax.plot(x, kept, style, label=label)
+            xs = [xi for xi, v, sp in zip(x, y, sparse) if sp and v == v]
+            if xs:
+                # Greyed, on the axis: where the bin is, not its value (it would set the scale).
+                ax.plot(xs, [0.0] * len(xs), "x", color="0.6",
+                        label=None if marked else f"bins of fewer than {threshold:.0f} contact samples (not plotted)")
+                marked = True
         if hline is not None:
             ax.axhline(hline, color="0.4", ls="--", lw=1, label=hlabel)
         ax.axvline(0, color="0.7", lw=0.8)
@@ -262,13 +323,22 @@ def nip_plots(plt, profile, out, relative_speed):
     one("nip_slip.png", "slip speed [m/s]", slip_series,
         "Slip speed of the beads touching the drum (cf. Kawamoto Fig. 17)", relative_speed,
         f"relative surface speed {relative_speed:.4g} m/s" if relative_speed is not None else None)
+    top = max((v for v in profile["normal_pressure_Pa"] if v == v), default=0.0)
+    show_pm = magnetic_pressure is not None and magnetic_pressure == magnetic_pressure and 0 < top and \
+        magnetic_pressure < 3 * top
     one("nip_pressure.png", "pressure on the drum [kPa]",
         [("normal", [v / 1e3 for v in profile["normal_pressure_Pa"]], "o-"),
          ("tangential", [v / 1e3 for v in profile["tangential_pressure_Pa"]], "s-")],
-        "Normal and tangential pressure on the drum (cf. Fig. 18)")
+        "Normal and tangential pressure on the drum (cf. Fig. 18)"
+        + ("" if show_pm or magnetic_pressure is None or magnetic_pressure != magnetic_pressure
+           else f"\nB²/2μ0 = {magnetic_pressure / 1e3:.3g} kPa at the gap centre (off the scale)"),
+        magnetic_pressure / 1e3 if show_pm else None,
+        f"B²/2μ0 at the gap centre {magnetic_pressure / 1e3:.3g} kPa" if show_pm else None)
     written.append(mirrored_pressure_plot(plt, profile, out))
+    mu = friction if friction is not None else 0.35
     one("nip_ratio.png", "tangential / normal", [("tangential / normal pressure", profile["tangential_over_normal"], "o-")],
-        "Ratio of tangential to normal pressure", 0.35, "bead-drum friction coefficient 0.35")
+        "Ratio of tangential to normal pressure", mu,
+        f"bead-drum friction coefficient {mu:.3g}: the Coulomb bound" + ("" if friction is not None else " (assumed)"))
     one("nip_density.png", "touching beads [1/mm²]", [("beads touching the drum", profile["density_per_mm2"], "o-")],
         "Density of the beads touching the drum (cf. Fig. 19)")
     one("nip_force_per_bead.png", "normal force per touching bead [µN]",
@@ -402,7 +472,9 @@ def snapshot_plot(plt, h5py, np, snap, geometry, out):
     return "brush_snapshot.png", t
 
 
-def series_plot(plt, series, nip_series, out):
+def series_plot(plt, series, nip_series, out, windows=()):
+    """Energies, wall loads and the nip's bead budget against time, each averaging window
+    shaded: windows = [(label, t_from [s])], each running to the end of the run."""
     panels = 3 if nip_series else 2
     fig, axes = plt.subplots(panels, 1, figsize=(8, 3 * panels), sharex=True)
     t = [v * 1e3 for v in series["time"]]
@@ -428,6 +500,14 @@ def series_plot(plt, series, nip_series, out):
         axes[2].set_ylabel("beads")
         axes[2].legend(fontsize=8, ncol=2)
     axes[-1].set_xlabel("time [ms] (t = 0: walls start turning)")
+    end = t[-1] if t else 0.0
+    colours = ("tab:blue", "tab:orange", "tab:green", "tab:purple")
+    for k, (label, t_from) in enumerate(windows):
+        for i, ax in enumerate(axes):
+            ax.axvspan(t_from * 1e3, end, color=colours[k % len(colours)], alpha=0.07,
+                       label=f"{label} averaged from {t_from * 1e3:.3g} ms" if i == len(axes) - 1 else None)
+    if windows:
+        axes[-1].legend(fontsize=8, ncol=2)
     for ax in axes:
         ax.grid(alpha=0.3)
     save(fig, os.path.join(out, "time_series.png"))
@@ -598,6 +678,19 @@ def symmetry_rows(run_summary):
     ]
 
 
+def with_error(run_summary, key, value, scale=1.0, digits=4):
+    """"value ± standard error" of a key of dem/summary.csv (the value as given, the error
+    scaled like it); the value alone when the run gives no error for it."""
+    se = float("nan")
+    for r in run_summary or []:
+        if r.get("key") == key:
+            try:
+                se = float(r.get("standard_error", "nan"))
+            except ValueError:
+                pass
+    return fmt(value * scale, digits) + (f" ± {fmt(se * scale, 2)}" if math.isfinite(se) else "")
+
+
 def key_numbers(summary, nip_series, series, flux, run_summary=None, flow=None):
     """[(what, value, reference, verdict)] for the summary table."""
     rows = steady_state_rows(run_summary, supplied=flow is not None)
@@ -605,6 +698,9 @@ def key_numbers(summary, nip_series, series, flux, run_summary=None, flow=None):
     def val(key):
         v = summary.get(key, (float("nan"), ""))[0]
         return v if isinstance(v, float) else float("nan")
+
+    def err(key, summary_key, scale=1.0, digits=4):
+        return with_error(run_summary, summary_key, val(key), scale, digits)
 
     samples = val("samples") if summary else float("nan")
     if summary and not (math.isfinite(samples) and samples > 0):
@@ -616,12 +712,12 @@ def key_numbers(summary, nip_series, series, flux, run_summary=None, flow=None):
     elif summary:
         rel = val("relative_surface_speed")
         slip = val("slip_at_gap_centre")
-        rows.append(("slip speed at the gap centre", f"{fmt(slip)} m/s (bead spread {fmt(val('slip_std_at_gap_centre'), 2)})",
+        rows.append(("slip speed at the gap centre", f"{err('slip_at_gap_centre', 'slip_at_gap_centre_m_s')} m/s (bead spread {fmt(val('slip_std_at_gap_centre'), 2)})",
                      f"relative surface speed {fmt(rel)} m/s (Kawamoto: equal)",
                      f"{fmt(slip / rel if rel else float('nan'), 3)} of it"))
         chain = val("chain_speed_at_gap_centre")
         if math.isfinite(chain):
-            rows.append(("chain speed over the drum at the gap centre", f"{fmt(chain)} m/s (bead centres, rolling included)",
+            rows.append(("chain speed over the drum at the gap centre", f"{err('chain_speed_at_gap_centre', 'chain_speed_at_gap_centre_m_s')} m/s (bead centres, rolling included)",
                          f"relative surface speed {fmt(rel)} m/s (Kawamoto: equal)",
                          f"{fmt(chain / rel if rel else float('nan'), 3)} of it"))
         b = val("gap_centre_field")
@@ -632,16 +728,19 @@ def key_numbers(summary, nip_series, series, flux, run_summary=None, flow=None):
             b = math.hypot(flux["Bn"][k], flux["Bt"][k])
         pm = b * b / (2 * MU0) if math.isfinite(b) else float("nan")
         peak = val("peak_normal_pressure")
-        rows.append(("peak normal pressure on the drum", f"{fmt(peak / 1e3)} kPa",
+        rows.append(("peak normal pressure on the drum", f"{err('peak_normal_pressure', 'peak_normal_pressure_Pa', 1e-3)} kPa",
                      f"B²/2μ0 = {fmt(pm / 1e3)} kPa at B = {fmt(b * 1e3)} mT (gap centre)",
                      f"{fmt(peak / pm if pm else float('nan'), 3)} × B²/2μ0"))
-        rows.append(("normal pressure at the gap centre", f"{fmt(val('normal_pressure_at_gap_centre') / 1e3)} kPa", "", ""))
+        rows.append(("normal pressure at the gap centre",
+                     f"{err('normal_pressure_at_gap_centre', 'normal_pressure_at_gap_centre_Pa', 1e-3)} kPa", "", ""))
         rows += symmetry_rows(run_summary)
-        rows.append(("tangential / normal (whole nip)", fmt(val("tangential_over_normal"), 3),
+        rows.append(("tangential / normal (whole nip)", err("tangential_over_normal", "tangential_over_normal", 1.0, 3),
                      "bead-drum friction coefficient 0.35 (Kawamoto: ≈ 0.35)", ""))
-        rows.append(("touching-bead density at the gap centre", f"{fmt(val('density_at_gap_centre'))} /mm²",
+        rows.append(("touching-bead density at the gap centre",
+                     f"{err('density_at_gap_centre', 'density_at_gap_centre_per_mm2')} /mm²",
                      "∝ 1/d² (Kawamoto Fig. 19)", ""))
-        rows.append(("normal force on the drum per length", f"{fmt(val('normal_force_per_length'))} N/m", "", ""))
+        rows.append(("normal force on the drum per length",
+                     f"{err('normal_force_per_length', 'normal_force_per_length_N_m')} N/m", "", ""))
         rows.append(("averaged over", f"{int(val('samples'))} samples, t = {fmt(val('t_from') * 1e3)} .. "
                      f"{fmt(val('t_to') * 1e3)} ms", "", ""))
     fed = budget_row(flow)
@@ -664,8 +763,69 @@ def key_numbers(summary, nip_series, series, flux, run_summary=None, flow=None):
     return rows
 
 
-def build_index(args, images, rows, run_times, phases, snapshot_time, dem_done):
+# The inputs a designer changes first, by key prefix, in the order shown (the whole resolved
+# case is linked beside them).
+MAIN_INPUTS = ("name", "sleeve.radius", "sleeve.rpm", "drum.radius", "drum.rpm", "drum.gap", "roller.poles.",
+               "blades.", "electric.enabled", "electric.bias", "electric.image.", "populations.", "inflow.areal_mass",
+               "dem.periodic_length", "dem.duration", "dem.time_step", "nip.average_from", "development.average_from",
+               "dma.average_from", "flow_report.average_from")
+MAIN_INPUT_LEAVES = (".angle", ".strength", ".gap", ".diameter", ".count", ".charge_to_mass", ".kind", ".period",
+                     ".duty")
+
+
+def inputs_table(resolved_path):
+    """[(key, value)] of the main inputs in case_resolved.txt ("key = value" lines)."""
+    if not resolved_path or not os.path.exists(resolved_path):
+        return []
+    rows = []
+    with open(resolved_path) as f:
+        for line in f:
+            if line.startswith("#") or " = " not in line:
+                continue
+            key, value = (part.strip() for part in line.split(" = ", 1))
+            for prefix in MAIN_INPUTS:
+                if key == prefix or (prefix.endswith(".") and key.startswith(prefix) and
+                                     key.endswith(MAIN_INPUT_LEAVES)):
+                    rows.append((key, value))
+                    break
+    return rows
+
+
+def read_overrides(run_dir):
+    """The --set overrides of the run (variant.txt in its folder, "set key=value" lines)."""
+    path = os.path.join(run_dir, "variant.txt")
+    if not os.path.exists(path):
+        return None
+    with open(path) as f:
+        return [line[4:].strip() for line in f if line.startswith("set ")]
+
+
+def all_key_numbers(run_summary):
+    """[(key, value ± se, unit, bound, meaning)] of every row of dem/summary.csv, the keys that
+    are bounds (<key>_bound) shown beside the key they bound rather than as rows."""
+    by_key = {r["key"]: r for r in run_summary or []}
+    rows = []
+    for r in run_summary or []:
+        key = r["key"]
+        if key.endswith("_bound") and key[: -len("_bound")] in by_key:
+            continue
+        try:
+            value = float(r["value"])
+        except (KeyError, ValueError):
+            value = float("nan")
+        bound = by_key.get(key + "_bound")
+        rows.append((key, with_error(run_summary, key, value), r.get("unit", ""),
+                     fmt(float(bound["value"])) if bound else "", r.get("meaning", "")))
+    return rows
+
+
+def build_index(args, images, rows, run_times, phases, snapshot_time, dem_done, run_summary=None):
     links = []
+    run_dir = os.path.dirname(os.path.normpath(args.dem_dir))
+    resolved = os.path.join(args.out, "case_resolved.txt")
+    inputs = inputs_table(resolved)
+    overrides = read_overrides(run_dir)
+    every_key = all_key_numbers(run_summary)
     xdmf = os.path.join(args.dem_dir, "particles.xdmf")
     if os.path.exists(xdmf):
         links.append(("particles (ParaView, time series)", os.path.relpath(xdmf, args.out)))
@@ -684,6 +844,16 @@ def build_index(args, images, rows, run_times, phases, snapshot_time, dem_done):
     md += ["## Key numbers", "", "| quantity | value | reference | |", "|---|---|---|---|"]
     md += [f"| {a} | {b} | {c} | {d} |" for a, b, c, d in rows]
     md.append("")
+    md += ["## Inputs", "", "The whole resolved case: [case_resolved.txt](case_resolved.txt). Overrides: " +
+           (", ".join(f"`{o}`" for o in overrides) if overrides else "none (the case as its file gives it)"
+            if overrides is not None else "not recorded (run with `magbrush run` to keep them)"), ""]
+    if inputs:
+        md += ["| key | value |", "|---|---|"] + [f"| {k} | {v} |" for k, v in inputs] + [""]
+    if every_key:
+        md += ["## Every key number (dem/summary.csv)", "", "value ± standard error (block averages over the window)",
+               "", "| key | value | unit | bound | meaning |", "|---|---|---|---|---|"]
+        md += [f"| {k} | {v} | {u} | {b} | {m} |" for k, v, u, b, m in every_key]
+        md.append("")
     if run_times:
         md += ["## Run time per stage", "", "| stage | wall time [s] |", "|---|---|"]
         md += [f"| {s} | {t:.1f} |" for s, t in run_times]
@@ -705,9 +875,26 @@ def build_index(args, images, rows, run_times, phases, snapshot_time, dem_done):
          "<style>body{font-family:sans-serif;max-width:1000px;margin:2em auto;} table{border-collapse:collapse;}"
          " td,th{border:1px solid #bbb;padding:3px 8px;} img{max-width:100%;margin:6px 0;}</style></head><body>",
          f"<h1>magbrush report: {e(args.case_name)}</h1>", "<h2>Key numbers</h2>",
+         "<p>value ± standard error (block averages over the averaging window); a number without ± has none "
+         "in the run's summary (a single bin's value, or a ratio of sums).</p>",
          "<table><tr><th>quantity</th><th>value</th><th>reference</th><th></th></tr>"]
     h += [f"<tr><td>{e(a)}</td><td>{e(b)}</td><td>{e(c)}</td><td>{e(d)}</td></tr>" for a, b, c, d in rows]
     h.append("</table>")
+    h.append("<h2>Inputs</h2><p>The whole resolved case: <a href='case_resolved.txt'>case_resolved.txt</a>. Overrides: " +
+             (", ".join(f"<code>{e(o)}</code>" for o in overrides) if overrides else
+              "none (the case as its file gives it)" if overrides is not None else
+              "not recorded (run with <code>magbrush run</code> to keep them)") + "</p>")
+    if inputs:
+        h.append("<table><tr><th>key</th><th>value</th></tr>")
+        h += [f"<tr><td>{e(k)}</td><td>{e(v)}</td></tr>" for k, v in inputs]
+        h.append("</table>")
+    if every_key:
+        h += ["<h2>Every key number (dem/summary.csv)</h2><p>value ± standard error (block averages over the "
+              "averaging window); a bound is the physical limit the key is judged against</p>",
+              "<table><tr><th>key</th><th>value</th><th>unit</th><th>bound</th><th>meaning</th></tr>"]
+        h += [f"<tr><td>{e(k)}</td><td>{e(v)}</td><td>{e(u)}</td><td>{e(b)}</td><td>{e(m)}</td></tr>"
+              for k, v, u, b, m in every_key]
+        h.append("</table>")
     if run_times:
         h += ["<h2>Run time per stage</h2><table><tr><th>stage</th><th>wall time [s]</th></tr>"]
         h += [f"<tr><td>{e(s)}</td><td>{t:.1f}</td></tr>" for s, t in run_times]
@@ -779,8 +966,12 @@ def main():
 
     images = []
     relative_speed = summary.get("relative_surface_speed", (None, ""))[0] if summary else None
+    samples = summary.get("samples", (float("nan"), ""))[0] if summary else float("nan")
+    magnetic_pressure = summary.get("magnetic_pressure", (None, ""))[0] if summary else None
+    log = os.path.join(args.dem_dir, "dem.log")
     if profile:
-        images += nip_plots(plt, profile, args.out, relative_speed)
+        images += nip_plots(plt, profile, args.out, relative_speed, samples if isinstance(samples, float) else float("nan"),
+                            drum_friction(log), magnetic_pressure if isinstance(magnetic_pressure, float) else None)
     if chains:
         images.append(chain_plot(plt, chains, flux, args.out))
     if flux:
@@ -792,12 +983,11 @@ def main():
                                             (args.sleeve_radius, args.drum_radius, (cx, cy), args.sleeve_sense), args.out)
         if name:
             images.append(name)
-    images.append(series_plot(plt, series, nip_series, args.out))
+    images.append(series_plot(plt, series, nip_series, args.out, averaging_windows(args.dem_dir, os.path.join(args.out, "case_resolved.txt"))))
 
     run_times = []
     if run_times_table:
         run_times = list(zip(run_times_table["stage"], run_times_table["seconds"]))
-    log = os.path.join(args.dem_dir, "dem.log")
     phases = read_phase_times(log)
     dem_done = read_log_line(log, "done:")
     run_summary = read_run_summary(os.path.join(args.dem_dir, "summary.csv"))
@@ -809,7 +999,7 @@ def main():
         images.append(profile_image)
     flow = read_csv(os.path.join(args.dem_dir, "flow_report.csv"))
     rows = key_numbers(summary, nip_series, series, flux, run_summary, flow)
-    build_index(args, images, rows, run_times, phases, snapshot_time, dem_done)
+    build_index(args, images, rows, run_times, phases, snapshot_time, dem_done, run_summary)
     for a, b, c, d in rows:
         print(f"  {a:42s} {b}  {('[' + c + ']') if c else ''} {d}")
     return 0

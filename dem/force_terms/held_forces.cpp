@@ -231,6 +231,7 @@ void HeldForces::particles_changed(const std::vector<std::int32_t> &origin)
   };
   for (auto *a : {&held_.fx, &held_.fy, &held_.fz, &held_.tx, &held_.ty, &held_.tz, &x0_, &y0_, &z0_, &u0_})
     carry(*a);
+  held_.zero_fast();
   std::vector<std::uint8_t> stale(n, 1);
   for (std::size_t k = 0; k < n; ++k)
     if (origin[k] >= 0)
@@ -260,6 +261,7 @@ void HeldForces::read_state(CheckpointReader &in)
   for (auto *a : {&held_.fx, &held_.fy, &held_.fz, &held_.tx, &held_.ty, &held_.tz, &x0_, &y0_, &z0_, &u0_})
     in.get_array(*a);
   in.get_array(stale_);
+  held_.zero_fast();
   const std::size_t n = held_.fx.size();
   for (const auto *a : {&held_.fy, &held_.fz, &held_.tx, &held_.ty, &held_.tz, &x0_, &y0_, &z0_})
     if (a->size() != n)

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 
 namespace {
@@ -124,9 +125,11 @@ TEST(Sweep, ADiameterStudyOfAPopulationGivenByMassScalesItsSpreadAndTheStep)
                                       "populations.carrier.diameter=100um,50um", "--skip", "mesh,field,dem,report",
                                       "--set", "output.directory=" + (dir / "out").string()});
   ASSERT_EQ(r.status, 0) << r.output;
-  const std::size_t second = r.output.find("p1_diameter-50um");
-  ASSERT_NE(second, std::string::npos) << r.output;
-  const std::string point = r.output.substr(second);
+  // The point's case as it ran: `magbrush run` writes it resolved into the point's folder.
+  const fs::path resolved_file = dir / "out" / "sweep_diameter" / "p1_diameter-50um" / "case_resolved.txt";
+  ASSERT_TRUE(fs::exists(resolved_file)) << r.output;
+  std::ifstream resolved_in(resolved_file);
+  const std::string point((std::istreambuf_iterator<char>(resolved_in)), std::istreambuf_iterator<char>());
   auto resolved = [&](const std::string &key) {
     const std::size_t at = point.find("\n" + key + " ");
     if (at == std::string::npos)

@@ -188,3 +188,32 @@ TEST(CommandLine, ForwardOnlyWhatTheStageDeclares)
 }
 
 } // namespace
+
+TEST(CommandLine, ALastPositionalOfOneOrMoreTakesEveryFurtherWord)
+{
+  CommandSpec spec;
+  spec.program = "magbrush compare";
+  spec.usage = "magbrush compare RUN_A RUN_B [RUN ...]";
+  spec.positionals = {{"RUN_A", "the reference"}, {"RUN_B", "the others", Positional::one_or_more}};
+  const ParsedArguments three = parse(spec, {"a", "b", "c"});
+  EXPECT_EQ(three.positionals(), (std::vector<std::string>{"a", "b", "c"}));
+  EXPECT_THROW(parse(spec, {"a"}), UsageError); // one or more: RUN_B is required
+  EXPECT_NE(help_text(spec).find("(one or more)"), std::string::npos);
+}
+
+TEST(CommandLine, TheHelpEndsWithTheExamplesThenTheExitStatus)
+{
+  CommandSpec spec;
+  spec.program = "magbrush check";
+  spec.usage = "magbrush check CASE";
+  spec.epilog = "A note.\n";
+  spec.examples = {{"magbrush check a.yaml", "validate it"}};
+  spec.exit_status = "0 valid, 1 invalid, 2 bad usage.";
+  const std::string help = help_text(spec);
+  const auto note = help.find("A note."), example = help.find("Example:\n  magbrush check a.yaml\n      validate it\n"),
+             exit_status = help.find("Exit status: 0 valid, 1 invalid, 2 bad usage.\n");
+  ASSERT_NE(example, std::string::npos) << help;
+  ASSERT_NE(exit_status, std::string::npos) << help;
+  EXPECT_LT(note, example);
+  EXPECT_LT(example, exit_status);
+}

@@ -41,12 +41,19 @@ const std::string nip_case = std::string(MAGBRUSH_SOURCE_DIR) + "/cases/kawamoto
 
 TEST(ProgramCommandLines, EverySubcommandHelpExitsZero)
 {
-  for (const char *command : {"check", "mesh", "field", "flux", "design", "dem", "report", "run", "sweep"})
+  for (const char *command : {"check", "mesh", "field", "flux", "design", "dem", "report", "compare", "run", "sweep"})
   {
     const Result r = run({bin + "magbrush", command, "--help"});
     EXPECT_EQ(r.status, 0) << command << "\n" << r.output;
     EXPECT_NE(r.output.find(std::string("Usage: magbrush ") + command), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("--help"), std::string::npos) << r.output;
+    // One help format: every command ends with its examples, then its exit status.
+    const auto example = r.output.find("\nExample"), exit_status = r.output.find("\nExit status: ");
+    EXPECT_NE(example, std::string::npos) << command << ": no example\n" << r.output;
+    EXPECT_NE(exit_status, std::string::npos) << command << ": no exit status\n" << r.output;
+    EXPECT_LT(example, exit_status) << command;
+    EXPECT_NE(r.output.find(std::string("\n  magbrush ") + command + " "), std::string::npos)
+        << command << ": the example is not a command line of its own";
   }
   EXPECT_EQ(run({bin + "magbrush-dem", "--help"}).status, 0);
 }

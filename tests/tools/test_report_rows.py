@@ -198,5 +198,46 @@ class NipRows(unittest.TestCase):
         self.assertTrue(any(r[0] == "peak normal pressure on the drum" for r in rows), rows)
 
 
+
+class DecisionPage(unittest.TestCase):
+    """What makes the report a page to decide from: errors, bounds, windows, sparse bins, inputs."""
+
+    def test_a_one_contact_edge_bin_is_masked(self):
+        # The default nip's 1 ms run: an edge bin touched once (175 uN) among bins of hundreds.
+        profile = {"x_mm": [-2.5, -2.25, -2.0, 0.0], "contact_samples": [1, 82, 300, 0]}
+        self.assertEqual(report.sparse_bins(profile, 251), [True, False, False, False])
+        self.assertEqual(report.sparse_bins({"x_mm": [0.0]}, 251), [False])  # no counts: nothing masked
+
+    def test_key_numbers_carry_their_standard_errors_and_bounds(self):
+        rows = [{"key": "dma_kg_per_m2", "value": "0.31", "standard_error": "0.012", "unit": "kg/m^2",
+                 "meaning": "DMA"},
+                {"key": "dma_kg_per_m2_bound", "value": "0.6", "standard_error": "nan", "unit": "kg/m^2",
+                 "meaning": "bulk"},
+                {"key": "peak_normal_pressure_Pa", "value": "360", "standard_error": "nan", "unit": "Pa",
+                 "meaning": "peak"}]
+        self.assertEqual(report.with_error(rows, "dma_kg_per_m2", 0.31), "0.31 ± 0.012")
+        self.assertEqual(report.with_error(rows, "peak_normal_pressure_Pa", 360.0, 1e-3), "0.36")
+        every = report.all_key_numbers(rows)
+        self.assertEqual([r[0] for r in every], ["dma_kg_per_m2", "peak_normal_pressure_Pa"])
+        self.assertEqual(every[0][3], "0.6")  # the bound beside its key, not a row of its own
+
+    def test_windows_and_inputs_come_from_the_resolved_case(self):
+        import tempfile
+        with tempfile.TemporaryDirectory() as d:
+            dem = os.path.join(d, "dem")
+            os.makedirs(dem)
+            for name in ("nip_profile.csv", "flow_report.csv"):
+                open(os.path.join(dem, name), "w").close()
+            resolved = os.path.join(d, "case_resolved.txt")
+            with open(resolved, "w") as f:
+                f.write("# case\nname = nip\ndrum.gap = 400 um\nroller.poles.S1.angle = 0 deg\n"
+                        "roller.poles.S1.shape_factor = 10 rad^-2\nnip.average_from = 25 ms\n"
+                        "flow_report.average_from = 500 us\ndevelopment.average_from = 3 ms\n")
+            self.assertEqual(report.averaging_windows(dem, resolved), [("nip", 0.025), ("flow report", 0.0005)])
+            keys = [k for k, _ in report.inputs_table(resolved)]
+            self.assertIn("drum.gap", keys)
+            self.assertIn("roller.poles.S1.angle", keys)
+            self.assertNotIn("roller.poles.S1.shape_factor", keys)
+
 if __name__ == "__main__":
     unittest.main()

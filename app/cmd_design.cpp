@@ -63,7 +63,7 @@ largest net outward acceleration in the release window (dma.release_from → rel
         {"--field-unit", {}, "T|mT|G|kG", "poles: unit of a profile target's Bn/Bt columns"},
         {"--no-fem-check", {}, "", "poles: skip the finite-element check of the designed layout"},
         {"--no-plot", {}, "", "poles: do not call tools/plot_design.py"},
-        {"--output", {"-o"}, "DIR", "poles: output folder (default <output.directory>/<case>/design)", false, {}, false},
+        {"--output", {"-o"}, "DIR", "poles: output folder (default <output.directory>/design)", false, {}, false},
         cli::set_option("roller.poles.S2.angle=150deg"),
         {"--quantity", {}, "KEY", "gap, bias: the study's column (default dma_kg_per_m2 / tma_kg_per_m2)"},
         {"--key", {}, "KEY", "gap, bias: the varied column (default blades.doctor.gap / electric.bias)"},
@@ -78,7 +78,9 @@ largest net outward acceleration in the release window (dma.release_from → rel
          {"auto", "piecewise", "line"}}};
     s.epilog = R"(Outputs of design poles in DIR: design_report.txt, <case>_designed.yaml, design_profile.csv
 (the designed profile, and the FEM's), design_requirements.csv, design_sensitivity.csv,
-design_bands.csv, design_profile.png. See docs/design_tools.md.
+design_bands.csv, design_profile.png, and the design's page index.html (index.md): the profile against
+the target, the requirements, the layout and the sensitivities; the case's run report links it.
+See docs/design_tools.md.
 )";
     s.examples = {
         {"magbrush design poles cases/kweon_development.yaml --target cases/data/kweon_development_spec.yaml",

@@ -103,7 +103,7 @@ int run_design_release(const cli::ParsedArguments &args)
     if (layouts.empty())
     {
       window = window_of(c, args.value("--window"));
-      dir = args.value("--output", c.output.directory + "/" + c.name + "/design");
+      dir = args.value("--output", c.output.directory + "/design");
       in = ReleaseInputs::from(c);
     }
     Layout l;

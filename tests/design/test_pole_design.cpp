@@ -23,6 +23,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 
 using namespace magbrush;
 
@@ -250,8 +251,14 @@ TEST(DesignCommand, SpecificationMetAndCheckedByFemWithinBudget)
   EXPECT_LT(total_seconds(r.output), 30.0) << r.output;
   const Case designed = load_case((dir / "kweon_development_designed.yaml").string());
   EXPECT_EQ(designed.roller->poles.size(), 5u);
-  for (const char *f : {"design_report.txt", "design_profile.csv", "design_requirements.csv", "design_sensitivity.csv"})
+  for (const char *f : {"design_report.txt", "design_profile.csv", "design_requirements.csv", "design_sensitivity.csv",
+                        "index.md", "index.html"})
     EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
+  // The design's page: the requirements judged on the ring and the FEM, the layout, the sensitivities.
+  std::ifstream in(dir / "index.md");
+  const std::string page((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (const char *section : {"## Requirements", "## Layout", "## Sensitivity", "verdict (FEM)", "S1 peak \\|Bn\\|"})
+    EXPECT_NE(page.find(section), std::string::npos) << section << "\n" << page;
 }
 
 TEST(DesignCommand, RecoversTheCaseFromItsOwnProfile)

@@ -324,6 +324,12 @@ private:
       double from = wrap_0_2pi(c.from) * to_deg, to = from + wrap_0_2pi(c.to - c.from) * to_deg;
       bands << "B_ceiling," << from << "," << to << "," << 0.0 << "," << (c.level + c.tolerance) * 1e3 << ",|B| below\n";
     }
+    if (target_.release)
+    {
+      const double from = wrap_0_2pi(target_.release->from) * to_deg,
+                   to = from + wrap_0_2pi(target_.release->to - target_.release->from) * to_deg;
+      bands << "release," << from << "," << to << ",0,0,released (a_net >= " << target_.release->margin << " g)\n";
+    }
     if (target_.profile)
     {
       const auto &t = *target_.profile;

@@ -192,7 +192,7 @@ int run_design_study(const cli::ParsedArguments &args, const std::string &mode)
     if (next.gain() < 0.1)
     {
       std::cout << "--refine: one more point would narrow the answer by " << std::lround(100 * next.gain())
-                << " % only: the error is now that of one run; longer runs or --repeats narrow it, more points do not.\n";
+                << " % only: the answer's error is set by the runs' own errors; longer runs or --repeats narrow it, more points of this length hardly do.\n";
       return 4;
     }
     const FinishedSweep sweep = read_finished_sweep(fs::path(path).parent_path(), kind.key);

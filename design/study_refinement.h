@@ -12,9 +12,9 @@
 // For the piecewise inverse with bracket (x_i, x_{i+1}) and a new point c between them the
 // answer's error becomes |Δx/Δy| · hypot((1 − t)σ_c, t σ_j) over the new, shorter piece, so
 // the best c lies near the answer itself — a little towards the better-known neighbour (at
-// t = σ_c²/(σ_c² + σ_j²)). Once points are that close, more of them no longer help: the error
-// of the answer is then that of one run (σ_c / |slope|), and only longer runs or repeats
-// narrow it. `gain` says how much the best candidate is predicted to narrow the answer; the
+// t = σ_c²/(σ_c² + σ_j²)). A point of the same length as its neighbours cannot beat their
+// mean, so once the answer sits between two points of similar error more points hardly help:
+// its error is set by the runs' own (~σ/|slope|), and only longer runs or repeats narrow it. `gain` says how much the best candidate is predicted to narrow the answer; the
 // caller stops when it is small.
 #pragma once
 

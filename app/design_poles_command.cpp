@@ -6,9 +6,10 @@
 //   4. <case>_designed.yaml, the profile and requirement tables;
 //   5. the FEM check: magbrush-field on the designed case, the requirements judged again on
 //      its profile;
-//   6. the plot (tools/plot_design.py) and the time taken.
+//   6. the plot (tools/plot_design.py), the time taken and the design's page (app/design_page.h).
 #include "app/design_poles_command.h"
 
+#include "app/design_page.h"
 #include "app/flux_tools.h"
 #include "calibration/flux_scan.h"
 #include "common/atomic_file.h"
@@ -168,6 +169,8 @@ public:
     report_ << buf;
     write_text_atomically(dir_ + "/design_report.txt", report_.str());
     std::cout << "  report      " << dir_ << "/design_report.txt\n";
+    write_page(buf + 1);
+    std::cout << "  page        " << dir_ << "/index.html\n";
     return design_.feasible ? 0 : 3;
   }
 
@@ -183,6 +186,8 @@ private:
   std::vector<RequirementResult> fem_requirements_;
   std::string fem_path_;
   double solve_seconds_ = 0, fem_seconds_ = 0;
+  SensitivityTable sensitivity_;
+  std::string fem_note_;
   std::ostringstream report_; // everything printed, for design_report.txt
 
   void say(const std::string &text)
@@ -212,8 +217,10 @@ private:
     if (args_.has("--angle-range"))
       constraints_.angle_range = parse_quantity(args_.value("--angle-range"), Dimension::angle);
     options_.starts = int(args_.whole_number("--starts", 8, 1, 1000));
+    if (target_.release)
+      target_.release_inputs = ReleaseInputs::from(case_);
     probe_radius_ = target_.probe_radius > 0 ? target_.probe_radius : probe_radius_of(case_);
-    dir_ = args_.value("--output", case_.output.directory + "/" + case_.name + "/design");
+    dir_ = args_.value("--output", case_.output.directory + "/design");
     fs::create_directories(dir_);
     say("magbrush design poles: case '" + case_.name + "', " + std::to_string(case_.roller->poles.size()) +
         " poles, target " + target_file + " (" +
@@ -221,6 +228,7 @@ private:
         (target_.peaks.empty() ? "" : ", " + std::to_string(target_.peaks.size()) + " pole peaks") +
         (target_.ceilings.empty() ? "" : ", " + std::to_string(target_.ceilings.size()) + " low-field arcs") +
         (target_.min_spacing > 0 ? ", minimum spacing " + fixed(target_.min_spacing * to_deg, 1) + " deg" : "") +
+        (target_.release ? ", a release arc" : "") +
         "), probe radius " + fixed(probe_radius_ * 1e3, 3) + " mm\n");
   }
 
@@ -256,13 +264,14 @@ private:
         s << "  " << b << "\n";
     }
     const RingProfile ring(*case_.roller, probe_radius_);
-    const RequirementSet set(target_, case_.roller->poles);
+    const RequirementSet set(target_, *case_.roller);
     const SensitivityTable t = sensitivities(set, ring, design_.poles);
     s << "\nSensitivity: change of each requirement's value per +1 deg of a pole's angle (1 deg = "
       << fixed(case_.roller->magnet_radius * 1e3 * M_PI / 180.0, 3)
       << " mm on the magnet's surface) or per +10 kA/m of its |M| (stronger):\n"
       << format_sensitivities(t);
     write_text_atomically(dir_ + "/design_sensitivity.csv", sensitivities_csv(t));
+    sensitivity_ = t;
     say(s.str());
   }
 
@@ -315,6 +324,12 @@ private:
       double from = wrap_0_2pi(c.from) * to_deg, to = from + wrap_0_2pi(c.to - c.from) * to_deg;
       bands << "B_ceiling," << from << "," << to << "," << 0.0 << "," << (c.level + c.tolerance) * 1e3 << ",|B| below\n";
     }
+    if (target_.release)
+    {
+      const double from = wrap_0_2pi(target_.release->from) * to_deg,
+                   to = from + wrap_0_2pi(target_.release->to - target_.release->from) * to_deg;
+      bands << "release," << from << "," << to << ",0,0,released (a_net >= " << target_.release->margin << " g)\n";
+    }
     if (target_.profile)
     {
       const auto &t = *target_.profile;
@@ -334,6 +349,7 @@ private:
     if (args_.has("--no-fem-check"))
     {
       say("\nFEM check skipped (--no-fem-check)\n");
+      fem_note_ = "FEM check skipped (--no-fem-check).";
       write_text_atomically(dir_ + "/design_requirements.csv", requirements_csv(design_.requirements, nullptr));
       return;
     }
@@ -348,10 +364,11 @@ private:
     if (!failure.empty() || fem_path_.empty())
     {
       say("FEM check not done: " + (failure.empty() ? why : failure) + "\n");
+      fem_note_ = "FEM check not done: " + (failure.empty() ? why : failure);
       write_text_atomically(dir_ + "/design_requirements.csv", requirements_csv(design_.requirements, nullptr));
       return;
     }
-    const RequirementSet set(target_, case_.roller->poles);
+    const RequirementSet set(target_, *case_.roller);
     fem_requirements_ = set.evaluate(design_.poles, profile_from_file(fem_path_));
     bool all_met = true;
     for (const auto &r : fem_requirements_)
@@ -370,6 +387,9 @@ private:
       diff = std::max(diff, std::hypot(Fn[k] - Bn[k], Ft[k] - Bt[k]));
       peak = std::max(peak, std::hypot(Bn[k], Bt[k]));
     }
+    fem_note_ = "The FEM (" + fem_path_ + ") against the exact ring of the designed layout: max |ΔB| = " +
+                fixed(diff * 1e3, 3) + " mT (" + scientific(diff / peak) + " of the peak |B|); " +
+                (all_met ? "it meets every requirement." : "it misses a requirement.");
     say("Requirements on the finite-element profile (" + fem_path_ + "):\n" + requirements_table(fem_requirements_) +
         (all_met ? "The FEM of the designed layout meets every requirement.\n"
                  : "The FEM of the designed layout misses a requirement (above).\n") +
@@ -403,6 +423,44 @@ private:
       out << buf;
     }
     write_text_atomically(dir_ + "/design_profile.csv", out.str());
+  }
+
+  void write_page(const std::string &time)
+  {
+    DesignPage page;
+    page.case_name = case_.name;
+    page.target = args_.value("--target");
+    page.verdict = design_.feasible ? "Every requirement is met on the exact ring."
+                                    : "INFEASIBLE: no layout within the constraints meets every requirement; the "
+                                      "layout below is the nearest (least squares).";
+    page.method = "Bounded least squares on the exact ring from " + std::to_string(design_.start_costs.size()) +
+                  " starts (" + std::to_string(design_.starts_at_best) + " reached the best); " + design_.status + ".";
+    page.time = time.substr(0, time.find_last_not_of('\n') + 1);
+    if (!args_.has("--no-plot") && fs::exists(dir_ + "/design_profile.png"))
+      page.image = "design_profile.png";
+    for (size_t i = 0; i < design_.poles.size(); ++i)
+    {
+      bool angle_free = false, strength_free = false;
+      for (const auto &q : design_.parameters)
+        if (q.pole == i)
+          (q.angle ? angle_free : strength_free) = true;
+      const Pole &from = case_.roller->poles[i], &to = design_.poles[i];
+      page.layout.push_back({to.name, fixed(wrap_0_2pi(from.angle) * to_deg, 3), fixed(to.angle * to_deg, 3),
+                             fixed(std::abs(from.strength) * 1e-3, 2), fixed(std::abs(to.strength) * 1e-3, 2),
+                             std::string(angle_free ? "angle free" : "angle fixed") +
+                                 (strength_free ? ", |M| free" : ", |M| fixed")});
+    }
+    page.ring = design_.requirements;
+    page.fem = fem_requirements_;
+    page.fem_note = fem_note_;
+    page.binding = design_.binding;
+    page.sensitivity = sensitivity_;
+    for (const char *f : {"design_report.txt", "design_requirements.csv", "design_sensitivity.csv", "design_profile.csv",
+                          "design_bands.csv", "design_target_profile.csv", "design_fem_check.log"})
+      if (fs::exists(dir_ + "/" + f))
+        page.files.push_back(f);
+    page.files.push_back(fs::path(designed_case_).filename().string());
+    write_design_page(dir_, page);
   }
 
   void plot()

@@ -103,7 +103,8 @@ int run_design_release(const cli::ParsedArguments &args)
     if (layouts.empty())
     {
       window = window_of(c, args.value("--window"));
-      dir = args.value("--output", c.output.directory + "/" + c.name + "/design");
+      // The case's own run folder (with --set only): not the folder of the first --vary variant.
+      dir = args.value("--output", load_case(args.positional(1), args.values("--set")).output.directory + "/design");
       in = ReleaseInputs::from(c);
     }
     Layout l;

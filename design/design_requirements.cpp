@@ -11,6 +11,10 @@ namespace magbrush {
 namespace {
 
 constexpr double deg = M_PI / 180.0;
+// A one-sided requirement (|B| below a level, a spacing, a release) aims this fraction of its
+// residual scale inside its limit: the least squares balances a hinge against the pull towards
+// the case's layout a hair outside the limit, and the aim keeps that hair inside.
+constexpr double inside = 0.02;
 
 std::string f1(double v)
 {
@@ -125,9 +129,22 @@ double wrap_0_2pi(double a)
   return a < 0 ? a + 2.0 * M_PI : a;
 }
 
-RequirementSet::RequirementSet(const DesignTarget &target, const std::vector<Pole> &nominal)
-    : target_(target), nominal_(nominal)
+RequirementSet::RequirementSet(const DesignTarget &target, const Roller &roller)
+    : target_(target), nominal_(roller.poles)
 {
+  if (target_.release)
+  {
+    if (!target_.release_inputs)
+      throw std::invalid_argument("a release requirement needs the carrier bead, sleeve and gravity of the case");
+    const ReleaseInputs &in = *target_.release_inputs;
+    const double r = in.sleeve_radius + in.bead_radius, h = 1e-3 * in.bead_radius;
+    release_rings_.emplace_back(roller, r - h);
+    release_rings_.emplace_back(roller, r + h);
+    double span = wrap_0_2pi(target_.release->to - target_.release->from);
+    const int n = int(std::ceil(span / (0.25 * deg))) + 1;
+    for (int k = 0; k < n; ++k)
+      release_angles_.push_back(target_.release->from + span * k / (n - 1));
+  }
   if (target_.profile)
   {
     arc_samples_.assign(nominal_.size(), {});
@@ -263,7 +280,7 @@ void RequirementSet::field_below(const ProfileFunction &profile, std::vector<Req
     for (size_t k = ceiling_start_[c]; k < ceiling_start_[c + 1]; ++k)
     {
       const double B = std::hypot(Bn[k], Bt[k]);
-      r.residuals.push_back(std::max(0.0, B - fc.level) / scale);
+      r.residuals.push_back(std::max(0.0, B - (fc.level - inside * scale)) / scale);
       if (B > worst)
       {
         worst = B;
@@ -275,6 +292,41 @@ void RequirementSet::field_below(const ProfileFunction &profile, std::vector<Req
     r.detail = "largest |B| at " + f1(wrap_0_2pi(worst_angle) / deg) + "°";
     out.push_back(r);
   }
+}
+
+void RequirementSet::release(const std::vector<Pole> &poles, std::vector<RequirementResult> &out) const
+{
+  if (!target_.release)
+    return;
+  const ReleaseInputs &in = *target_.release_inputs;
+  const double r = in.sleeve_radius + in.bead_radius, h = 1e-3 * in.bead_radius;
+  const double beta = (in.bead_mu_r - 1.0) / (in.bead_mu_r + 2.0), mu0 = 4e-7 * M_PI;
+  const double g = 9.81; // the margin's unit, whatever the case's own gravity (which may be zero)
+  std::vector<double> n0, t0, n1, t1;
+  release_rings_[0](poles, release_angles_, n0, t0);
+  release_rings_[1](poles, release_angles_, n1, t1);
+  RequirementResult res;
+  res.name = "release somewhere on " + f1(wrap_0_2pi(target_.release->from) / deg) + "–" +
+             f1(wrap_0_2pi(target_.release->to) / deg) + "°";
+  res.unit = "g";
+  res.kind = RequirementResult::Kind::at_least;
+  res.target = target_.release->margin;
+  res.value = -1e300;
+  for (size_t k = 0; k < release_angles_.size(); ++k)
+  {
+    const double t = release_angles_[k];
+    const double dB2 = (n1[k] * n1[k] + t1[k] * t1[k] - n0[k] * n0[k] - t0[k] * t0[k]) / (2 * h);
+    const double net = 3.0 * beta / (2.0 * mu0 * in.bead_density) * dB2 + in.omega * in.omega * r +
+                       in.gx * std::cos(t) + in.gy * std::sin(t);
+    if (net / g > res.value)
+    {
+      res.value = net / g;
+      res.detail = "largest net outward acceleration of a carrier bead at " + f1(wrap_0_2pi(t) / deg) + "° (exact ring)";
+    }
+  }
+  res.residuals = {std::max(0.0, res.target + inside * 0.1 - res.value) / 0.1};
+  res.miss = miss_of(res);
+  out.push_back(res);
 }
 
 void RequirementSet::spacing(const std::vector<Pole> &poles, std::vector<RequirementResult> &out) const
@@ -297,7 +349,7 @@ void RequirementSet::spacing(const std::vector<Pole> &poles, std::vector<Require
   {
     const Pole &a = poles[order[j]], &b = poles[order[(j + 1) % order.size()]];
     const double gap = wrap_0_2pi(b.angle - a.angle);
-    r.residuals.push_back(std::max(0.0, target_.min_spacing - gap) / (0.5 * deg));
+    r.residuals.push_back(std::max(0.0, target_.min_spacing + inside * 0.5 * deg - gap) / (0.5 * deg));
     if (gap / deg < r.value)
     {
       r.value = gap / deg;
@@ -317,6 +369,7 @@ std::vector<RequirementResult> RequirementSet::evaluate(const std::vector<Pole> 
   pole_peaks(poles, profile, out);
   field_below(profile, out);
   spacing(poles, out);
+  release(poles, out);
   return out;
 }
 

@@ -9,8 +9,12 @@
 //                    1° grid and refined by successive parabolas to 1e-9 rad, so that its size
 //                    and angle are smooth functions of the layout; residual (value − target)/tol
 //   field below      |B| at 0.5° steps over the arc; residual (|B| − level)₊ / scale per sample
-//                    (scale: the tolerance, or 5 % of the level)
+//                    (scale: the tolerance, or 5 % of the level; a one-sided requirement aims
+//                    2 % of its scale inside its limit, so that the optimum lands inside)
 //   minimum spacing  per neighbouring pair, (spacing − gap)₊ / 0.5°
+//   release          the largest net outward acceleration of a carrier bead on the arc
+//                    (release_criterion.h), always on the exact ring (it needs ∂B²/∂r, which a
+//                    probe profile does not give); residual (margin − largest)₊ / 0.1 g
 #pragma once
 
 #include "design/design_target.h"
@@ -38,8 +42,9 @@ struct RequirementResult
 class RequirementSet
 {
 public:
-  // `nominal` fixes the profile target's arcs (the case's pole sectors).
-  RequirementSet(const DesignTarget &target, const std::vector<Pole> &nominal);
+  // The case's roller: its poles fix the profile target's arcs (the case's pole sectors), its
+  // geometry and shapes the ring on which the release requirement is judged.
+  RequirementSet(const DesignTarget &target, const Roller &roller);
   std::vector<RequirementResult> evaluate(const std::vector<Pole> &poles,
                                           const ProfileFunction &profile) const;
   // All residuals of evaluate() stacked, in a fixed order and count for a given target.
@@ -51,7 +56,10 @@ private:
   std::vector<std::vector<size_t>> arc_samples_; // profile samples per nominal sector
   std::vector<double> ceiling_angles_;           // all arcs' sample angles, concatenated
   std::vector<size_t> ceiling_start_;
+  std::vector<double> release_angles_;
+  std::vector<RingProfile> release_rings_; // at the bead's centre − h, + h
 
+  void release(const std::vector<Pole> &poles, std::vector<RequirementResult> &out) const;
   void profile_arcs(const ProfileFunction &profile, std::vector<RequirementResult> &out) const;
   void pole_peaks(const std::vector<Pole> &poles, const ProfileFunction &profile,
                   std::vector<RequirementResult> &out) const;

@@ -301,7 +301,7 @@ DesignTarget read_design_spec(const std::string &path, double default_tolerance,
                               DesignConstraints &constraints)
 {
   const YAML::Node root = load_yaml(path);
-  refuse_unknown_keys(root, {"probe_radius", "poles", "field_below", "min_spacing", "profile", "constraints"}, path);
+  refuse_unknown_keys(root, {"probe_radius", "poles", "field_below", "min_spacing", "release", "profile", "constraints"}, path);
   DesignTarget t;
   t.source = path;
   if (root["probe_radius"])
@@ -314,6 +314,19 @@ DesignTarget read_design_spec(const std::string &path, double default_tolerance,
       t.ceilings.push_back(read_ceiling(root["field_below"][i], "field_below[" + std::to_string(i) + "]"));
   if (root["min_spacing"])
     t.min_spacing = quantity(root["min_spacing"], Dimension::angle, "min_spacing");
+  if (root["release"])
+  {
+    const YAML::Node n = root["release"];
+    refuse_unknown_keys(n, {"from", "to", "margin"}, "release");
+    if (!n["from"] || !n["to"])
+      throw std::invalid_argument("release: needs from and to (e.g. {from: 180 deg, to: 200 deg, margin: 0.5})");
+    ReleaseRequirement r;
+    r.from = quantity(n["from"], Dimension::angle, "release.from");
+    r.to = quantity(n["to"], Dimension::angle, "release.to");
+    if (n["margin"])
+      r.margin = quantity(n["margin"], Dimension::dimensionless, "release.margin");
+    t.release = r;
+  }
   if (root["profile"])
   {
     std::filesystem::path p = root["profile"].as<std::string>();
@@ -324,7 +337,7 @@ DesignTarget read_design_spec(const std::string &path, double default_tolerance,
   if (root["constraints"])
     read_constraints_node(root["constraints"], constraints, "constraints");
   if (t.empty())
-    throw std::invalid_argument(path + ": the specification asks for nothing (give poles, field_below, min_spacing or profile)");
+    throw std::invalid_argument(path + ": the specification asks for nothing (give poles, field_below, min_spacing, release or profile)");
   return t;
 }
 

@@ -11,6 +11,9 @@
 //   field_below:                    # arcs (counter-clockwise from → to) where |B| ≤ level
 //     - {from: 165 deg, to: 195 deg, level: 20 mT, tolerance: 1 mT}   # e.g. the release
 //   min_spacing: 40 deg             # between neighbouring poles' angles
+//   release: {from: 180 deg, to: 200 deg, margin: 0.5}   # a carrier bead is let go somewhere
+//                                   # on the arc: the field criterion for release
+//                                   # (release_criterion.h) reaches +margin g there
 //   profile: scan.csv               # optional: a profile target as well (relative to this file)
 //   constraints: ...                # see DesignConstraints (also accepted alone via --constraints)
 //
@@ -29,6 +32,7 @@
 
 #include "calibration/flux_scan.h"
 #include "coupling/case_model.h"
+#include "design/release_criterion.h"
 
 #include <cmath>
 #include <limits>
@@ -66,6 +70,14 @@ struct FieldCeiling
   double tolerance = 0.0;      // [T], slack allowed when judging
 };
 
+// Somewhere on the arc from → to the net outward acceleration of a carrier bead at the sleeve
+// (release_criterion.h) reaches `margin` × g: the layer is let go there.
+struct ReleaseRequirement
+{
+  double from = 0.0, to = 0.0; // [rad]
+  double margin = 0.0;         // [g]
+};
+
 struct DesignTarget
 {
   std::string source;
@@ -74,7 +86,12 @@ struct DesignTarget
   std::vector<PeakRequirement> peaks;
   std::vector<FieldCeiling> ceilings;
   double min_spacing = 0.0;  // [rad]; 0 = none
-  bool empty() const { return !profile && peaks.empty() && ceilings.empty() && min_spacing <= 0.0; }
+  std::optional<ReleaseRequirement> release;
+  std::optional<ReleaseInputs> release_inputs; // the bead, sleeve and gravity (from the case)
+  bool empty() const
+  {
+    return !profile && peaks.empty() && ceilings.empty() && min_spacing <= 0.0 && !release;
+  }
 };
 
 // A pole's box: angle in [low, high] (unwrapped around its start), |M| in [low, high].

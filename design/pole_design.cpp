@@ -256,7 +256,7 @@ DesignResult design_poles(const Roller &roller, double probe_radius, const Desig
   if (roller.poles.empty())
     throw std::invalid_argument("the case's roller has no poles to design");
   const RingProfile ring(roller, probe_radius);
-  const RequirementSet requirements(target, roller.poles);
+  const RequirementSet requirements(target, roller);
   const auto limits = constraints.limits_for(roller.poles);
   DesignResult result;
   result.harmonics = ring.harmonics();

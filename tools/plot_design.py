@@ -9,7 +9,7 @@ Called by `magbrush design poles` with the files it writes:
 Top: Bn and Bt of the designed layout (exact ring, lines; the FEM check dashed when present;
 the case's layout thin grey), a profile target as its band (target ± tolerance), a
 specification's pole boxes (peak angle ± tolerance by peak ± tolerance) on Bn. Bottom: |B|
-with the arcs where it must stay below a level. Exit status 3 when matplotlib is missing
+with the arcs where it must stay below a level and the arc where the layer must be released. Exit status 3 when matplotlib is missing
 (the caller then warns and carries on), 2 for bad arguments or unreadable files.
 """
 import argparse
@@ -92,6 +92,8 @@ def main():
                     top.add_patch(Rectangle((x0, lo), x1 - x0, hi - lo, fill=False, ec="tab:red", lw=1.5))
                 top.annotate(str(label), ((x0 + x1) / 2, hi if hi > 0 else lo), color="tab:red",
                              ha="center", va="bottom" if hi > 0 else "top", fontsize=8)
+            elif kind == "release":  # somewhere on the arc the layer must be let go
+                bottom.axvspan(x0, x1, color="tab:purple", alpha=0.15, label=str(label) if shift == 0.0 else None)
             else:
                 bottom.hlines(hi, x0, x1, color="tab:red", lw=2)
                 bottom.axvspan(x0, x1, color="tab:red", alpha=0.1)

@@ -819,6 +819,29 @@ def all_key_numbers(run_summary):
     return rows
 
 
+def design_section(run_dir, out):
+    """The design of this case's poles (`magbrush design poles` writes <run folder>/design/): its
+    profile against the target, its requirements met or missed, and a link to its own page
+    (layout, binding constraints, sensitivities). None when the case has no design."""
+    folder = os.path.join(run_dir, "design")
+    page = os.path.join(folder, "index.html")
+    if not os.path.exists(page):
+        return None
+    rows = []
+    try:
+        with open(os.path.join(folder, "design_requirements.csv"), newline="") as f:
+            for r in csv.DictReader(line for line in f if not line.startswith("#")):
+                fem = r.get("value_fem")
+                rows.append((r["requirement"], f"{r['target']} ± {r['tolerance']} {r['unit']} ({r['kind']})",
+                             r["value_ring"], "met" if r["met_ring"] == "1" else "MISSED",
+                             fem or "", ("met" if r.get("met_fem") == "1" else "MISSED") if fem else ""))
+    except (OSError, KeyError):
+        pass
+    image = os.path.join(folder, "design_profile.png")
+    return {"page": os.path.relpath(page, out), "rows": rows,
+            "image": os.path.relpath(image, out) if os.path.exists(image) else None}
+
+
 def build_index(args, images, rows, run_times, phases, snapshot_time, dem_done, run_summary=None):
     links = []
     run_dir = os.path.dirname(os.path.normpath(args.dem_dir))
@@ -864,6 +887,17 @@ def build_index(args, images, rows, run_times, phases, snapshot_time, dem_done, 
         md.append("")
     if dem_done:
         md += [f"DEM: `{dem_done}`", ""]
+    design = design_section(run_dir, args.out)
+    if design:
+        md += ["## Design of the poles (magbrush design poles)", "",
+               f"The design's own page, with the layout, the binding constraints and the sensitivities: "
+               f"[{design['page']}]({design['page']}).", ""]
+        if design["image"]:
+            md += [f"![designed profile against the target]({design['image']})", ""]
+        if design["rows"]:
+            md += ["| requirement | target | exact ring | | FEM | |", "|---|---|---|---|---|---|"]
+            md += ["| " + " | ".join(c.replace("|", "\\|") for c in r) + " |" for r in design["rows"]]
+            md.append("")
     md += ["## Plots", ""]
     md += [f"![{img}]({img})" for img in images]
     md += ["", "## Files (ParaView: open the .xdmf / .pvtu)", ""]
@@ -906,6 +940,15 @@ def build_index(args, images, rows, run_times, phases, snapshot_time, dem_done, 
         h.append("</table>")
     if dem_done:
         h.append(f"<p>DEM: <code>{e(dem_done)}</code></p>")
+    if design:
+        h.append("<h2>Design of the poles (magbrush design poles)</h2><p>The design's own page, with the layout, "
+                 f"the binding constraints and the sensitivities: <a href='{e(design['page'])}'>{e(design['page'])}</a></p>")
+        if design["image"]:
+            h.append(f"<p><img src='{e(design['image'])}' alt='designed profile against the target'></p>")
+        if design["rows"]:
+            h.append("<table><tr><th>requirement</th><th>target</th><th>exact ring</th><th></th><th>FEM</th><th></th></tr>")
+            h += ["<tr>" + "".join(f"<td>{e(c)}</td>" for c in r) + "</tr>" for r in design["rows"]]
+            h.append("</table>")
     h.append("<h2>Plots</h2>")
     h += [f"<p><a href='{e(img)}'><img src='{e(img)}' alt='{e(img)}'></a></p>" for img in images]
     h.append("<h2>Files (ParaView: open the .xdmf / .pvtu)</h2><ul>")

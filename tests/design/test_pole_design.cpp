@@ -5,10 +5,14 @@
 //    six-pole roller with its own shape factors that no case or fit test uses), with the time;
 //  * a specification (peaks, a low-field arc, spacing) met by the designed layout, judged by
 //    an independent evaluation of the exact ring (MultipoleRing);
+//  * a release requirement (cases/data/kweon_release_spec.yaml: S2 alone moved so that the
+//    layer is let go between S2 and S3) met, judged by the release criterion's own profile
+//    (release_criterion.h, an independent code path: B² by field_polar on a 0.05° grid);
 //  * an infeasible specification reported as such, with the bound that binds;
 #include "coupling/case_parser.h"
 #include "coupling/multipole_ring.h"
 #include "design/pole_design.h"
+#include "design/release_criterion.h"
 #include "tests/cli_run.h"
 #include "tests/test_temp_dir.h"
 
@@ -19,6 +23,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 
 using namespace magbrush;
 
@@ -150,6 +155,44 @@ TEST(PoleDesign, MeetsASpecification)
     EXPECT_LE(std::hypot(Bn[k], Bt[k]), 25e-3 + 1e-5) << a[k] / deg;
 }
 
+TEST(PoleDesign, MeetsAReleaseRequirement)
+{
+  const std::string src = MAGBRUSH_SOURCE_DIR;
+  const Case c = load_case(src + "/cases/kweon_release.yaml");
+  DesignConstraints constraints;
+  DesignTarget spec = read_design_spec(src + "/cases/data/kweon_release_spec.yaml", 1e-3, constraints);
+  ASSERT_TRUE(spec.release);
+  spec.release_inputs = ReleaseInputs::from(c);
+  const DesignResult d = design_poles(*c.roller, 10e-3, spec, constraints);
+  for (const auto &req : d.requirements)
+    std::printf("  %-36s target %8.3f ± %.3f %s, value %8.3f (%s)\n", req.name.c_str(), req.target,
+                req.tolerance, req.unit.c_str(), req.value, req.met() ? "met" : "MISSED");
+  ASSERT_TRUE(d.feasible);
+  Roller designed = *c.roller;
+  designed.poles = d.poles;
+  for (size_t i = 0; i < designed.poles.size(); ++i)
+    if (designed.poles[i].name != "S2") // the others are fixed by the specification
+    {
+      EXPECT_NEAR(std::remainder(designed.poles[i].angle - c.roller->poles[i].angle, 2 * M_PI), 0.0, 1e-12);
+      EXPECT_EQ(designed.poles[i].strength, c.roller->poles[i].strength);
+    }
+  const auto [S2, S2_angle] = peak_near(designed, 10e-3, "S2");
+  std::printf("designed S2 at %.2f°, %.1f kA/m: peak %.2f mT at %.2f°\n", designed.poles[2].angle / deg,
+              std::abs(designed.poles[2].strength) / 1e3, S2 * 1e3, S2_angle / deg);
+  EXPECT_NEAR(S2, 50e-3, 10e-3);
+  // The case's layout holds on 185–200°; the designed one lets go there by at least 0.5 g.
+  const ReleaseInputs in = ReleaseInputs::from(c);
+  const ReleaseVerdict before = release_in_window(release_profile(MultipoleRing(*c.roller), in, 0.05 * deg),
+                                                  185 * deg, 200 * deg);
+  const ReleaseVerdict after = release_in_window(release_profile(MultipoleRing(designed), in, 0.05 * deg),
+                                                 185 * deg, 200 * deg);
+  std::printf("largest net outward acceleration on 185–200°: case %.2f g, designed %.3f g at %.2f°\n",
+              before.peak / 9.81, after.peak / 9.81, after.at / deg);
+  EXPECT_FALSE(before.releases);
+  EXPECT_TRUE(after.releases);
+  EXPECT_GE(after.peak / 9.81, 0.5 - 1e-3); // the grid's 0.05° against the requirement's 0.25°
+}
+
 TEST(PoleDesign, ReportsAnInfeasibleTargetWithTheBindingBound)
 {
   const Roller start = case_roller("kweon_development.yaml");
@@ -208,8 +251,14 @@ TEST(DesignCommand, SpecificationMetAndCheckedByFemWithinBudget)
   EXPECT_LT(total_seconds(r.output), 30.0) << r.output;
   const Case designed = load_case((dir / "kweon_development_designed.yaml").string());
   EXPECT_EQ(designed.roller->poles.size(), 5u);
-  for (const char *f : {"design_report.txt", "design_profile.csv", "design_requirements.csv", "design_sensitivity.csv"})
+  for (const char *f : {"design_report.txt", "design_profile.csv", "design_requirements.csv", "design_sensitivity.csv",
+                        "index.md", "index.html"})
     EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
+  // The design's page: the requirements judged on the ring and the FEM, the layout, the sensitivities.
+  std::ifstream in(dir / "index.md");
+  const std::string page((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (const char *section : {"## Requirements", "## Layout", "## Sensitivity", "verdict (FEM)", "S1 peak \\|Bn\\|"})
+    EXPECT_NE(page.find(section), std::string::npos) << section << "\n" << page;
 }
 
 TEST(DesignCommand, RecoversTheCaseFromItsOwnProfile)

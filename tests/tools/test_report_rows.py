@@ -6,6 +6,7 @@ runs it."""
 import math
 import os
 import sys
+import tempfile
 import unittest
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tools"))
@@ -238,6 +239,29 @@ class DecisionPage(unittest.TestCase):
             self.assertIn("drum.gap", keys)
             self.assertIn("roller.poles.S1.angle", keys)
             self.assertNotIn("roller.poles.S1.shape_factor", keys)
+
+class DesignSection(unittest.TestCase):
+    """The design of the poles in the run report: linked from <run folder>/design/, its requirements shown."""
+
+    def test_a_run_folder_without_a_design_has_no_section(self):
+        with tempfile.TemporaryDirectory() as run:
+            self.assertIsNone(report.design_section(run, os.path.join(run, "report")))
+
+    def test_the_design_page_is_linked_with_its_requirements(self):
+        with tempfile.TemporaryDirectory() as run:
+            os.makedirs(os.path.join(run, "design"))
+            open(os.path.join(run, "design", "index.html"), "w").write("<html></html>")
+            open(os.path.join(run, "design", "design_requirements.csv"), "w").write(
+                "requirement,kind,unit,target,tolerance,value_ring,met_ring,miss_ring,value_fem,met_fem,miss_fem\n"
+                '"S2 peak |Bn|",equal,mT,50,10,50.0012,1,-9.9988,49.2,1,-9.2\n'
+                '"release somewhere on 185.0–200.0°",at_least,g,0.5,0,0.41,0,0.09,0.40,0,0.1\n')
+            d = report.design_section(run, os.path.join(run, "report"))
+            self.assertEqual(d["page"], os.path.join("..", "design", "index.html"))
+            self.assertIsNone(d["image"])
+            self.assertEqual(d["rows"][0], ("S2 peak |Bn|", "50 ± 10 mT (equal)", "50.0012", "met", "49.2", "met"))
+            self.assertEqual(d["rows"][1][3], "MISSED")
+            self.assertEqual(d["rows"][1][5], "MISSED")
+
 
 if __name__ == "__main__":
     unittest.main()

@@ -59,6 +59,33 @@ long CellMultipoleField::find(const Level &level, const std::array<long, 3> &I) 
   return (it != level.keys.end() && *it == key) ? it - level.keys.begin() : -1;
 }
 
+void CellMultipoleField::Level::reset()
+{
+  size = {0.0, 0.0, 0.0};
+  cells = {0, 0, 0};
+  factor = {1, 1, 1};
+  scale = 1.0;
+  for (auto *v : {&parent, &child_begin, &children, &list_begin, &list_source})
+    v->clear();
+  keys.clear();
+  index.clear();
+  list_matrix.clear();
+  list_matrix_f.clear();
+  Mf.clear();
+  row_scale.clear();
+  M.clear();
+  L.clear();
+}
+
+CellMultipoleField::Level CellMultipoleField::take_spare_level()
+{
+  if (spare_levels_.empty())
+    return Level{};
+  Level l = std::move(spare_levels_.back());
+  spare_levels_.pop_back();
+  return l;
+}
+
 void CellMultipoleField::build_dense_index(const Level &fine)
 {
   // The near pairs look up 5³ cells around every bead (twice: count, then fill); a binary
@@ -192,8 +219,14 @@ void CellMultipoleField::build(std::size_t n, const double *x, const double *y, 
     for (int d = 0; d < 3; ++d)
       wrap_shift_[3 * b + d] = xw_[3 * b + d] - coord[d][b];
 
-  levels_.clear();
-  levels_.emplace_back();
+  // Coarsest first, so that the finest level takes the finest level's storage back.
+  while (!levels_.empty())
+  {
+    levels_.back().reset();
+    spare_levels_.push_back(std::move(levels_.back()));
+    levels_.pop_back();
+  }
+  levels_.push_back(take_spare_level());
   Level &fine = levels_[0];
   fine.size = h_;
   for (int d = 0; d < 3; ++d)
@@ -266,7 +299,7 @@ void CellMultipoleField::build(std::size_t n, const double *x, const double *y, 
       l.factor = {1, 1, 1};
       break;
     }
-    Level next;
+    Level next = take_spare_level();
     for (int d = 0; d < 3; ++d)
     {
       next.size[d] = l.factor[d] * l.size[d];

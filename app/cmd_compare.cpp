@@ -106,18 +106,7 @@ int compare(const cli::ParsedArguments &args)
   }
   std::vector<std::string> command = {python_interpreter(), script, "--out", out};
   command.insert(command.end(), runs.begin(), runs.end());
-  int status = -1;
-  std::string why;
-  try
-  {
-    status = run_program(command);
-    why = "exit " + std::to_string(status);
-  }
-  catch (const ChildProcessError &e)
-  {
-    why = e.what();
-  }
-  if (status != 0)
+  if (const std::string why = run_program_failure(command); !why.empty())
   {
     std::cerr << "magbrush compare: tools/compare.py failed (" << why << ")\n";
     return 1;

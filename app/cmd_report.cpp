@@ -201,18 +201,7 @@ int report(const cli::ParsedArguments &args)
     command.push_back(scan);
   }
   std::cout << "magbrush report: writing " << report_dir.string() << "/ ..." << std::endl;
-  int status = -1;
-  std::string why;
-  try
-  {
-    status = run_program(command);
-    why = "exit " + std::to_string(status);
-  }
-  catch (const ChildProcessError &e)
-  {
-    why = e.what();
-  }
-  if (status != 0)
+  if (const std::string why = run_program_failure(command); !why.empty())
   {
     std::cerr << "magbrush report: the plot script failed (" << why << "): " << command_text(command)
               << "\n  It needs python3 with numpy, matplotlib and h5py (Debian: apt-get install python3-matplotlib "

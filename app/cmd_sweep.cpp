@@ -812,17 +812,8 @@ int merge_points(const SweepPlan &plan)
   const char *env_python = std::getenv("MAGBRUSH_PYTHON");
   const std::string python = env_python ? env_python : (fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3");
   const std::vector<std::string> command = {python, chosen, "--dir", plan.sweep_dir.string()};
-  std::string failure = chosen.empty() ? "tools/plot_sweep.py not found; set MAGBRUSH_TOOLS to the tools folder" : "";
-  try
-  {
-    if (!chosen.empty())
-      if (const int status = run_program(command); status != 0)
-        failure = "exit " + std::to_string(status);
-  }
-  catch (const ChildProcessError &e)
-  {
-    failure = e.what();
-  }
+  const std::string failure = chosen.empty() ? "tools/plot_sweep.py not found; set MAGBRUSH_TOOLS to the tools folder"
+                                              : run_program_failure(command);
   if (!failure.empty())
     std::cerr << "magbrush sweep: the comparison plots failed (" << failure << ": " << python << " " << chosen
               << " --dir " << plan.sweep_dir.string() << "); the CSV files are written\n";

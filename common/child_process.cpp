@@ -104,6 +104,19 @@ int run_program(const std::vector<std::string> &command, const ChildOutput &outp
   throw ChildProcessError("'" + command[0] + "' stopped without an exit status");
 }
 
+std::string run_program_failure(const std::vector<std::string> &command, const ChildOutput &output)
+{
+  try
+  {
+    const int status = run_program(command, output);
+    return status == 0 ? "" : "exit " + std::to_string(status);
+  }
+  catch (const ChildProcessError &e)
+  {
+    return e.what();
+  }
+}
+
 bool program_exists(const std::string &name)
 {
   if (name.empty())

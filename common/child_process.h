@@ -42,6 +42,10 @@ public:
 // first, so that the two appear in the order they were written.
 int run_program(const std::vector<std::string> &command, const ChildOutput &output = {});
 
+// The same for a caller that only reports a failure: "" when the program exited with 0, else
+// why not ("exit 3", or the ChildProcessError's message).
+std::string run_program_failure(const std::vector<std::string> &command, const ChildOutput &output = {});
+
 // Is there an executable `name` (a path, or a program on the PATH)?
 bool program_exists(const std::string &name);
 

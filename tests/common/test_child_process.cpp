@@ -115,4 +115,15 @@ TEST_F(ChildProcess, KilledBySignalIsAnError)
   }
 }
 
+// For callers that only report a failure: the reason as text, empty on success.
+TEST_F(ChildProcess, AFailureComesBackAsItsReason)
+{
+  EXPECT_EQ(magbrush::run_program_failure({"/bin/sh", "-c", "exit 0"}), "");
+  EXPECT_EQ(magbrush::run_program_failure({"/bin/sh", "-c", "exit 3"}), "exit 3");
+  EXPECT_EQ(magbrush::run_program_failure({"/no/such/program"}),
+            "cannot run '/no/such/program': No such file or directory");
+  EXPECT_NE(magbrush::run_program_failure({"/bin/sh", "-c", "kill -TERM $$"}).find("killed by signal 15"),
+            std::string::npos);
+}
+
 } // namespace

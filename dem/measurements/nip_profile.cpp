@@ -385,13 +385,18 @@ std::vector<SummaryValue> NipProfile::summary() const
                                "speed of the touching beads' centres over the drum in the centre bin");
   chain.value = chain_speed_at_gap_centre();
   chain.drift = chain.drift_standard_error = std::numeric_limits<double>::quiet_NaN();
+  // T/N: the bins' sums are the per-sample series' sums (the same contacts), so its error is
+  // the scatter of the blocks' ratios.
+  SummaryValue t_over_n = plain("tangential_over_normal", tangential_over_normal(), "1",
+                                "sum of tangential over sum of normal drum forces");
+  t_over_n.standard_error = ratio_standard_error(tangential_force_, normal_force_, blocks);
   std::vector<SummaryValue> out = {
       slip,
       chain,
       plain("relative_surface_speed_m_s", frame_.relative_surface_speed(), "m/s", "sleeve minus drum surface speed"),
       plain("peak_normal_pressure_Pa", peak_normal_pressure(), "Pa", "largest bin normal pressure"),
       plain("normal_pressure_at_gap_centre_Pa", centre.normal_pressure, "Pa", "normal pressure of the centre bin"),
-      plain("tangential_over_normal", tangential_over_normal(), "1", "sum of tangential over sum of normal drum forces"),
+      t_over_n,
       plain("density_at_gap_centre_per_mm2", centre.density * 1e-6, "1/mm^2", "touching beads per drum area, centre bin"),
       sampled("normal_force_per_length_N_m", normal_force_, "N/m", "normal force on the drum per slab depth"),
       sampled("tangential_force_per_length_N_m", tangential_force_, "N/m", "tangential force on the drum per slab depth"),

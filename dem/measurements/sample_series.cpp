@@ -100,6 +100,26 @@ SummaryValue summarise(const SampleSeries &series, std::size_t blocks, bool stea
   return v;
 }
 
+double ratio_standard_error(const SampleSeries &num, const SampleSeries &den, std::size_t blocks)
+{
+  const std::vector<double> &a = num.values(), &b = den.values();
+  if (blocks < 2 || a.size() != b.size())
+    return nan;
+  // Equal-length blocks have sums proportional to their means: the ratio of means is theirs.
+  const std::vector<double> top = block_means(a.begin(), a.end(), blocks);
+  const std::vector<double> bottom = block_means(b.begin(), b.end(), blocks);
+  if (top.empty())
+    return nan;
+  std::vector<double> ratios(top.size());
+  for (std::size_t k = 0; k < top.size(); ++k)
+  {
+    if (bottom[k] == 0.0)
+      return nan;
+    ratios[k] = top[k] / bottom[k];
+  }
+  return std::sqrt(squared_error_of_mean(ratios));
+}
+
 SummaryValue summarise_blocks(const std::vector<double> &blocks, bool steady_test, std::string key,
                               std::string unit, std::string meaning)
 {

@@ -62,6 +62,12 @@ private:
 SummaryValue summarise(const SampleSeries &series, std::size_t blocks, bool steady_test, std::string key,
                        std::string unit, std::string meaning);
 
+// Standard error of a ratio of sums, Σ num / Σ den over the same samples (the tangential over
+// the normal force on the drum): the ratio of each block's sums (blocks as for standard_error)
+// and the standard error of their mean. NaN with fewer than two blocks of two samples, series
+// of different lengths, or a block whose den sums to zero.
+double ratio_standard_error(const SampleSeries &num, const SampleSeries &den, std::size_t blocks);
+
 // The same for values that are already independent blocks (the developed image's whole
 // periods, toner_development.h): the mean of the blocks, its standard error from their scatter
 // (NaN with fewer than two), the drift between the means of the older and the newer half (the

@@ -153,6 +153,31 @@ TEST(SampleSeries, ATrendStandsOutOfItsNoiseAndNoiseDoesNot)
   EXPECT_FALSE(std::isnan(few.drift_standard_error(4)));
 }
 
+// A ratio of sums: blocks whose ratios are known exactly give the standard error of their mean.
+TEST(SampleSeries, RatioStandardErrorIsTheScatterOfTheBlocksRatios)
+{
+  SampleSeries num, den;
+  // 4 blocks of 3 samples; block k has den = 2, 4, 6 (sum 12) and num = r_k × den.
+  const double r[4] = {0.30, 0.34, 0.36, 0.40};
+  for (int k = 0; k < 4; ++k)
+    for (double d : {2.0, 4.0, 6.0})
+    {
+      den.add(d);
+      num.add(r[k] * d);
+    }
+  // Mean 0.35, deviations -0.05, -0.01, 0.01, 0.05: s^2 = 0.0052/3, SE^2 = s^2/4.
+  EXPECT_NEAR(ratio_standard_error(num, den, 4), std::sqrt(0.0052 / 3.0 / 4.0), 1e-14);
+  // One constant ratio: no scatter.
+  SampleSeries twice;
+  for (double v : den.values())
+    twice.add(2.0 * v);
+  EXPECT_NEAR(ratio_standard_error(twice, den, 4), 0.0, 1e-15);
+  // Too few samples per block, or series of different lengths: no number.
+  EXPECT_TRUE(std::isnan(ratio_standard_error(num, den, 8)));
+  twice.add(1.0);
+  EXPECT_TRUE(std::isnan(ratio_standard_error(twice, den, 4)));
+}
+
 TEST(SteadyStateVerdict, SaysWhetherAFailedTestIsATrendOrTooLittleData)
 {
   using magbrush::dem::SteadyStateVerdict;

@@ -15,10 +15,12 @@ struct CliResult
   std::string output; // stdout and stderr
 };
 
-// `program` from the build's bin/ folder with `args` (quoted by the caller where needed).
-inline CliResult run_program(const std::string &program, const std::string &args)
+// `program` from the build's bin/ folder with `args` (quoted by the caller where needed), in
+// `working_dir` when one is given (for outputs named relative to it).
+inline CliResult run_program(const std::string &program, const std::string &args, const std::string &working_dir = "")
 {
-  const std::string cmd = std::string("'") + MAGBRUSH_BINARY_DIR + "/bin/" + program + "' " + args + " 2>&1";
+  const std::string cd = working_dir.empty() ? "" : "cd '" + working_dir + "' && ";
+  const std::string cmd = cd + "'" + MAGBRUSH_BINARY_DIR + "/bin/" + program + "' " + args + " 2>&1";
   CliResult r;
   FILE *p = popen(cmd.c_str(), "r");
   if (!p)

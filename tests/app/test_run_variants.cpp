@@ -6,6 +6,7 @@
 //  * the case is printed in ten lines, not the ~230 of the resolved case.
 #include "app/quick_preset.h"
 #include "coupling/case_parser.h"
+#include "tests/cli_run.h"
 #include "tests/test_temp_dir.h"
 
 #include <gtest/gtest.h>
@@ -23,27 +24,10 @@ using namespace magbrush;
 namespace {
 const std::string fed_case = std::string(MAGBRUSH_SOURCE_DIR) + "/cases/kawamoto_nip_fed.yaml";
 
-struct Output
-{
-  int status;
-  std::string text;
-};
-
 // `magbrush run CASE <args> --only check` in `dir`: its exit status and what it printed.
-Output run_check_stage(const fs::path &dir, const std::string &args)
+magbrush::testing::CliResult run_check_stage(const fs::path &dir, const std::string &args)
 {
-  const std::string cmd = "cd '" + dir.string() + "' && '" + MAGBRUSH_BINARY_DIR + "/bin/magbrush' run '" + fed_case +
-                          "' --only check " + args + " 2>&1";
-  Output o{-1, {}};
-  FILE *p = popen(cmd.c_str(), "r");
-  if (!p)
-    return o;
-  char buf[4096];
-  while (fgets(buf, sizeof buf, p))
-    o.text += buf;
-  const int status = pclose(p);
-  o.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return o;
+  return magbrush::testing::run_program("magbrush", "run '" + fed_case + "' --only check " + args, dir.string());
 }
 
 std::string file_text(const fs::path &path)
@@ -69,12 +53,12 @@ int count_lines(const std::string &s, const std::string &from, const std::string
 TEST(RunVariants, TwoVariantsLandInTwoFoldersEachSayingWhatItHolds)
 {
   const fs::path dir = magbrush::testing::test_temp_dir("run_variants");
-  const Output base = run_check_stage(dir, "");
-  const Output seed = run_check_stage(dir, "--set dem.seed=2");
-  const Output gap = run_check_stage(dir, "--set drum.gap=0.5mm");
-  ASSERT_EQ(base.status, 0) << base.text;
-  ASSERT_EQ(seed.status, 0) << seed.text;
-  ASSERT_EQ(gap.status, 0) << gap.text;
+  const magbrush::testing::CliResult base = run_check_stage(dir, "");
+  const magbrush::testing::CliResult seed = run_check_stage(dir, "--set dem.seed=2");
+  const magbrush::testing::CliResult gap = run_check_stage(dir, "--set drum.gap=0.5mm");
+  ASSERT_EQ(base.code, 0) << base.output;
+  ASSERT_EQ(seed.code, 0) << seed.output;
+  ASSERT_EQ(gap.code, 0) << gap.output;
 
   const Case c_seed = load_case(fed_case, {"dem.seed=2"}), c_gap = load_case(fed_case, {"drum.gap=0.5mm"});
   const fs::path f_base = dir / "results" / "kawamoto_nip_fed", f_seed = dir / c_seed.output.directory,
@@ -93,10 +77,10 @@ TEST(RunVariants, TwoVariantsLandInTwoFoldersEachSayingWhatItHolds)
   EXPECT_EQ(c_gap.field.output_dir, c_gap.output.directory + "/fields");
 
   // The terminal gets ten lines of the case, and where the rest is.
-  EXPECT_EQ(count_lines(seed.text, "  case ", "== magbrush run: done"), 11) << seed.text; // 10 + the blank line
-  EXPECT_NE(seed.text.find("full case  " + c_seed.output.directory + "/case_resolved.txt"), std::string::npos)
-      << seed.text;
-  EXPECT_EQ(seed.text.find("materials.carrier.youngs_modulus"), std::string::npos) << "the whole case was printed";
+  EXPECT_EQ(count_lines(seed.output, "  case ", "== magbrush run: done"), 11) << seed.output; // 10 + the blank line
+  EXPECT_NE(seed.output.find("full case  " + c_seed.output.directory + "/case_resolved.txt"), std::string::npos)
+      << seed.output;
+  EXPECT_EQ(seed.output.find("materials.carrier.youngs_modulus"), std::string::npos) << "the whole case was printed";
 }
 
 TEST(RunQuick, ScalesTheDurationAndEveryWindowTogetherAndSaysSo)
@@ -127,10 +111,10 @@ TEST(RunQuick, ScalesTheDurationAndEveryWindowTogetherAndSaysSo)
 
   // On the command line: what it changed, then the run in its own folder.
   const fs::path dir = magbrush::testing::test_temp_dir("run_quick");
-  const Output o = run_check_stage(dir, "--quick");
-  ASSERT_EQ(o.status, 0) << o.text;
-  EXPECT_NE(o.text.find("dem.duration               75 ms -> 5 ms"), std::string::npos) << o.text;
-  EXPECT_NE(o.text.find("nip.average_from           25 ms -> 1.66667 ms"), std::string::npos) << o.text;
+  const magbrush::testing::CliResult o = run_check_stage(dir, "--quick");
+  ASSERT_EQ(o.code, 0) << o.output;
+  EXPECT_NE(o.output.find("dem.duration               75 ms -> 5 ms"), std::string::npos) << o.output;
+  EXPECT_NE(o.output.find("nip.average_from           25 ms -> 1.66667 ms"), std::string::npos) << o.output;
   EXPECT_TRUE(fs::exists(dir / quick.output.directory / "variant.txt")) << quick.output.directory;
   EXPECT_NE(quick.output.directory, c.output.directory);
 }
@@ -149,10 +133,10 @@ TEST(RunQuick, AWindowBeyondTheRunIsStillRefused)
   // Without --quick a short duration leaves the case's windows beyond the run: `run` stops at
   // `check`, naming both keys, before any stage spends time.
   const fs::path dir = magbrush::testing::test_temp_dir("run_quick_refused");
-  const Output o = run_check_stage(dir, "--set dem.duration=0.5ms");
-  EXPECT_EQ(o.status, 1) << o.text;
-  EXPECT_NE(o.text.find("nip.average_from"), std::string::npos) << o.text;
-  EXPECT_NE(o.text.find("dem.duration"), std::string::npos) << o.text;
+  const magbrush::testing::CliResult o = run_check_stage(dir, "--set dem.duration=0.5ms");
+  EXPECT_EQ(o.code, 1) << o.output;
+  EXPECT_NE(o.output.find("nip.average_from"), std::string::npos) << o.output;
+  EXPECT_NE(o.output.find("dem.duration"), std::string::npos) << o.output;
 }
 
 TEST(RunQuick, TheFoldersTheReadmeNamesAreTheOnesTheRunsWriteTo)

@@ -97,6 +97,13 @@ NipProfile::NipProfile(const Case &c) : settings_(c.nip), statistics_(c.statisti
   slip2_.assign(n, 0.0);
   chain_.assign(n, 0.0);
   count_.assign(n, 0);
+  bin_pressure_.assign(n, SampleSeries{});
+  sample_fn_.assign(n, 0.0);
+  for (int k = -bins_half_; k <= bins_half_; ++k)
+  {
+    const double lo = (k - 0.5) * settings_.bin_width, hi = (k + 0.5) * settings_.bin_width;
+    bin_area_.push_back((frame_.drum_arc_of_x(hi) - frame_.drum_arc_of_x(lo)) * frame_.slab_depth);
+  }
   gap_field_ = field_at_gap_centre(c, frame_);
 }
 
@@ -145,6 +152,8 @@ void NipProfile::add_sample(double time, const std::vector<DrumContact> &contact
   double fn = 0.0, ft = 0.0, centre_slip = 0.0, centre_chain = 0.0;
   long touching = 0, centre = 0;
   asymmetry_.start_sample();
+  std::fill(sample_fn_.begin(), sample_fn_.end(), 0.0);
+  long centre_touching = 0;
   for (const auto &c : contacts)
   {
     const DrumContactInFrame r = resolve_drum_contact(frame_, c);
@@ -154,6 +163,7 @@ void NipProfile::add_sample(double time, const std::vector<DrumContact> &contact
     asymmetry_.add_contact(r.x, r.normal);
     const auto k = static_cast<std::size_t>(b);
     fn_[k] += r.normal;
+    sample_fn_[k] += r.normal;
     ft_[k] += r.tangential;
     slip_[k] += r.slip;
     slip2_[k] += r.slip * r.slip;
@@ -168,9 +178,12 @@ void NipProfile::add_sample(double time, const std::vector<DrumContact> &contact
     ft += r.tangential;
     ++touching;
     if (b == bins_half_)
-      centre_slip += r.slip, centre_chain += r.chain_speed, ++centre;
+      centre_slip += r.slip, centre_chain += r.chain_speed, ++centre, ++centre_touching;
   }
   asymmetry_.end_sample();
+  for (std::size_t k = 0; k < sample_fn_.size(); ++k)
+    bin_pressure_[k].add(sample_fn_[k] / bin_area_[k]);
+  centre_touching_.add(static_cast<double>(centre_touching));
   normal_force_.add(fn / frame_.slab_depth);
   tangential_force_.add(ft / frame_.slab_depth);
   touching_.add(static_cast<double>(touching));
@@ -184,7 +197,7 @@ void NipProfile::add_sample(double time, const std::vector<DrumContact> &contact
 std::vector<NipBin> NipProfile::bins() const
 {
   std::vector<NipBin> out;
-  const double w = settings_.bin_width, depth = frame_.slab_depth;
+  const double w = settings_.bin_width;
   const double per_sample = samples_ > 0 ? 1.0 / static_cast<double>(samples_) : nan;
   for (int k = -bins_half_; k <= bins_half_; ++k)
   {
@@ -193,7 +206,7 @@ std::vector<NipBin> NipProfile::bins() const
     b.x = k * w;
     b.x_lo = b.x - 0.5 * w;
     b.x_hi = b.x + 0.5 * w;
-    b.area = (frame_.drum_arc_of_x(b.x_hi) - frame_.drum_arc_of_x(b.x_lo)) * depth;
+    b.area = bin_area_[i];
     b.contacts = count_[i];
     b.touching = static_cast<double>(count_[i]) * per_sample;
     b.density = b.touching / b.area;
@@ -259,14 +272,20 @@ double NipProfile::sliding_downstream_share() const
   return fn > 0.0 ? fn_sliding_downstream_ / fn : nan;
 }
 
+std::size_t NipProfile::peak_bin() const
+{
+  std::size_t peak = 0;
+  for (std::size_t k = 1; k < fn_.size(); ++k)
+    if (fn_[k] / bin_area_[k] > fn_[peak] / bin_area_[peak])
+      peak = k;
+  return peak;
+}
+
 double NipProfile::peak_normal_pressure() const
 {
   if (samples_ == 0)
     return nan; // no sample in the averaging window: no peak, not 0 Pa
-  double peak = 0.0;
-  for (const auto &b : bins())
-    peak = std::max(peak, b.normal_pressure);
-  return peak;
+  return std::max(0.0, fn_[peak_bin()] / bin_area_[peak_bin()] / static_cast<double>(samples_));
 }
 
 std::string NipProfile::csv() const
@@ -390,14 +409,29 @@ std::vector<SummaryValue> NipProfile::summary() const
   SummaryValue t_over_n = plain("tangential_over_normal", tangential_over_normal(), "1",
                                 "sum of tangential over sum of normal drum forces");
   t_over_n.standard_error = ratio_standard_error(tangential_force_, normal_force_, blocks);
+  // The peak: the standard error of the peak bin's own mean (the bin is chosen by the same
+  // data, so that when two bins are within their errors the peak's error is somewhat larger).
+  // Not tested for drift: one bin's halves are noisy; the forces below judge the steady state.
+  auto bin_value = [&](const char *key, const SampleSeries &s, double value, double scale, const char *unit,
+                       const char *meaning) {
+    SummaryValue v = sampled(key, s, unit, meaning);
+    v.value = value;
+    v.standard_error *= scale;
+    v.drift = v.drift_standard_error = std::numeric_limits<double>::quiet_NaN();
+    return v;
+  };
+  const auto centre_bin = static_cast<std::size_t>(bins_half_);
   std::vector<SummaryValue> out = {
       slip,
       chain,
       plain("relative_surface_speed_m_s", frame_.relative_surface_speed(), "m/s", "sleeve minus drum surface speed"),
-      plain("peak_normal_pressure_Pa", peak_normal_pressure(), "Pa", "largest bin normal pressure"),
-      plain("normal_pressure_at_gap_centre_Pa", centre.normal_pressure, "Pa", "normal pressure of the centre bin"),
+      bin_value("peak_normal_pressure_Pa", bin_pressure_[peak_bin()], peak_normal_pressure(), 1.0, "Pa",
+                "largest bin normal pressure"),
+      bin_value("normal_pressure_at_gap_centre_Pa", bin_pressure_[centre_bin], centre.normal_pressure, 1.0, "Pa",
+                "normal pressure of the centre bin"),
       t_over_n,
-      plain("density_at_gap_centre_per_mm2", centre.density * 1e-6, "1/mm^2", "touching beads per drum area, centre bin"),
+      bin_value("density_at_gap_centre_per_mm2", centre_touching_, centre.density * 1e-6,
+                1e-6 / bin_area_[centre_bin], "1/mm^2", "touching beads per drum area, centre bin"),
       sampled("normal_force_per_length_N_m", normal_force_, "N/m", "normal force on the drum per slab depth"),
       sampled("tangential_force_per_length_N_m", tangential_force_, "N/m", "tangential force on the drum per slab depth"),
       sampled("touching_beads", touching_, "1", "beads touching the drum within the profile"),
@@ -437,6 +471,9 @@ void NipProfile::write_state(StateOut &out) const
   for (const auto *s : {&normal_force_, &tangential_force_, &touching_, &centre_slip_, &centre_chain_})
     s->write_state(out);
   asymmetry_.write_state(out);
+  for (const auto &s : bin_pressure_)
+    s.write_state(out);
+  centre_touching_.write_state(out);
 }
 
 void NipProfile::read_state(StateIn &in)
@@ -458,6 +495,9 @@ void NipProfile::read_state(StateIn &in)
   for (auto *s : {&normal_force_, &tangential_force_, &touching_, &centre_slip_, &centre_chain_})
     s->read_state(in);
   asymmetry_.read_state(in);
+  for (auto &s : bin_pressure_)
+    s.read_state(in);
+  centre_touching_.read_state(in);
 }
 
 } // namespace magbrush::dem

@@ -89,7 +89,7 @@ public:
   explicit NipProfile(const Case &c);
 
   const char *name() const override { return "nip profile"; }
-  int state_version() const override { return 2; } // 2: with the asymmetry's series
+  int state_version() const override { return 3; } // 2: with the asymmetry's series; 3: each bin's pressure series
   double interval() const override { return settings_.sample_interval; }
   void sample(const DemSystem &system) override;
   void write(const std::string &directory) const override;
@@ -138,12 +138,19 @@ private:
   double t_first_ = -1.0, t_last_ = -1.0;
   // Per-sample totals over the profile (for standard errors and the steady-state test).
   SampleSeries normal_force_, tangential_force_, touching_, centre_slip_, centre_chain_;
+  // Per sample and bin, the normal pressure [Pa] (the standard errors of the peak and of the
+  // centre bin's pressure), and the centre bin's touching beads (its density's error).
+  std::vector<SampleSeries> bin_pressure_;
+  SampleSeries centre_touching_;
+  std::vector<double> bin_area_;      // drum surface of each bin in the slab [m²]
+  std::vector<double> sample_fn_;     // one sample's normal force per bin (reused)
   NipAsymmetry asymmetry_; // centroid, spread and up/down ratio of the pressure and the touching beads
   double gap_field_;
   std::vector<WallContactRecord> records_; // reused between samples
   std::vector<DrumContact> contacts_;
 
   int bin_of(double x) const;         // −1: outside the profile
+  std::size_t peak_bin() const;       // the bin of the largest mean normal pressure
   std::size_t find_drum_wall(const DemSystem &system) const;
 };
 

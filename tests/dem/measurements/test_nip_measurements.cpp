@@ -12,6 +12,8 @@
 
 #include "coupling/case_parser.h"
 
+#include "common/state_stream.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -514,4 +516,78 @@ TEST(NipProfile, SummaryJudgesSteadyStateByTheDriftOfItsMeans)
   m.clear();
   m.push_back(std::make_unique<NipProfile>(draining));
   EXPECT_NE(run_summary_csv(m, c.statistics).find("steady_state,0,"), std::string::npos);
+}
+
+// The peak and the centre bin carry standard errors from their own per-sample series: the
+// scatter of the means of ten blocks of ten samples, computed here from the blocks' known means.
+TEST(NipProfile, PeakAndCentreBinHaveBlockStandardErrors)
+{
+  const Case c = nip_case(0.0);
+  NipProfile profile(c);
+  const NipFrame &f = profile.frame();
+  const double r = 30e-6, overlap = 0.2e-6;
+  auto bead = [&](double x, double newtons) {
+    DrumContact b;
+    b.position = on_drum(f, x, r - overlap);
+    b.radius = r;
+    const double psi = std::asin(x / f.drum_radius);
+    const double nox = -f.nx * std::cos(psi) + f.tx * std::sin(psi), noy = -f.ny * std::cos(psi) + f.ty * std::sin(psi);
+    b.force_on_wall = {-newtons * nox, -newtons * noy, 0.0};
+    return b;
+  };
+  // Block j (samples 10 j .. 10 j + 9): one bead of (1 + 0.1 j) mN at the centre, a second
+  // one of 1 mN there in even blocks; at x = 1 mm a steady 5 mN, the peak with no scatter.
+  std::vector<double> centre_force(10), centre_beads(10);
+  for (int k = 0; k < 100; ++k)
+  {
+    const int j = k / 10;
+    std::vector<DrumContact> beads = {bead(0.0, 1e-3 * (1.0 + 0.1 * j)), bead(1e-3, 5e-3)};
+    if (j % 2 == 0)
+      beads.push_back(bead(0.0, 1e-3));
+    centre_force[static_cast<std::size_t>(j)] = 1e-3 * (1.0 + 0.1 * j) + (j % 2 == 0 ? 1e-3 : 0.0);
+    centre_beads[static_cast<std::size_t>(j)] = j % 2 == 0 ? 2.0 : 1.0;
+    profile.add_sample(k * 1e-6, beads);
+  }
+  auto mean_and_error = [](const std::vector<double> &blocks) {
+    double m = 0.0, ss = 0.0;
+    for (double v : blocks)
+      m += v / 10.0;
+    for (double v : blocks)
+      ss += (v - m) * (v - m);
+    return std::make_pair(m, std::sqrt(ss / 9.0 / 10.0));
+  };
+  auto value = [](const std::vector<SummaryValue> &s, const std::string &key) {
+    for (const auto &v : s)
+      if (v.key == key)
+        return v;
+    ADD_FAILURE() << "no " << key;
+    return SummaryValue{};
+  };
+  const auto bins = profile.bins();
+  const double area0 = bins[8].area, area4 = bins[12].area;
+  const auto summary = profile.summary();
+  const auto [f0, f0_error] = mean_and_error(centre_force);
+  const SummaryValue centre = value(summary, "normal_pressure_at_gap_centre_Pa");
+  EXPECT_NEAR(centre.value, f0 / area0, 1e-9 * f0 / area0);
+  EXPECT_NEAR(centre.standard_error, f0_error / area0, 1e-9 * f0 / area0);
+  const auto [n0, n0_error] = mean_and_error(centre_beads);
+  const SummaryValue density = value(summary, "density_at_gap_centre_per_mm2");
+  EXPECT_NEAR(density.value, n0 / area0 * 1e-6, 1e-9 * n0 / area0 * 1e-6);
+  EXPECT_NEAR(density.standard_error, n0_error / area0 * 1e-6, 1e-9 * n0 / area0 * 1e-6);
+  // The peak is the steady bin at 1 mm (5 mN over a bin of nearly the centre's area), exact.
+  ASSERT_GT(5e-3 / area4, f0 / area0);
+  const SummaryValue peak = value(summary, "peak_normal_pressure_Pa");
+  EXPECT_NEAR(peak.value, 5e-3 / area4, 1e-9 * 5e-3 / area4);
+  EXPECT_NEAR(peak.standard_error, 0.0, 1e-9 * 5e-3 / area4);
+  EXPECT_GT(centre.standard_error, 0.0);
+
+  // The series survive a checkpoint: a profile read back gives the same errors.
+  MemoryStateOut out;
+  profile.write_state(out);
+  MemoryStateIn in(out.bytes(), "test state");
+  NipProfile restored(c);
+  restored.read_state(in);
+  const SummaryValue again = value(restored.summary(), "normal_pressure_at_gap_centre_Pa");
+  EXPECT_EQ(again.standard_error, centre.standard_error);
+  EXPECT_EQ(value(restored.summary(), "density_at_gap_centre_per_mm2").standard_error, density.standard_error);
 }

@@ -13,24 +13,10 @@ with the arcs where it must stay below a level and the arc where the layer must 
 (the caller then warns and carries on), 2 for bad arguments or unreadable files.
 """
 import argparse
-import csv
 import math
 import sys
 
-
-def read_columns(path):
-    """Columns of a magbrush CSV by header name ('#' lines skipped); non-numeric cells kept as text."""
-    with open(path, newline="") as f:
-        rows = [r for r in csv.reader(line for line in f if not line.startswith("#")) if r]
-    header, data = rows[0], rows[1:]
-
-    def value(cell):
-        try:
-            return float(cell)
-        except ValueError:
-            return cell
-
-    return {name: [value(r[i]) for r in data] for i, name in enumerate(header)}
+from magbrush_plots import pyplot, read_columns
 
 
 def finite(values):
@@ -45,14 +31,10 @@ def main():
     parser.add_argument("--title", default="Designed sleeve flux")
     parser.add_argument("-o", "--output", required=True)
     args = parser.parse_args()
-    try:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-        from matplotlib.patches import Rectangle
-    except ImportError as e:
-        print(f"plot_design.py: matplotlib is not available ({e}); no plot written", file=sys.stderr)
+    plt = pyplot("plot_design.py")
+    if plt is None:
         return 3
+    from matplotlib.patches import Rectangle
     try:
         p = read_columns(args.profile)
         bands = read_columns(args.bands)

@@ -13,17 +13,10 @@ residuals. Exit status 3 when matplotlib is missing (the caller then
 warns and carries on), 2 for bad arguments or unreadable files.
 """
 import argparse
-import csv
 import os
 import sys
 
-
-def read_columns(path):
-    """The numeric columns of a magbrush residual CSV, by header name ('#' lines skipped)."""
-    with open(path, newline="") as f:
-        rows = [r for r in csv.reader(line for line in f if not line.startswith("#")) if r]
-    header, data = rows[0], rows[1:]
-    return {name: [float(r[i]) for r in data] for i, name in enumerate(header)}
+from magbrush_plots import pyplot, read_columns
 
 
 def main():
@@ -35,12 +28,8 @@ def main():
     parser.add_argument("-o", "--output", required=True, help="PNG file to write")
     args = parser.parse_args()
 
-    try:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError as e:
-        print(f"plot_flux.py: matplotlib is not available ({e}); no plot written", file=sys.stderr)
+    plt = pyplot("plot_flux.py")
+    if plt is None:
         return 3
 
     try:

@@ -11,28 +11,11 @@ and labelled with its shift (angle, change of |Bn|); bottom: B − A. Exit statu
 missing (the caller then warns and carries on), 2 for unreadable files.
 """
 import argparse
-import csv
 import math
 import os
 import sys
 
-
-def read_columns(path):
-    """The columns of a magbrush CSV by header name ('#' lines skipped); numbers where they
-    parse, NaN for empty cells, text otherwise."""
-    with open(path, newline="") as f:
-        rows = [r for r in csv.reader(line for line in f if not line.startswith("#")) if r]
-    header, data = rows[0], rows[1:]
-
-    def cell(text):
-        if text == "":
-            return math.nan
-        try:
-            return float(text)
-        except ValueError:
-            return text
-
-    return {name: [cell(r[i]) for r in data] for i, name in enumerate(header)}
+from magbrush_plots import pyplot, read_columns
 
 
 def main():
@@ -44,12 +27,8 @@ def main():
     parser.add_argument("-o", "--output", required=True, help="PNG file to write")
     args = parser.parse_args()
 
-    try:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError as e:
-        print(f"plot_flux_compare.py: matplotlib is not available ({e}); no plot written", file=sys.stderr)
+    plt = pyplot("plot_flux_compare.py")
+    if plt is None:
         return 3
     try:
         p = read_columns(args.profiles)

@@ -23,6 +23,7 @@ import os
 import sys
 
 import development_threshold
+from magbrush_plots import pyplot
 
 
 def read(path):
@@ -181,12 +182,8 @@ def main():
     p.add_argument("--dir", required=True)
     p.add_argument("--key", action="append", default=[], help="a summary key to plot (repeatable)")
     args = p.parse_args()
-    try:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError as e:
-        print(f"plot_sweep.py: {e}", file=sys.stderr)
+    plt = pyplot("plot_sweep.py")
+    if plt is None:
         return 3
     table = "sweep_mean.csv" if os.path.exists(os.path.join(args.dir, "sweep_mean.csv")) else "sweep_summary.csv"
     try:

@@ -3,7 +3,8 @@
 // table and plot: Kawamoto's nip studies (Fig. 22–27: carrier diameter, supplied layer,
 // development gap), Kweon's TMA against the bias and DMA against the blade gap.
 //
-//   points = the Cartesian product of the --vary lists → for each: its overrides (a carrier
+//   points = the Cartesian product of the --vary lists (a --with list moving together with the
+//   first --vary, value for value) → for each: its overrides (a carrier
 //   diameter also rescales the bead count so that the supplied volume — the layer — stays the
 //   same) → `magbrush run` with output.directory and field.output_dir inside the point's
 //   folder, timed → gather every point's dem/summary.csv (whatever its measurements report,
@@ -68,9 +69,9 @@ const cli::CommandSpec &sweep_command_line()
               "                      [--point INDEX | --merge | --emit slurm]\n"
               "       mpirun -np K magbrush sweep CASE --vary ...";
     s.description = R"(Runs the pipeline (check, field, dem, report; the Gmsh meshes are not needed per point) once
-for every combination of the --vary values, each point in results/sweep_<NAME>/<point>/
-(<output.directory>/sweep_<NAME>/<point>/ when the case names a folder; the point's dem/ and
-report/; the stored fields in sweep_<NAME>/fields/<digests of the field inputs>/, solved once
+for every combination of the --vary values (a --with key goes value for value with the first
+--vary), each point in results/sweep_<NAME>/<point>/ (<output.directory>/sweep_<NAME>/<point>/
+when the case names a folder; the point's dem/ and report/; the stored fields in sweep_<NAME>/fields/<digests of the field inputs>/, solved once
 for the points that share them),
 then compares the nip profiles of all points:
   sweep_summary.csv    one row per point: the varied values (as given and in SI), the bead
@@ -144,6 +145,8 @@ run_time_s):
 )";
     s.positionals = {{"CASE", "the case file"}};
     s.options = {{"--vary", {}, "key=v1,v2", "the values of one key to run (repeatable: every combination)", true},
+                 {"--with", {}, "key=v1,v2", "a key whose values go with the first --vary's, value for value (as\n"
+                                             "many values; repeatable): one point per pair, not every combination", true},
                  cli::set_option(),
                  {"--repeats", {}, "N", "run every point N times with other seeds (dem.seed + 0 .. N-1) and tabulate\n"
                                         "their means with the standard error of their spread (sweep_mean.csv)"},
@@ -166,7 +169,10 @@ run_time_s):
                    "Kawamoto Fig. 22-23: the carrier diameter"},
                   {"magbrush sweep cases/kawamoto_nip.yaml --vary populations.carrier.count=9000,12300,15000",
                    "Fig. 24-25: the amount of developer"},
-                  {"magbrush sweep cases/kawamoto_nip.yaml --vary drum.gap=0.3mm,0.4mm,0.5mm", "Fig. 26-27: the gap"}};
+                  {"magbrush sweep cases/kawamoto_nip.yaml --vary drum.gap=0.3mm,0.4mm,0.5mm", "Fig. 26-27: the gap"},
+                  {"magbrush sweep cases/kweon_development.yaml --vary electric.bias=-500V,-600V,-700V,-800V,-800V "
+                   "--with electric.image.duty=1,1,1,1,0 --spin-up 8ms --settle 8.5ms",
+                   "Kweon Fig. 9: the TMA at four biases and the fog (a dark drum) at the last, one spin-up"}};
     s.exit_status = "0 every point done, 1 an invalid case or a failed point, 2 bad usage.";
     return s;
   }();
@@ -185,6 +191,7 @@ struct Vary
 {
   std::string key;
   std::vector<std::string> values;
+  int follows = -1; // a --with key: the index of the --vary whose value index it takes (else -1)
 };
 
 std::vector<std::string> split(const std::string &s, char sep)
@@ -377,10 +384,20 @@ SweepPlan plan_sweep(const cli::ParsedArguments &args)
     plan.vary.push_back(parse_vary(v));
   if (plan.vary.empty())
     throw cli::UsageError("nothing to vary: give --vary key=v1,v2,...");
+  const std::size_t leaders = plan.vary.size();
+  for (const auto &v : args.values("--with"))
+  {
+    Vary with = parse_vary(v);
+    if (with.values.size() != plan.vary[0].values.size())
+      throw cli::UsageError("--with " + with.key + " gives " + std::to_string(with.values.size()) +
+                            " values; they go value for value with the first --vary (" + plan.vary[0].key + "), which has " +
+                            std::to_string(plan.vary[0].values.size()));
+    with.follows = 0;
+    plan.vary.push_back(with);
+  }
   plan.tolerance = std::atof(args.value("--tolerance", "0.1").c_str());
-  if (args.has("--measured") && plan.vary.size() > 1)
-    throw cli::UsageError("--measured compares along one varied key; this sweep varies " +
-                          std::to_string(plan.vary.size()));
+  if (args.has("--measured") && leaders > 1)
+    throw cli::UsageError("--measured compares along one varied key; this sweep varies " + std::to_string(leaders));
   if (!(plan.tolerance > 0.0))
     throw cli::UsageError("--tolerance expects a positive fraction (0.1 = 10 %), found '" +
                           args.value("--tolerance", "") + "'");
@@ -411,10 +428,16 @@ SweepPlan plan_sweep(const cli::ParsedArguments &args)
     plan.vary.push_back(seeds);
   }
 
-  // Every combination (the last --vary runs fastest).
+  // Every combination (the last --vary runs fastest); a --with key takes its leader's index.
   plan.points.assign(1, {});
   for (const auto &v : plan.vary)
   {
+    if (v.follows >= 0)
+    {
+      for (auto &p : plan.points)
+        p.push_back(p[static_cast<std::size_t>(v.follows)]);
+      continue;
+    }
     std::vector<std::vector<std::size_t>> next;
     for (const auto &p : plan.points)
       for (std::size_t k = 0; k < v.values.size(); ++k)

@@ -109,6 +109,49 @@ TEST(Sweep, PointsWithTheSameFieldInputsShareOneSolvedField)
   fs::remove_all(dir);
 }
 
+// A --with key goes value for value with the first --vary (a TMA study's fog point: the last
+// bias again on a dark drum): one point per pair, not every combination, each with both values
+// in its row and folder; a --with list of another length is refused, naming both counts.
+TEST(Sweep, AWithKeyGoesValueForValueWithTheFirstVary)
+{
+  const fs::path dir = magbrush::testing::test_temp_dir("app_sweep_with");
+  const std::string roller = std::string(MAGBRUSH_SOURCE_DIR) + "/tests/coupling/case/valid/minimal_roller.yaml";
+  const Result r = run_magbrush(dir, {"sweep", roller, "--vary", "drum.rpm=-100rpm,-120rpm,-120rpm", "--with",
+                                      "roller.poles.N1.strength=150kA/m,150kA/m,160kA/m", "--name", "zip", "--skip",
+                                      "mesh,dem,report", "--set", "output.directory=" + (dir / "out").string()});
+  ASSERT_EQ(r.status, 0) << r.output;
+  const auto rows = magbrush::testing::read_csv_rows(dir / "out" / "sweep_zip" / "sweep_summary.csv");
+  ASSERT_EQ(rows.size(), 4u) << r.output; // three points, not nine
+  auto column = [&](const std::string &name) {
+    for (std::size_t k = 0; k < rows[0].size(); ++k)
+      if (rows[0][k] == name)
+        return k;
+    ADD_FAILURE() << "no column " << name;
+    return std::size_t(0);
+  };
+  const std::vector<std::pair<double, double>> expected = {{-100.0, 150e3}, {-120.0, 150e3}, {-120.0, 160e3}};
+  for (std::size_t n = 0; n < expected.size(); ++n)
+  {
+    EXPECT_NEAR(std::stod(rows[n + 1][column("drum.rpm [rad/s]")]), expected[n].first * 2.0 * M_PI / 60.0, 1e-7); // printed to 9 digits
+    EXPECT_DOUBLE_EQ(std::stod(rows[n + 1][column("roller.poles.N1.strength [A/m]")]), expected[n].second);
+  }
+  EXPECT_TRUE(fs::exists(dir / "out" / "sweep_zip" / "p2_rpm--120rpm_strength-160kA_m")) << r.output;
+  // Two pole strengths: two solved fields for three points.
+  int fields = 0;
+  for (const auto &entry : fs::directory_iterator(dir / "out" / "sweep_zip" / "fields"))
+    fields += entry.is_directory();
+  EXPECT_EQ(fields, 2);
+
+  const Result bad = run_magbrush(dir, {"sweep", roller, "--vary", "drum.rpm=-100rpm,-120rpm", "--with",
+                                        "roller.poles.N1.strength=150kA/m", "--skip", "mesh,dem,report", "--set",
+                                        "output.directory=" + (dir / "out2").string()});
+  EXPECT_EQ(bad.status, 2) << bad.output;
+  EXPECT_NE(bad.output.find("gives 1 values; they go value for value with the first --vary (drum.rpm), which has 2"),
+            std::string::npos)
+    << bad.output;
+  fs::remove_all(dir);
+}
+
 // A population given by its mass (or supplied by the inflow: count 0) keeps its volume by
 // itself when its diameter changes; the sweep must still scale its spread and a fixed time
 // step with the diameter (a fed nip at 42 µm otherwise runs at the 60 µm step, above the

@@ -300,13 +300,14 @@ void fem_check(const std::string &fitted_case, const FluxScan &scan, const std::
   }
   std::cout << "FEM check: running magbrush-field on " << fitted_case << " ...\n" << std::flush;
   const std::string log = dir + "/flux_fem_check.log";
-  const std::string failure = run_magnetic_field_solver(fitted_case, log);
+  const std::vector<std::string> fields_here = {"field.output_dir=" + dir + "/fem_check_fields"};
+  const std::string failure = run_magnetic_field_solver(fitted_case, log, fields_here);
   if (!failure.empty())
   {
     std::cout << "FEM check failed: " << failure << "\n";
     return;
   }
-  const Case fitted = load_case(fitted_case);
+  const Case fitted = load_case(fitted_case, fields_here);
   const double r = probe_radius_of(fitted);
   std::string why;
   const std::string path = fem_profile_path(fitted, r, why);

@@ -354,11 +354,12 @@ private:
       return;
     }
     say("\nFEM check: magbrush-field on " + designed_case_ + " ...\n");
-    const std::string failure = run_magnetic_field_solver(designed_case_, dir_ + "/design_fem_check.log");
+    const std::vector<std::string> fields_here = {"field.output_dir=" + dir_ + "/fem_check_fields"};
+    const std::string failure = run_magnetic_field_solver(designed_case_, dir_ + "/design_fem_check.log", fields_here);
     std::string why;
     if (failure.empty())
     {
-      const Case designed = load_case(designed_case_);
+      const Case designed = load_case(designed_case_, fields_here);
       fem_path_ = fem_profile_path(designed, probe_radius_, why);
     }
     if (!failure.empty() || fem_path_.empty())

@@ -129,7 +129,8 @@ ComputedProfile computed_at(const std::vector<double> &angles, const MultipoleRi
   return p;
 }
 
-std::string run_magnetic_field_solver(const std::string &case_file, const std::string &log)
+std::string run_magnetic_field_solver(const std::string &case_file, const std::string &log,
+                                      const std::vector<std::string> &overrides)
 {
   const fs::path field_exe = fs::path(executable_dir()) / "magbrush-field";
   if (!fs::exists(field_exe))
@@ -139,7 +140,13 @@ std::string run_magnetic_field_solver(const std::string &case_file, const std::s
   to_log.stderr_to_stdout = true;
   try
   {
-    const int status = run_program({field_exe.string(), case_file, "--only", "magnetic", "--no-vtu"}, to_log);
+    std::vector<std::string> words = {field_exe.string(), case_file, "--only", "magnetic", "--no-vtu"};
+    for (const auto &o : overrides)
+    {
+      words.push_back("--set");
+      words.push_back(o);
+    }
+    const int status = run_program(words, to_log);
     if (status != 0)
       return "magbrush-field exited with status " + std::to_string(status) + " (see " + log + ")";
   }

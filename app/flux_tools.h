@@ -36,9 +36,12 @@ struct ComputedProfile
 ComputedProfile computed_at(const std::vector<double> &angles, const MultipoleRing &ring,
                             double probe_radius, const std::string &fem_path);
 
-// magbrush-field CASE --only magnetic --no-vtu with its output in `log`: "" when it ran, else
-// what went wrong (including "not built").
-std::string run_magnetic_field_solver(const std::string &case_file, const std::string &log);
+// magbrush-field CASE --only magnetic --no-vtu [--set OVERRIDE ...] with its output in `log`: ""
+// when it ran, else what went wrong (including "not built"). A check of a written case passes
+// `field.output_dir=<its folder>/...` so that the check's fields stay with it, not in the
+// working directory's results/.
+std::string run_magnetic_field_solver(const std::string &case_file, const std::string &log,
+                                      const std::vector<std::string> &overrides = {});
 
 // tools/<script> with the first python3 that has matplotlib ($MAGBRUSH_PYTHON, python3 on the
 // PATH, /usr/bin/python3); prints "  plot  PNG" or a warning saying why there is none.

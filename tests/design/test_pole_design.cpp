@@ -254,6 +254,8 @@ TEST(DesignCommand, SpecificationMetAndCheckedByFemWithinBudget)
   for (const char *f : {"design_report.txt", "design_profile.csv", "design_requirements.csv", "design_sensitivity.csv",
                         "index.md", "index.html"})
     EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
+  // The FEM check's fields stay in the design's folder (not in the working directory's results/).
+  EXPECT_TRUE(std::filesystem::exists(dir / "fem_check_fields" / "kweon_development_designed_magnetic.h5"));
   // The design's page: the requirements judged on the ring and the FEM, the layout, the sensitivities.
   std::ifstream in(dir / "index.md");
   const std::string page((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

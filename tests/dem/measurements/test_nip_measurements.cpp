@@ -75,6 +75,16 @@ Vector3 on_drum(const NipFrame &f, double x, double out, double z = 0.5e-3)
   return {f.cx + (f.drum_radius + out) * ux, f.cy + (f.drum_radius + out) * uy, z};
 }
 
+// The summary row of `key` (a failure when there is none).
+SummaryValue value(const std::vector<SummaryValue> &s, const std::string &key)
+{
+  for (const auto &v : s)
+    if (v.key == key)
+      return v;
+  ADD_FAILURE() << "no " << key;
+  return SummaryValue{};
+}
+
 } // namespace
 
 TEST(NipFrame, RelativeSpeedAndCoordinatesOfThePrototype)
@@ -479,13 +489,6 @@ TEST(NipProfile, SummaryJudgesSteadyStateByTheDriftOfItsMeans)
     b.force_on_wall = {newtons * p.frame().nx, newtons * p.frame().ny, 0.0};
     return b;
   };
-  auto value = [](const std::vector<SummaryValue> &s, const std::string &key) {
-    for (const auto &v : s)
-      if (v.key == key)
-        return v;
-    ADD_FAILURE() << "no " << key;
-    return SummaryValue{};
-  };
   // Steady: the same 1 mN bead every sample, alternating with a second one of 1 mN.
   NipProfile steady(c);
   for (int k = 0; k < 100; ++k)
@@ -555,13 +558,6 @@ TEST(NipProfile, PeakAndCentreBinHaveBlockStandardErrors)
     for (double v : blocks)
       ss += (v - m) * (v - m);
     return std::make_pair(m, std::sqrt(ss / 9.0 / 10.0));
-  };
-  auto value = [](const std::vector<SummaryValue> &s, const std::string &key) {
-    for (const auto &v : s)
-      if (v.key == key)
-        return v;
-    ADD_FAILURE() << "no " << key;
-    return SummaryValue{};
   };
   const auto bins = profile.bins();
   const double area0 = bins[8].area, area4 = bins[12].area;

@@ -224,6 +224,8 @@ std::vector<ResolvedEntry> resolved_entries(const Case &c)
   e.b("electric.conductor_images", "electric.conductor_images", c.electric.conductor_images);
   e.i("electric.pair_image_terms", "electric.pair_image_terms", c.electric.pair_image_terms);
   e.q("electric.hold_distance", "electric.hold_distance", c.electric.hold_distance);
+  e.s("electric.coulomb_hold_frame", "electric.coulomb_hold_frame",
+      c.electric.coulomb_hold_frame == Electric::HoldFrame::sleeve ? "sleeve" : "lab");
   e.q("electric.image.edge_width", "electric.image.edge_width", im.edge_width);
 
   const auto &f = c.applied_field;

@@ -47,6 +47,9 @@ std::vector<KeySpec> electric_keys()
       quantity("electric.hold_distance", D::length,
                "The electric forces (qE, Coulomb, images) are evaluated again when some particle or the latent image has moved this far since their last evaluation, and held in between (0 = every step). 20 nm: force error against cost in docs/electrostatics.md.")
           .def("20 nm").non_negative(),
+      choice("electric.coulomb_hold_frame", {"lab", "sleeve"},
+             "The frame in which the Coulomb term's moves are measured against electric.hold_distance: lab, or sleeve (the frame turning with the sleeve: a developer riding it changes no pair and renews nothing; docs/electrostatics.md).")
+          .def("lab"),
       quantity("electric.image.edge_width", D::length, "Width of the smooth (raised-cosine) transition at each strip edge, at most the narrower strip (0 = sharp edges).")
           .def("0 um").non_negative().affects(A::electric),
   };

@@ -14,6 +14,15 @@ double rpm_to_rad_per_s(double rpm) { return rpm * two_pi / 60.0; }
 double Sleeve::omega() const { return rpm_to_rad_per_s(rpm); }
 double Sleeve::surface_speed() const { return std::abs(omega()) * radius; }
 
+double Sleeve::turned(double t) const
+{
+  // The sleeve wall's speed ramps linearly from rest over spin_up_time (dem/wall_contacts.cpp).
+  if (t <= 0.0)
+    return 0.0;
+  const double w = omega(), T = spin_up_time;
+  return T > 0.0 && t < T ? 0.5 * w * t * t / T : w * (T > 0.0 ? t - 0.5 * T : t);
+}
+
 double Drum::omega() const { return rpm_to_rad_per_s(rpm); }
 
 Vec2 Drum::center(double sleeve_radius) const

@@ -55,6 +55,7 @@ struct Sleeve
   double spin_up_time = 0.0; // linear ramp of the speed from rest from t = 0 [s] (0 = at once)
   double omega() const;    // angular velocity [rad/s]
   double surface_speed() const; // |ω| R [m/s]
+  double turned(double t) const; // the angle turned by time t, the ramp included (0 for t <= 0) [rad]
 };
 
 struct Drum
@@ -171,6 +172,9 @@ struct Electric
   // The electric forces are evaluated again when a particle or the latent image has moved
   // this far since the last evaluation, held in between (0 = every step; dem/force_terms/held_forces.h).
   double hold_distance = 20e-9;  // [m]
+  // The frame Coulomb's moves are measured in: the lab's, or the one turning with the sleeve
+  // (the developer riding the sleeve then changes no pair and renews nothing).
+  enum class HoldFrame { lab, sleeve } coulomb_hold_frame = HoldFrame::lab;
 };
 
 // Applied magnetic field: from the roller (field solver grid) or uniform (the compression test).

@@ -1220,6 +1220,8 @@ private:
     c.electric.conductor_images = flag(s, "conductor_images");
     c.electric.pair_image_terms = static_cast<int>(integer(s, "pair_image_terms"));
     c.electric.hold_distance = q(s, "hold_distance");
+    c.electric.coulomb_hold_frame =
+      str(s, "coulomb_hold_frame") == "sleeve" ? Electric::HoldFrame::sleeve : Electric::HoldFrame::lab;
     li.edge_width = q(image, "edge_width");
     if (li.period > 0.0 && li.edge_width > std::min(li.duty, 1.0 - li.duty) * li.period)
       error_at_path(image.display, "edge_width " + std::to_string(li.edge_width * 1e6) +

@@ -284,8 +284,15 @@ std::string coulomb_not_needed_because(const Case &c)
 const bool registered = dem::register_force_term(
     {"Coulomb", dem::force_term_order::coulomb, coulomb_not_needed_because,
      [](const Case &c, const dem::DemSystem &system) -> std::unique_ptr<dem::ForceTerm> {
+       std::optional<dem::RotatingFrame> frame;
+       if (c.electric.coulomb_hold_frame == Electric::HoldFrame::sleeve && c.sleeve)
+       {
+         // The sleeve turns about the z axis through the origin (geometry/wall_primitives.cpp).
+         frame = dem::RotatingFrame{};
+         frame->angle = [sleeve = *c.sleeve](double t) { return sleeve.turned(t); };
+       }
        return dem::held_for(std::make_unique<CoulombTerm>(CoulombTermSettings::from_case(c), system.box().length),
-                            c.electric.hold_distance, system.box().length, {}, renew_share);
+                            c.electric.hold_distance, system.box().length, {}, renew_share, std::move(frame));
      }});
 } // namespace
 

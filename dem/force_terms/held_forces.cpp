@@ -11,15 +11,49 @@
 namespace magbrush::dem {
 
 HeldForces::HeldForces(std::unique_ptr<ForceTerm> inner, double hold_distance, const std::array<double, 3> &box,
-                       std::function<double(double)> source_travel, double renew_share)
+                       std::function<double(double)> source_travel, double renew_share,
+                       std::optional<RotatingFrame> frame)
   : inner_(std::move(inner)), hold_distance_(hold_distance), box_(box), source_travel_(std::move(source_travel)),
-    renew_share_(renew_share)
+    renew_share_(renew_share), frame_(std::move(frame))
 {
   if (!inner_)
     throw std::invalid_argument("held forces: no force term given");
   if (!(hold_distance_ >= 0.0))
     throw std::invalid_argument("held forces: the hold distance must be >= 0");
   per_particle_ = inner_->acts_on_each_particle_alone();
+  if (frame_ && per_particle_)
+    throw std::invalid_argument("held forces: '" + std::string(inner_->name()) +
+                                "' acts on each particle where it is in the lab: its moves cannot be measured in a "
+                                "turning frame");
+  if (frame_ && (box_[0] > 0.0 || box_[1] > 0.0))
+    throw std::invalid_argument("held forces: a frame turning about z needs x and y not periodic");
+  if (frame_ && (!frame_->angle || !(frame_->max_turn > 0.0)))
+    throw std::invalid_argument("held forces: a turning frame needs its angle and a positive max_turn");
+}
+
+void HeldForces::turn_frame(double t)
+{
+  if (!frame_)
+    return;
+  const double a = frame_->angle(t);
+  cos_ = std::cos(a);
+  sin_ = std::sin(a);
+}
+
+void HeldForces::set_reference(const ParticleState &state, std::size_t i)
+{
+  if (frame_)
+  {
+    const double dx = state.x[i] - frame_->cx, dy = state.y[i] - frame_->cy;
+    x0_[i] = cos_ * dx + sin_ * dy;
+    y0_[i] = -sin_ * dx + cos_ * dy;
+  }
+  else
+  {
+    x0_[i] = state.x[i];
+    y0_[i] = state.y[i];
+  }
+  z0_[i] = state.z[i];
 }
 
 void HeldForces::squared_moves(const ParticleState &state, std::size_t begin, std::size_t end, double *out) const
@@ -32,6 +66,21 @@ void HeldForces::squared_moves(const ParticleState &state, std::size_t begin, st
   const double *x0 = x0_.data(), *y0 = y0_.data(), *z0 = z0_.data();
   const double bx = box_[0], by = box_[1], bz = box_[2];
   const double hx = 0.5 * bx, hy = 0.5 * by, hz = 0.5 * bz;
+  if (frame_)
+  {
+    // In the turning frame (x and y are not periodic there): the position turned back by the
+    // frame's angle, against the reference stored the same way.
+    const double c = cos_, s = sin_, cx = frame_->cx, cy = frame_->cy;
+    for (std::size_t i = begin; i < end; ++i)
+    {
+      const double px = x[i] - cx, py = y[i] - cy;
+      const double dx = c * px + s * py - x0[i], dy = -s * px + c * py - y0[i];
+      double dz = z[i] - z0[i];
+      dz -= (dz > hz ? bz : 0.0) - (dz < -hz ? bz : 0.0);
+      out[i - begin] = dx * dx + dy * dy + dz * dz;
+    }
+    return;
+  }
   for (std::size_t i = begin; i < end; ++i)
   {
     double dx = x[i] - x0[i], dy = y[i] - y0[i], dz = z[i] - z0[i];
@@ -45,6 +94,8 @@ void HeldForces::squared_moves(const ParticleState &state, std::size_t begin, st
 bool HeldForces::stale_as_a_whole(const ParticleState &state, double t) const
 {
   if (!valid_ || held_.fx.size() != state.size())
+    return true;
+  if (frame_ && std::abs(frame_->angle(t) - frame_->angle(evaluated_at_)) >= frame_->max_turn)
     return true;
   return source_travel_ && std::abs(source_travel_(t) - source_travel_(evaluated_at_)) >= hold_distance_;
 }
@@ -74,9 +125,20 @@ void HeldForces::evaluate(const ParticleState &state, double t)
 {
   held_.resize(state.size()); // zeroed
   inner_->add_forces(state, held_, t);
-  x0_ = state.x;
-  y0_ = state.y;
-  z0_ = state.z;
+  if (frame_)
+  {
+    x0_.resize(state.size());
+    y0_.resize(state.size());
+    z0_.resize(state.size());
+    for (std::size_t i = 0; i < state.size(); ++i)
+      set_reference(state, i);
+  }
+  else
+  {
+    x0_ = state.x;
+    y0_ = state.y;
+    z0_ = state.z;
+  }
   evaluated_at_ = t;
   valid_ = true;
   evaluations_ += 1;
@@ -118,11 +180,7 @@ void HeldForces::hold_as_a_whole(const ParticleState &state, double t)
     return;
   }
   for (const std::uint32_t i : which_)
-  {
-    x0_[i] = state.x[i];
-    y0_[i] = state.y[i];
-    z0_[i] = state.z[i];
-  }
+    set_reference(state, i);
   renewals_ += 1;
   renewed_ += static_cast<long>(which_.size());
 }
@@ -178,6 +236,7 @@ void HeldForces::add_forces(const ParticleState &state, ForceBuffers &forces, do
   else
   {
     ++calls_;
+    turn_frame(t);
     hold_as_a_whole(state, t);
   }
   const long n = static_cast<long>(state.size());
@@ -286,17 +345,21 @@ std::string HeldForces::cost_note() const
                   "renewed at %ld steps since the start of this run (%.3g particles each)",
                   evaluations_, calls_, share, hold_distance_ * 1e9, renewals_,
                   renewals_ > 0 ? static_cast<double>(renewed_) / static_cast<double>(renewals_) : 0.0);
+  std::string note = line;
+  if (frame_)
+    note += " (moves measured in the frame turning with the sleeve)";
   const std::string inner = inner_->cost_note();
-  return inner.empty() ? std::string(line) : std::string(line) + "; " + inner;
+  return inner.empty() ? note : note + "; " + inner;
 }
 
 std::unique_ptr<ForceTerm> held_for(std::unique_ptr<ForceTerm> term, double hold_distance,
                                     const std::array<double, 3> &box, std::function<double(double)> source_travel,
-                                    double renew_share)
+                                    double renew_share, std::optional<RotatingFrame> frame)
 {
   if (hold_distance <= 0.0)
     return term;
-  return std::make_unique<HeldForces>(std::move(term), hold_distance, box, std::move(source_travel), renew_share);
+  return std::make_unique<HeldForces>(std::move(term), hold_distance, box, std::move(source_travel), renew_share,
+                                      std::move(frame));
 }
 
 } // namespace magbrush::dem

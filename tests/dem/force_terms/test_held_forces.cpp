@@ -156,6 +156,78 @@ TEST(HeldForces, AMovingSourceCountsAsAMove)
   EXPECT_DOUBLE_EQ(f.fx[0], -(s.x[0] - v * 1.01 * d / v));
 }
 
+// Measured in the frame turning with a sleeve about (cx, cy): particles carried rigidly by the
+// turn (by far more than d) renew nothing, while the same turn measured in the lab renews at
+// every step; a particle that moves over the turning frame is renewed when IT moved d there;
+// the frame's own turn by max_turn evaluates everybody again.
+TEST(HeldForces, ATurningFrameIgnoresTheRideAndSeesTheMovesOverIt)
+{
+  const double cx = 1e-3, cy = -2e-3, omega = 40.0; // [m], [rad/s]: the ride ~0.1 m/s at 2 mm
+  RotatingFrame frame;
+  frame.cx = cx, frame.cy = cy;
+  frame.angle = [omega](double t) { return omega * t; };
+  frame.max_turn = 1e-2;
+  long in_frame = 0, in_lab = 0;
+  HeldForces turning(std::make_unique<SpringToMovingCentre>(1.0, 0.0, &in_frame), d, {0, 0, 1e-4}, {}, 0.0, frame);
+  HeldForces lab(std::make_unique<SpringToMovingCentre>(1.0, 0.0, &in_lab), d, {0, 0, 1e-4});
+  // `base` turned about (cx, cy) by omega t: particles carried rigidly by the frame.
+  auto turned_by = [&](const ParticleState &base, double t) {
+    ParticleState s = base;
+    const double c = std::cos(omega * t), sn = std::sin(omega * t);
+    for (std::size_t i = 0; i < s.size(); ++i)
+    {
+      const double px = base.x[i] - cx, py = base.y[i] - cy;
+      s.x[i] = cx + c * px - sn * py;
+      s.y[i] = cy + sn * px + c * py;
+    }
+    return s;
+  };
+  const ParticleState start = three_particles();
+  auto carried = [&](double t) { return turned_by(start, t); };
+  const double dt = 1e-6; // each step carries the particles ~9 d at 2.2 mm from the axis
+  for (int k = 0; k < 10; ++k)
+  {
+    const ParticleState s = carried(k * dt);
+    forces_of(turning, s, k * dt);
+    forces_of(lab, s, k * dt);
+  }
+  EXPECT_EQ(in_frame, 1); // the first evaluation only
+  EXPECT_EQ(in_lab, 10);
+
+  // Particle 1 moves 1.1 d radially over the frame (and 0.9 d does not count).
+  ParticleState s = carried(10 * dt);
+  const double px = s.x[1] - cx, py = s.y[1] - cy, r = std::hypot(px, py);
+  ParticleState near = s, far = s;
+  near.x[1] += 0.9 * d * px / r, near.y[1] += 0.9 * d * py / r;
+  far.x[1] += 1.1 * d * px / r, far.y[1] += 1.1 * d * py / r;
+  forces_of(turning, near, 10 * dt);
+  EXPECT_EQ(in_frame, 1);
+  const ForceBuffers f = forces_of(turning, far, 10 * dt);
+  EXPECT_EQ(in_frame, 2);
+  EXPECT_DOUBLE_EQ(f.fx[1], -far.x[1]); // evaluated where it is now
+
+  // The frame turns max_turn since that evaluation: everybody again, though nothing moved in it.
+  const ParticleState moved_base = turned_by(far, -10 * dt); // where they now sit in the frame
+  const double t_held = 10 * dt + 0.99 * frame.max_turn / omega, t_turned = 10 * dt + 1.01 * frame.max_turn / omega;
+  forces_of(turning, turned_by(moved_base, t_held), t_held);
+  EXPECT_EQ(in_frame, 2);
+  forces_of(turning, turned_by(moved_base, t_turned), t_turned);
+  EXPECT_EQ(in_frame, 3);
+}
+
+TEST(HeldForces, ATurningFrameIsRefusedWhereItCannotHold)
+{
+  long n = 0;
+  RotatingFrame frame;
+  frame.angle = [](double t) { return t; };
+  // A term acting on each particle where it is in the lab (qE): no frame.
+  EXPECT_THROW(HeldForces(std::make_unique<SpringPerParticle>(1.0, &n), d, {0, 0, 0}, {}, 0.0, frame),
+               std::invalid_argument);
+  // Periodic along x: a turn about z does not map the box onto itself.
+  EXPECT_THROW(HeldForces(std::make_unique<SpringToMovingCentre>(1.0, 0.0, &n), d, {1e-3, 0, 0}, {}, 0.0, frame),
+               std::invalid_argument);
+}
+
 TEST(HeldForces, HeldForcesFollowReSortedParticlesAndAnExchangeEvaluatesAgain)
 {
   long n = 0;

@@ -71,8 +71,8 @@ const cli::CommandSpec &sweep_command_line()
     s.description = R"(Runs the pipeline (check, field, dem, report; the Gmsh meshes are not needed per point) once
 for every combination of the --vary values (a --with key goes value for value with the first
 --vary), each point in results/sweep_<NAME>/<point>/ (<output.directory>/sweep_<NAME>/<point>/
-when the case names a folder; the point's dem/ and report/; the stored fields in sweep_<NAME>/fields/<digests of the field inputs>/, solved once
-for the points that share them),
+when the case names a folder; the point's dem/ and report/; the stored fields in
+sweep_<NAME>/fields/<digests of the field inputs>/, solved once for the points that share them),
 then compares the nip profiles of all points:
   sweep_summary.csv    one row per point: the varied values (as given and in SI), the bead
                        count, every key number the point's measurements report (dem/summary.csv:

@@ -14,16 +14,22 @@ double rpm_to_rad_per_s(double rpm) { return rpm * two_pi / 60.0; }
 double Sleeve::omega() const { return rpm_to_rad_per_s(rpm); }
 double Sleeve::surface_speed() const { return std::abs(omega()) * radius; }
 
-double Sleeve::turned(double t) const
+namespace {
+// ∫ ω dt from 0 to t for a cylinder whose speed ramps linearly from rest over spin_up_time
+// (dem/wall_contacts.cpp cylinder_omega); at rest before t = 0 (the particles settle).
+double turned_with_ramp(double omega, double spin_up_time, double t)
 {
-  // The sleeve wall's speed ramps linearly from rest over spin_up_time (dem/wall_contacts.cpp).
   if (t <= 0.0)
     return 0.0;
-  const double w = omega(), T = spin_up_time;
-  return T > 0.0 && t < T ? 0.5 * w * t * t / T : w * (T > 0.0 ? t - 0.5 * T : t);
+  const double T = spin_up_time;
+  return T > 0.0 && t < T ? 0.5 * omega * t * t / T : omega * (T > 0.0 ? t - 0.5 * T : t);
 }
+} // namespace
+
+double Sleeve::turned(double t) const { return turned_with_ramp(omega(), spin_up_time, t); }
 
 double Drum::omega() const { return rpm_to_rad_per_s(rpm); }
+double Drum::turned(double t) const { return turned_with_ramp(omega(), spin_up_time, t); }
 
 Vec2 Drum::center(double sleeve_radius) const
 {

@@ -70,6 +70,7 @@ struct Drum
   double pc_eps_r = 3.0;           // photoconductor relative permittivity
   Vec2 center(double sleeve_radius) const; // drum centre [m]
   double omega() const;
+  double turned(double t) const; // the angle turned by time t, the ramp included (0 for t <= 0) [rad]
 };
 
 // A doctor blade or a guide wall: a polygon in the x-y plane extruded along the roller axis.

@@ -50,14 +50,8 @@ NipPotentialField NipPotentialField::for_case(const Case &c, const std::string &
 
 double NipPotentialField::surface_travel(const Drum &drum, double t)
 {
-  // Θ(t) = ∫ ω: the drum wall's speed ramps linearly from rest over spin_up_time
-  // (dem/wall_contacts.cpp cylinder_omega), and the drum rests while the particles settle (t < 0).
-  if (t <= 0.0)
-    return 0.0;
-  const double omega = drum.omega(), T = drum.spin_up_time;
-  const double angle = T > 0.0 && t < T ? 0.5 * omega * t * t / T
-                                        : omega * (T > 0.0 ? t - 0.5 * T : t);
-  return drum.radius * angle;
+  // Θ(t) = ∫ ω, the spin-up ramp included (Drum::turned).
+  return drum.radius * drum.turned(t);
 }
 
 NipPotentialField::PhaseWeights NipPotentialField::make_phase_weights() const

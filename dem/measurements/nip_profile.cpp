@@ -153,7 +153,6 @@ void NipProfile::add_sample(double time, const std::vector<DrumContact> &contact
   long touching = 0, centre = 0;
   asymmetry_.start_sample();
   std::fill(sample_fn_.begin(), sample_fn_.end(), 0.0);
-  long centre_touching = 0;
   for (const auto &c : contacts)
   {
     const DrumContactInFrame r = resolve_drum_contact(frame_, c);
@@ -178,12 +177,12 @@ void NipProfile::add_sample(double time, const std::vector<DrumContact> &contact
     ft += r.tangential;
     ++touching;
     if (b == bins_half_)
-      centre_slip += r.slip, centre_chain += r.chain_speed, ++centre, ++centre_touching;
+      centre_slip += r.slip, centre_chain += r.chain_speed, ++centre;
   }
   asymmetry_.end_sample();
   for (std::size_t k = 0; k < sample_fn_.size(); ++k)
     bin_pressure_[k].add(sample_fn_[k] / bin_area_[k]);
-  centre_touching_.add(static_cast<double>(centre_touching));
+  centre_touching_.add(static_cast<double>(centre));
   normal_force_.add(fn / frame_.slab_depth);
   tangential_force_.add(ft / frame_.slab_depth);
   touching_.add(static_cast<double>(touching));
@@ -285,7 +284,8 @@ double NipProfile::peak_normal_pressure() const
 {
   if (samples_ == 0)
     return nan; // no sample in the averaging window: no peak, not 0 Pa
-  return std::max(0.0, fn_[peak_bin()] / bin_area_[peak_bin()] / static_cast<double>(samples_));
+  const std::size_t k = peak_bin();
+  return std::max(0.0, fn_[k] / bin_area_[k] / static_cast<double>(samples_));
 }
 
 std::string NipProfile::csv() const

@@ -119,14 +119,24 @@ void CoulombTerm::rebuild(double t)
 
 void CoulombTerm::add_forces(const dem::ParticleState &state, dem::ForceBuffers &forces, double t)
 {
-  if (must_select_ || state.size() != state_size_)
+  const bool exchange = must_select_ || state.size() != state_size_;
+  if (exchange)
     select(state);
   const std::size_t n = index_.size();
   if (n == 0)
     return;
+  const bool was_stale = must_rebuild_;
   gather(state);
+  const bool charge_changed = !was_stale && must_rebuild_;
   if (must_rebuild_ || t - built_at_ >= settings_.refresh || moved_too_far())
+  {
+    long &cause = exchange || was_stale      ? causes_.exchange
+                  : charge_changed           ? causes_.charge
+                  : t - built_at_ >= settings_.refresh ? causes_.refresh
+                                                       : causes_.move;
+    ++cause;
     rebuild(t);
+  }
   coulomb_.field(x_.data(), y_.data(), z_.data(), q_.data(), radius_.data(), E_.data(), nullptr);
   for (std::size_t k = 0; k < n; ++k)
   {
@@ -260,7 +270,10 @@ bool CoulombTerm::renew_moved(const dem::ParticleState &state, dem::ForceBuffers
 std::string CoulombTerm::cost_note() const
 {
   // (How often the moved were renewed alone, the hold around the term counts.)
-  return "far field rebuilt " + std::to_string(evaluations_) + " times";
+  return "far field rebuilt " + std::to_string(evaluations_) + " times; since this run (re)started " +
+         std::to_string(causes_.exchange) + " after exchanges, " + std::to_string(causes_.charge) +
+         " for changed charges, " + std::to_string(causes_.refresh) + " at the refresh interval, " +
+         std::to_string(causes_.move) + " for a charge beyond a quarter cell";
 }
 
 namespace {

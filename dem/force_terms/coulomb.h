@@ -81,6 +81,12 @@ private:
   bool must_select_ = true, must_rebuild_ = true;
   double built_at_ = 0.0;
   long evaluations_ = 0;
+  // Why the far field was rebuilt, since this run (re)started (the cost note): particles
+  // entered or left, a charge changed, the refresh interval elapsed, a charge left its cell's reach.
+  struct RebuildCauses
+  {
+    long exchange = 0, charge = 0, refresh = 0, move = 0;
+  } causes_;
   // Compact charged particles: engine index, charge, radius (image floor), unwrapped
   // positions now and at the last rebuild, field.
   std::vector<std::uint32_t> index_;

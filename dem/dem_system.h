@@ -239,7 +239,7 @@ private:
                           const ParticleState &all);
   void find_fast_pairs();
   void toner_substeps_phase(StepFlags &mine);
-  int fast_forces(double dt, StepFlags &mine, bool react);
+  int fast_forces(double dt, StepFlags &mine);
   void initial_fast_forces(StepFlags &mine);
   void copy_fast_history(bool into_list); // the list's slots <-> the substeps' compact copy
   void add_fast_reaction_phase();

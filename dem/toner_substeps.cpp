@@ -119,6 +119,35 @@ void DemSystem::find_fast_pairs()
     a->resize(S.dragged.size());
   for (auto *a : {&S.start_x, &S.start_y, &S.start_z})
     a->resize(S.movers.size());
+  // Each member's pairs in ascending pair order (a counting sort over the pairs).
+  S.member_of.assign(n, -1);
+  for (std::size_t k = 0; k < S.movers.size(); ++k)
+    S.member_of[U(S.movers[k])] = static_cast<std::int32_t>(k);
+  for (std::size_t k = 0; k < S.dragged.size(); ++k)
+    S.member_of[U(S.dragged[k])] = static_cast<std::int32_t>(k);
+  S.mover_begin.assign(S.movers.size() + 1, 0);
+  S.dragged_begin.assign(S.dragged.size() + 1, 0);
+  auto begin_of = [&](std::int32_t i) -> std::vector<std::int32_t> & {
+    return S.fast(s.species[U(i)]) ? S.mover_begin : S.dragged_begin;
+  };
+  for (std::size_t q = 0; q < m; ++q)
+    for (const std::int32_t i : {S.owner[q], S.partner[q]})
+      ++begin_of(i)[U(S.member_of[U(i)]) + 1];
+  for (auto *b : {&S.mover_begin, &S.dragged_begin})
+    for (std::size_t k = 1; k < b->size(); ++k)
+      (*b)[k] += (*b)[k - 1];
+  S.mover_pairs.resize(U(S.mover_begin.back()));
+  S.dragged_pairs.resize(U(S.dragged_begin.back()));
+  std::vector<std::int32_t> mover_fill(S.mover_begin.begin(), S.mover_begin.end() - 1),
+      dragged_fill(S.dragged_begin.begin(), S.dragged_begin.end() - 1);
+  for (std::size_t q = 0; q < m; ++q)
+    for (int side = 0; side < 2; ++side)
+    {
+      const std::int32_t i = side == 0 ? S.owner[q] : S.partner[q];
+      const bool fast = S.fast(s.species[U(i)]);
+      std::int32_t &slot = (fast ? mover_fill : dragged_fill)[U(S.member_of[U(i)])];
+      (fast ? S.mover_pairs : S.dragged_pairs)[U(slot++)] = static_cast<std::int32_t>(2 * q + U(side));
+    }
 }
 
 // The fast pairs' history and touching flags between the list's slots (where the rebuild,
@@ -126,9 +155,11 @@ void DemSystem::find_fast_pairs()
 void DemSystem::copy_fast_history(bool into_list)
 {
   TonerSubsteps &S = substeps_;
-  for (std::size_t q = 0; q < S.pair.size(); ++q)
+  const long m = static_cast<long>(S.pair.size());
+#pragma omp for schedule(static)
+  for (long ql = 0; ql < m; ++ql)
   {
-    const std::size_t p = U(S.pair[q]);
+    const std::size_t q = static_cast<std::size_t>(ql), p = U(S.pair[q]);
     double *list[3] = {&list_.hist_x[p], &list_.hist_y[p], &list_.hist_z[p]};
     double *compact[3] = {&S.hx[q], &S.hy[q], &S.hz[q]};
     for (int d = 0; d < 3; ++d)
@@ -137,22 +168,17 @@ void DemSystem::copy_fast_history(bool into_list)
   }
 }
 
-// The fast contacts at the current positions, with step dt (the history advances by dt): the
-// fast particles' force and torque from zero into forces_.fast_*, the fast pairs first (in
-// pair order), then each one's walls; with `react`, the slow members' reaction added to
-// theirs. Returns 1 when a fast pair overlaps beyond the guard.
-int DemSystem::fast_forces(double dt, StepFlags &mine, bool react)
+// The fast contacts at the current positions, with step dt (the history advances by dt): each
+// fast particle's force and torque from zero into forces_.fast_*, its pairs first (in pair
+// order), then its walls; each slow member's reaction added to theirs. Work-shared: every thread
+// of the team calls it (or one thread alone, outside the team). Returns 1 when a fast pair
+// overlaps beyond the guard (this thread's share).
+int DemSystem::fast_forces(double dt, StepFlags &mine)
 {
   TonerSubsteps &S = substeps_;
-  ParticleState &s = particles_;
-  ForceBuffers &f = forces_;
-  for (const std::int32_t i : S.movers)
-  {
-    const std::size_t iu = U(i);
-    f.fast().zero(iu);
-  }
+  const ForceArrays fast = forces_.fast();
   int alarm = 0;
-  const std::size_t m = S.pair.size();
+  const long m = static_cast<long>(S.pair.size());
   if (m > 0)
   {
     PairKernelData D = pair_kernel_data();
@@ -172,34 +198,59 @@ int DemSystem::fast_forces(double dt, StepFlags &mine, bool react)
     D.slot_base = 0;
     D.dt = dt;
     D.skip = nullptr;
-    const RowTorques T{S.tix.data(), S.tiy.data(), S.tiz.data()};
-    alarm = particle_pair_kernel(D, T, 0, static_cast<std::int64_t>(m));
-    const ForceArrays fast = f.fast();
-    for (std::size_t q = 0; q < m; ++q)
+    // The pairs in one block per thread: each writes only its own slot (torques on i indexed
+    // from the block's first pair).
+    const long threads = omp_in_parallel() ? omp_get_num_threads() : 1, me = omp_in_parallel() ? omp_get_thread_num() : 0;
+    const long begin = m * me / threads, end = m * (me + 1) / threads;
+    const RowTorques T{S.tix.data() + begin, S.tiy.data() + begin, S.tiz.data() + begin};
+    if (end > begin)
+      alarm = particle_pair_kernel(D, T, begin, end);
+  }
+#pragma omp barrier
+  // Each particle sums its own pairs, in pair order: the owner gets the pair's force and torque
+  // on i, the partner the opposite force and the torque on j.
+  auto add_pairs = [&](std::size_t i, const std::int32_t *e, const std::int32_t *e_end) {
+    for (; e < e_end; ++e)
     {
-      const std::size_t i = U(S.owner[q]), j = U(S.partner[q]);
-      const double on_i[3] = {S.fx[q], S.fy[q], S.fz[q]}, torque_i[3] = {S.tix[q], S.tiy[q], S.tiz[q]};
-      const double on_j[3] = {-S.fx[q], -S.fy[q], -S.fz[q]}, torque_j[3] = {S.tjx[q], S.tjy[q], S.tjz[q]};
-      if (react || S.fast(s.species[i]))
-        fast.add(i, on_i, torque_i);
-      if (react || S.fast(s.species[j]))
-        fast.add(j, on_j, torque_j);
+      const std::size_t q = U(*e >> 1);
+      if ((*e & 1) == 0)
+      {
+        const double f[3] = {S.fx[q], S.fy[q], S.fz[q]}, t[3] = {S.tix[q], S.tiy[q], S.tiz[q]};
+        fast.add(i, f, t);
+      }
+      else
+      {
+        const double f[3] = {-S.fx[q], -S.fy[q], -S.fz[q]}, t[3] = {S.tjx[q], S.tjy[q], S.tjz[q]};
+        fast.add(i, f, t);
+      }
     }
+  };
+  long wall_alarm = -1, too_many = -1;
+  const long movers = static_cast<long>(S.movers.size()), dragged = static_cast<long>(S.dragged.size());
+#pragma omp for schedule(static) nowait
+  for (long n = 0; n < movers; ++n)
+  {
+    const std::size_t k = static_cast<std::size_t>(n), i = U(S.movers[k]);
+    fast.zero(i);
+    add_pairs(i, S.mover_pairs.data() + S.mover_begin[k], S.mover_pairs.data() + S.mover_begin[k + 1]);
+    if (walls_.size() > 0)
+      particle_wall_contacts(i, dt, fast, wall_alarm, too_many);
+  }
+#pragma omp for schedule(static)
+  for (long n = 0; n < dragged; ++n)
+  {
+    const std::size_t k = static_cast<std::size_t>(n);
+    add_pairs(U(S.dragged[k]), S.dragged_pairs.data() + S.dragged_begin[k],
+              S.dragged_pairs.data() + S.dragged_begin[k + 1]);
   }
   if (walls_.size() > 0)
-  {
-    long wall_alarm = -1, too_many = -1;
-    const ForceArrays fast = f.fast();
-    for (const std::int32_t i : S.movers)
-      particle_wall_contacts(U(i), dt, fast, wall_alarm, too_many);
     record_wall_alarms(mine, wall_alarm, too_many);
-  }
   return alarm;
 }
 
 // The forces at the start, before the first step: the fast contacts as the slow ones (the
 // history advances by one substep, as every pair's does by one step), the slow members'
-// reaction added to their forces at once.
+// reaction added to their forces at once. (Outside the team: one thread.)
 void DemSystem::initial_fast_forces(StepFlags &mine)
 {
   TonerSubsteps &S = substeps_;
@@ -210,7 +261,7 @@ void DemSystem::initial_fast_forces(StepFlags &mine)
     f.fast().zero(du);
   }
   copy_fast_history(false);
-  mine.overlap_alarm |= fast_forces(S.substep, mine, true);
+  mine.overlap_alarm |= fast_forces(S.substep, mine);
   copy_fast_history(true);
   for (const std::int32_t d : S.dragged)
   {
@@ -219,99 +270,107 @@ void DemSystem::initial_fast_forces(StepFlags &mine)
   }
 }
 
-// One step's substeps (toner_substeps.h, item 3). Every thread of the team calls it; one
-// does the work, and the others wait at the end (the slow pass needs the fast pairs' history
-// back in the list, and the held terms need this step's largest move).
+// One step's substeps (toner_substeps.h, item 3). Every thread of the team calls it and takes
+// its share of each loop; the phase ends with a barrier (the slow pass needs the fast pairs'
+// history back in the list, and the held terms need this step's largest move).
 void DemSystem::toner_substeps_phase(StepFlags &mine)
 {
-#pragma omp single
+  TonerSubsteps &S = substeps_;
+  ParticleState &s = particles_;
+  ForceBuffers &f = forces_;
+  const int k = S.substeps;
+  const double delta = S.substep, h = 0.5 * delta;
+  const long movers = static_cast<long>(S.movers.size()), dragged = static_cast<long>(S.dragged.size());
+  // The slow partners: where their drift ends, and their reaction from zero; the movers' start.
+#pragma omp for schedule(static) nowait
+  for (long n = 0; n < dragged; ++n)
   {
-    TonerSubsteps &S = substeps_;
-    ParticleState &s = particles_;
-    ForceBuffers &f = forces_;
-    const int k = S.substeps;
-    const double delta = S.substep, h = 0.5 * delta;
-    // The slow partners: where their drift ends, and their reaction from zero.
-    for (std::size_t n = 0; n < S.dragged.size(); ++n)
-    {
-      const std::size_t d = U(S.dragged[n]);
-      S.end_x[n] = s.x[d];
-      S.end_y[n] = s.y[d];
-      S.end_z[n] = s.z[d];
-      f.fast().zero(d);
-    }
-    for (std::size_t n = 0; n < S.movers.size(); ++n)
-    {
-      const std::size_t i = U(S.movers[n]);
-      S.start_x[n] = s.x[i];
-      S.start_y[n] = s.y[i];
-      S.start_z[n] = s.z[i];
-    }
-    copy_fast_history(false);
-    // A fast particle's kick: the held force of the step plus its fast force.
-    auto kick = [&](std::size_t i) {
-      const double im = s.inv_mass[i], iI = s.inv_inertia[i];
-      s.vx[i] += h * (f.fx[i] + f.fast_fx[i]) * im;
-      s.vy[i] += h * (f.fy[i] + f.fast_fy[i]) * im;
-      s.vz[i] += h * (f.fz[i] + f.fast_fz[i]) * im;
-      s.wx[i] += h * (f.tx[i] + f.fast_tx[i]) * iI;
-      s.wy[i] += h * (f.ty[i] + f.fast_ty[i]) * iI;
-      s.wz[i] += h * (f.tz[i] + f.fast_tz[i]) * iI;
-    };
-    int alarm = 0;
-    for (int j = 1; j <= k; ++j)
-    {
-      for (const std::int32_t i : S.movers)
-      {
-        const std::size_t iu = U(i);
-        kick(iu);
-        s.x[iu] += delta * s.vx[iu];
-        s.y[iu] += delta * s.vy[iu];
-        s.z[iu] += delta * s.vz[iu];
-      }
-      // The slow partners on their straight drift (at the last substep exactly where it ends).
-      const double back = (k - j) * delta;
-      for (std::size_t n = 0; n < S.dragged.size(); ++n)
-      {
-        const std::size_t d = U(S.dragged[n]);
-        s.x[d] = S.end_x[n] - back * s.vx[d];
-        s.y[d] = S.end_y[n] - back * s.vy[d];
-        s.z[d] = S.end_z[n] - back * s.vz[d];
-      }
-      alarm |= fast_forces(delta, mine, true);
-      for (const std::int32_t i : S.movers)
-        kick(U(i));
-    }
-    for (std::size_t n = 0; n < S.dragged.size(); ++n)
-    {
-      const std::size_t d = U(S.dragged[n]);
-      s.x[d] = S.end_x[n];
-      s.y[d] = S.end_y[n];
-      s.z[d] = S.end_z[n];
-      // The reaction summed over the substeps, as an average force over the step.
-      const double inv_k = 1.0 / k;
-      f.fast_fx[d] *= inv_k;
-      f.fast_fy[d] *= inv_k;
-      f.fast_fz[d] *= inv_k;
-      f.fast_tx[d] *= inv_k;
-      f.fast_ty[d] *= inv_k;
-      f.fast_tz[d] *= inv_k;
-    }
-    copy_fast_history(true);
-    mine.overlap_alarm |= alarm;
-    // This step's largest move (the held force terms renew by it) and the fast particles' state.
-    double step2 = 0.0;
-    for (std::size_t n = 0; n < S.movers.size(); ++n)
-    {
-      const std::size_t i = U(S.movers[n]);
-      const double dx = s.x[i] - S.start_x[n], dy = s.y[i] - S.start_y[n], dz = s.z[i] - S.start_z[n];
-      step2 = std::max(step2, dx * dx + dy * dy + dz * dz);
-      if (!std::isfinite(s.vx[i] + s.vy[i] + s.vz[i] + s.wx[i] + s.wy[i] + s.wz[i] + s.x[i] + s.y[i] + s.z[i]) &&
-          mine.not_finite.particle < 0)
-        mine.not_finite.set(static_cast<long>(i), s.position(i));
-    }
-    mine.max_step2 = std::max(mine.max_step2, step2);
+    const std::size_t m = static_cast<std::size_t>(n), d = U(S.dragged[m]);
+    S.end_x[m] = s.x[d];
+    S.end_y[m] = s.y[d];
+    S.end_z[m] = s.z[d];
+    f.fast().zero(d);
   }
+#pragma omp for schedule(static) nowait
+  for (long n = 0; n < movers; ++n)
+  {
+    const std::size_t i = U(S.movers[static_cast<std::size_t>(n)]);
+    S.start_x[static_cast<std::size_t>(n)] = s.x[i];
+    S.start_y[static_cast<std::size_t>(n)] = s.y[i];
+    S.start_z[static_cast<std::size_t>(n)] = s.z[i];
+  }
+  copy_fast_history(false); // (ends with a barrier)
+  // A fast particle's kick: the held force of the step plus its fast force.
+  auto kick = [&](std::size_t i) {
+    const double im = s.inv_mass[i], iI = s.inv_inertia[i];
+    s.vx[i] += h * (f.fx[i] + f.fast_fx[i]) * im;
+    s.vy[i] += h * (f.fy[i] + f.fast_fy[i]) * im;
+    s.vz[i] += h * (f.fz[i] + f.fast_fz[i]) * im;
+    s.wx[i] += h * (f.tx[i] + f.fast_tx[i]) * iI;
+    s.wy[i] += h * (f.ty[i] + f.fast_ty[i]) * iI;
+    s.wz[i] += h * (f.tz[i] + f.fast_tz[i]) * iI;
+  };
+  int alarm = 0;
+  for (int j = 1; j <= k; ++j)
+  {
+#pragma omp for schedule(static) nowait
+    for (long n = 0; n < movers; ++n)
+    {
+      const std::size_t iu = U(S.movers[static_cast<std::size_t>(n)]);
+      kick(iu);
+      s.x[iu] += delta * s.vx[iu];
+      s.y[iu] += delta * s.vy[iu];
+      s.z[iu] += delta * s.vz[iu];
+    }
+    // The slow partners on their straight drift (at the last substep exactly where it ends).
+    const double back = (k - j) * delta;
+#pragma omp for schedule(static) nowait
+    for (long n = 0; n < dragged; ++n)
+    {
+      const std::size_t m = static_cast<std::size_t>(n), d = U(S.dragged[m]);
+      s.x[d] = S.end_x[m] - back * s.vx[d];
+      s.y[d] = S.end_y[m] - back * s.vy[d];
+      s.z[d] = S.end_z[m] - back * s.vz[d];
+    }
+    // (fast_forces starts with the pairs, which read every position: its barrier comes after
+    // them, so the positions must be complete first.)
+#pragma omp barrier
+    alarm |= fast_forces(delta, mine); // (ends with a barrier)
+#pragma omp for schedule(static)
+    for (long n = 0; n < movers; ++n)
+      kick(U(S.movers[static_cast<std::size_t>(n)]));
+  }
+  const double inv_k = 1.0 / k;
+#pragma omp for schedule(static) nowait
+  for (long n = 0; n < dragged; ++n)
+  {
+    const std::size_t m = static_cast<std::size_t>(n), d = U(S.dragged[m]);
+    s.x[d] = S.end_x[m];
+    s.y[d] = S.end_y[m];
+    s.z[d] = S.end_z[m];
+    // The reaction summed over the substeps, as an average force over the step.
+    f.fast_fx[d] *= inv_k;
+    f.fast_fy[d] *= inv_k;
+    f.fast_fz[d] *= inv_k;
+    f.fast_tx[d] *= inv_k;
+    f.fast_ty[d] *= inv_k;
+    f.fast_tz[d] *= inv_k;
+  }
+  mine.overlap_alarm |= alarm;
+  // This step's largest move (the held force terms renew by it) and the fast particles' state.
+  double step2 = 0.0;
+#pragma omp for schedule(static) nowait
+  for (long n = 0; n < movers; ++n)
+  {
+    const std::size_t m = static_cast<std::size_t>(n), i = U(S.movers[m]);
+    const double dx = s.x[i] - S.start_x[m], dy = s.y[i] - S.start_y[m], dz = s.z[i] - S.start_z[m];
+    step2 = std::max(step2, dx * dx + dy * dy + dz * dz);
+    if (!std::isfinite(s.vx[i] + s.vy[i] + s.vz[i] + s.wx[i] + s.wy[i] + s.wz[i] + s.x[i] + s.y[i] + s.z[i]) &&
+        mine.not_finite.particle < 0)
+      mine.not_finite.set(static_cast<long>(i), s.position(i));
+  }
+  mine.max_step2 = std::max(mine.max_step2, step2);
+  copy_fast_history(true); // (ends with a barrier)
 }
 
 // The slow particles' fast reaction (the average over the step's substeps) joins their

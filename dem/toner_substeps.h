@@ -36,9 +36,10 @@
 // segment between two positions within half a skin of the build position is within half a
 // skin too.
 //
-// The substeps run on one thread (deterministic: the same bits on any number of threads;
-// their work is the toner's contacts, a small part of a step). k = 1 is the engine without
-// substeps, bit for bit (no mask, no extra pass).
+// The substeps share their work among the team's threads: the fast pairs in blocks (each pair
+// writes only its own slot), then each particle sums its own pairs in pair order and adds its
+// walls — the order of one thread's pass, so the bits are the same on any number of threads.
+// k = 1 is the engine without substeps, bit for bit (no mask, no extra pass).
 #pragma once
 
 #include <cstdint>
@@ -62,6 +63,11 @@ struct TonerSubsteps
   std::vector<std::int32_t> movers;  // the fast particles, ascending
   std::vector<std::int32_t> dragged; // the slow particles of fast pairs, ascending
   std::vector<char> mark;            // per particle (scratch of the build)
+  // Each mover's and each dragged particle's fast pairs (CSR over S.movers and S.dragged), in
+  // ascending pair order: 2 q for the pair's owner, 2 q + 1 for its partner. A particle sums its
+  // pairs' forces in this order on any number of threads, the order of a serial pass over the pairs.
+  std::vector<std::int32_t> mover_begin, mover_pairs, dragged_begin, dragged_pairs;
+  std::vector<std::int32_t> member_of; // per particle (scratch of the build): its mover or dragged index
 
   // Scratch of the substeps (sized at the build: no allocation inside a step).
   std::vector<double> hx, hy, hz;                  // the fast pairs' history

@@ -232,7 +232,7 @@ DemSystem::Pause DemSystem::run_team(long &steps_left, Resume from)
       if (at != Resume::final_kick)
       {
         // The toner's substeps (toner_substeps.h): its motion over this step, before the
-        // slow forces at the step's end (one thread works, the others wait).
+        // slow forces at the step's end (the threads share it, toner_substeps.h).
         if (substeps_.on())
         {
           toner_substeps_phase(mine);

@@ -48,6 +48,8 @@ const cli::CommandSpec &report_command_line()
     s.description = R"(Writes the report of a finished run of CASE into <output.directory>/report/ (or DIR):
   nip_slip.png, nip_pressure.png, nip_ratio.png, nip_density.png, nip_force_per_bead.png,
   chain_inclination.png   profiles along the nip (Kawamoto Fig. 17-20), when the scene has a drum
+  brush_height.png        the brush's tip height against the gap and the carriers per sleeve area
+                          along the sleeve, when the scene has a drum
   flux_profile.png        the computed sleeve flux (over output.measured_flux_file's scan if given)
   brush_snapshot.png      the brush in the nip at the last snapshot, beads coloured by speed
   time_series.png         kinetic energy, contacts, wall loads, bead budget

@@ -234,6 +234,7 @@ void print_outputs(const Case &c)
       {"nip profile (CSV)", results / "dem" / "nip_profile.csv"},
       {"nip key numbers (CSV)", results / "dem" / "nip_summary.csv"},
       {"chain inclination (CSV)", results / "dem" / "chain_inclination.csv"},
+      {"brush height (CSV)", results / "dem" / "brush_height.csv"},
       {"nip bead budget (CSV)", results / "dem" / "nip_time_series.csv"},
       {"DEM log", results / "dem" / "dem.log"},
       {"checkpoint (restart)", results / "dem" / "checkpoint.bin"},

@@ -8,7 +8,7 @@ Called by `magbrush report CASE` (which checks the inputs and finds this script)
               [--sleeve-radius R --drum-radius RD --drum-center X,Y]
 
 Reads (what exists): dem/nip_profile.csv, nip_summary.csv, chain_inclination.csv,
-nip_time_series.csv (the nip measurements), time_series.csv, the last snapshot in
+brush_height.csv, nip_time_series.csv (the nip measurements), time_series.csv, the last snapshot in
 dem/snapshots/, dem/dem.log (time per phase and force term, written by `magbrush run`),
 <field-prefix>profile_sleeve.csv, dem/summary.csv (every key number with its standard error and
 bound), <out>/case_resolved.txt and the run folder's variant.txt (the inputs and overrides).
@@ -397,6 +397,31 @@ def chain_plot(plt, chains, flux, out):
     save(fig, os.path.join(out, "chain_inclination.png"))
     plt.close(fig)
     return "chain_inclination.png"
+
+
+def brush_height_plot(plt, brush, out):
+    """The brush's tip height against the gap along the sleeve (where the two meet, the brush
+    presses the drum), and the developer per sleeve area under it (a pile before the gap shows
+    as mass piling up where the tips already fill the gap)."""
+    theta = brush["theta_deg"]
+    fig, (top, bottom) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
+    top.plot(theta, [g * 1e3 for g in brush["gap_mm"]], "-", color="0.3", label="gap (sleeve to drum along the radius)")
+    top.plot(theta, [h * 1e3 for h in brush["tip_height_mm"]], "o-", label="brush tip (highest bead top, time mean)")
+    finite = [g * 1e3 for g in brush["gap_mm"] if isinstance(g, float) and math.isfinite(g)]
+    if finite:
+        top.set_ylim(0, min(max(finite), 3 * min(finite)))
+    top.set_ylabel("height above the sleeve [um]")
+    top.set_title("Brush height along the sleeve")
+    bottom.plot(theta, brush["mass_per_area_kg_m2"], "s-", color="tab:green")
+    bottom.set_ylabel("carriers per sleeve area [kg/m²]")
+    bottom.set_xlabel("sleeve angle from the gap centre [deg] (positive downstream)")
+    for ax in (top, bottom):
+        ax.axvline(0, color="0.7", lw=0.8)
+        ax.grid(alpha=0.3)
+    top.legend(fontsize=8)
+    save(fig, os.path.join(out, "brush_height.png"))
+    plt.close(fig)
+    return "brush_height.png"
 
 
 def flux_plot(plt, flux, measured, out, case_name):
@@ -854,8 +879,8 @@ def build_index(args, images, rows, run_times, phases, snapshot_time, dem_done, 
         links.append(("particles (ParaView, time series)", os.path.relpath(xdmf, args.out)))
     for vtu in sorted(glob.glob(args.field_prefix + "*.pvtu")):
         links.append(("field " + os.path.basename(vtu), os.path.relpath(vtu, args.out)))
-    for name in ("nip_profile.csv", "nip_summary.csv", "chain_inclination.csv", "nip_time_series.csv",
-                 "time_series.csv", "dem.log"):
+    for name in ("nip_profile.csv", "nip_summary.csv", "chain_inclination.csv", "brush_height.csv",
+                 "nip_time_series.csv", "time_series.csv", "dem.log"):
         p = os.path.join(args.dem_dir, name)
         if os.path.exists(p):
             links.append((name, os.path.relpath(p, args.out)))
@@ -989,6 +1014,7 @@ def main():
         profile = read_csv(os.path.join(args.dem_dir, "nip_profile.csv"))
         summary = read_summary(os.path.join(args.dem_dir, "nip_summary.csv"))
         chains = read_csv(os.path.join(args.dem_dir, "chain_inclination.csv"))
+        brush = read_csv(os.path.join(args.dem_dir, "brush_height.csv"))
         nip_series = read_csv(os.path.join(args.dem_dir, "nip_time_series.csv"))
         flux_raw = read_csv(args.field_prefix + "profile_sleeve.csv")
         measured = read_csv(args.measured_flux) if args.measured_flux else None
@@ -1017,6 +1043,8 @@ def main():
                             drum_friction(log), magnetic_pressure if isinstance(magnetic_pressure, float) else None)
     if chains:
         images.append(chain_plot(plt, chains, flux, args.out))
+    if brush:
+        images.append(brush_height_plot(plt, brush, args.out))
     if flux:
         images.append(flux_plot(plt, flux, measured, args.out, args.case_name))
     snap = last_snapshot(args.dem_dir)

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace magbrush::dem {
@@ -47,6 +48,17 @@ double NipFrame::x_along(double px, double py) const
 {
   const double h = sleeve_radius + 0.5 * gap; // P0 = S + h n; P0·t = S·t
   return (px - sx - h * nx) * tx + (py - sy - h * ny) * ty;
+}
+
+double NipFrame::radial_gap(double theta) const
+{
+  // The point S + λ u on the radius u = cos θ n + sin θ t lies on the drum where
+  // λ² − 2 λ D cos θ + D² − Rd² = 0 (D = |C − S|); the nearer root is the drum's near side.
+  const double D = std::hypot(cx - sx, cy - sy);
+  const double disc = drum_radius * drum_radius - D * D * std::sin(theta) * std::sin(theta);
+  if (disc < 0.0 || std::cos(theta) <= 0.0)
+    return std::numeric_limits<double>::quiet_NaN();
+  return D * std::cos(theta) - std::sqrt(disc) - sleeve_radius;
 }
 
 double NipFrame::sleeve_angle(double px, double py) const

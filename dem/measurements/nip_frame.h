@@ -46,6 +46,9 @@ struct NipFrame
   double drum_arc_of_x(double x) const;
   double drum_angle_of_x(double x) const;
   double sleeve_angle_of_x(double x) const;
+  // The gap along the sleeve's radius at sleeve angle θ: from the sleeve surface to the drum
+  // surface [m] (the development gap at θ = 0; NaN where that radius misses the drum).
+  double radial_gap(double theta) const;
   // Sleeve surface speed minus drum surface speed along t at the nip (0.135 m/s in the paper).
   double relative_surface_speed() const;
   // Velocity of the drum surface material at (px, py) [m/s].

@@ -110,7 +110,7 @@ INSTANTIATE_TEST_SUITE_P(
               true,
               "--set dem.duration=0.2ms --set dem.settle_time=0.05ms --set nip.average_from=0s "
               "--set dem.checkpoint_interval=0.1ms",
-              {"chain_inclination.csv", "flow_report.csv", "nip_profile.csv", "nip_summary.csv", "nip_time_series.csv",
+              {"chain_inclination.csv", "brush_height.csv", "flow_report.csv", "nip_profile.csv", "nip_summary.csv", "nip_time_series.csv",
                "summary.csv"}},
         Scene{"development",
               "tests/scenes/development/development_cell.yaml",

@@ -2,6 +2,7 @@
 // drum with known forces and velocities (exact bin values), hand-placed bead pairs with known
 // branch directions (exact inclinations), beads moved across the nip window (exact counts),
 // and one engine step with beads pressed on a turning drum (Hertz force, slip = −drum speed).
+#include "dem/measurements/brush_height.h"
 #include "dem/measurements/chain_inclination.h"
 #include "dem/measurements/nip_frame.h"
 #include "dem/measurements/nip_profile.h"
@@ -311,6 +312,80 @@ TEST(ChainInclination, HandPlacedPairsGiveTheirBranchAngle)
   EXPECT_TRUE(std::isnan(at(18).inclination)); // no contact there
   // Pairs farther apart than the sum of radii are not contacts.
   EXPECT_EQ(sample({{12.7e-3, 0, 0.5e-3}, {12.7e-3 + 61e-6, 0, 0.5e-3}}, {r, r})[10].contacts, 0.0);
+}
+
+TEST(BrushHeight, StackedBeadsGiveTheirTipHeightMassAndTheGap)
+{
+  Case c = nip_case(0.0);
+  c.nip.chain_bin_angle = 2.0 * pi / 180.0;
+  c.nip.chain_half_angle = 20.0 * pi / 180.0;
+  c.nip.average_from = 0.0;
+  Population toner = c.populations.front();
+  toner.name = "toner";
+  toner.kind = ParticleKind::toner;
+  c.populations.push_back(toner);
+  const double deg = pi / 180.0, rs = 12.5e-3, r = 30e-6, rho = c.material("carrier").density;
+  const double m = rho * 4.0 / 3.0 * pi * r * r * r;
+  DemSystem system(c);
+  auto place = [&](double theta_deg, double centre_height, int species) {
+    const double rm = rs + centre_height;
+    system.particles().add({rm * std::cos(theta_deg * deg), rm * std::sin(theta_deg * deg), 0.5e-3}, r, rho, species,
+                           0.0);
+  };
+  // At the gap centre (bin 0°) a stack whose tops are 60, 120 and 180 um above the sleeve, and
+  // a toner particle above it (not part of the brush); one bead in the bin at -6°.
+  place(0.3, 30e-6, 0);
+  place(-0.4, 90e-6, 0);
+  place(0.2, 150e-6, 0);
+  place(0.0, 300e-6, 1);
+  place(-6.4, 100e-6, 0);
+  system.initialize();
+  BrushHeight brush(c);
+  brush.sample(system);
+  // Second sample: the top bead of the stack sinks to 90 um (the tip is then the 120 um bead),
+  // the bead at -6° leaves the profile.
+  ParticleState &p = system.particles();
+  auto move = [&](std::size_t i, double theta_deg, double centre_height) {
+    p.x[i] = (rs + centre_height) * std::cos(theta_deg * deg);
+    p.y[i] = (rs + centre_height) * std::sin(theta_deg * deg);
+  };
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (std::abs(p.radius[i] - r) < 1e-12 && p.species[i] == 0 &&
+        std::abs(std::hypot(p.x[i], p.y[i]) - (rs + 150e-6)) < 1e-9)
+      move(i, 0.2, 60e-6);
+    else if (std::abs(std::atan2(p.y[i], p.x[i]) + 6.4 * deg) < 1e-9)
+      move(i, -30.0, 100e-6);
+  brush.sample(system);
+  ASSERT_EQ(brush.samples(), 2);
+  const auto bins = brush.bins();
+  auto at = [&](double theta_deg) { return bins[static_cast<std::size_t>(std::lround(theta_deg / 2.0) + 10)]; };
+  const double bin_area = rs * 2.0 * deg * 1e-3;
+  EXPECT_NEAR(at(0).tip_height, 0.5 * (180e-6 + 120e-6), 1e-12);
+  EXPECT_NEAR(at(0).carriers, 3.0, 0.0);
+  EXPECT_NEAR(at(0).mass_per_area, 3.0 * m / bin_area, 1e-9 * m / bin_area);
+  EXPECT_NEAR(at(-6).tip_height, 130e-6, 1e-12); // averaged over the sample that held a bead
+  EXPECT_NEAR(at(-6).carriers, 0.5, 0.0);        // but its mass over both
+  EXPECT_NEAR(at(-6).mass_per_area, 0.5 * m / bin_area, 1e-9 * m / bin_area);
+  EXPECT_TRUE(std::isnan(at(8).tip_height));
+  EXPECT_EQ(at(8).mass_per_area, 0.0);
+  // The gap: the development gap at the line of centres; elsewhere the point that far out along
+  // the sleeve's radius lies on the drum (drum centre at Rs + gap + Rd on +x), and the gap widens.
+  EXPECT_NEAR(at(0).gap, 0.4e-3, 1e-15);
+  const double d = rs + 0.4e-3 + 50e-3;
+  for (double theta : {-20.0, -10.0, 6.0, 20.0})
+  {
+    const double g = at(theta).gap, rp = rs + g;
+    EXPECT_NEAR(std::hypot(rp * std::cos(theta * deg) - d, rp * std::sin(theta * deg)), 50e-3, 1e-12) << theta;
+    EXPECT_GT(g, 0.4e-3);
+  }
+  EXPECT_NEAR(at(-10).gap, at(10).gap, 1e-15);
+  // Written and read back (the checkpoint's state): the same profile.
+  MemoryStateOut out;
+  brush.write_state(out);
+  BrushHeight restored(c);
+  MemoryStateIn in(out.bytes(), "test");
+  restored.read_state(in);
+  EXPECT_EQ(restored.csv(), brush.csv());
 }
 
 TEST(NipTimeSeries, CountsBeadsCrossingTheWindowAndLostBeads)

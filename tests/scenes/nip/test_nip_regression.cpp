@@ -131,7 +131,7 @@ void report_shows_every_plot(const ReducedNipRun &run)
 {
   const fs::path report = run.dir / "results" / "report";
   const std::string html = file_text(report / "index.html"), md = file_text(report / "index.md");
-  for (const char *f : {"nip_slip.png", "nip_pressure.png", "brush_snapshot.png", "chain_inclination.png",
+  for (const char *f : {"nip_slip.png", "nip_pressure.png", "brush_snapshot.png", "chain_inclination.png", "brush_height.png",
                         "flux_profile.png", "time_series.png"})
   {
     const auto [w, h] = png_size(report / f);
@@ -144,7 +144,7 @@ void report_shows_every_plot(const ReducedNipRun &run)
 
 void pipeline_runs_to_the_report(const ReducedNipRun &run)
 {
-  for (const char *f : {"nip_profile.csv", "nip_summary.csv", "chain_inclination.csv", "nip_time_series.csv"})
+  for (const char *f : {"nip_profile.csv", "nip_summary.csv", "chain_inclination.csv", "brush_height.csv", "nip_time_series.csv"})
     EXPECT_TRUE(fs::exists(run.dem() / f)) << f; // each read by the checks below
   // The snapshot index names the HDF5 file that holds the positions, and that file is there.
   const std::string xdmf = file_text(run.dem() / "particles.xdmf");

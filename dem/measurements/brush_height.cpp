@@ -20,10 +20,9 @@ constexpr double to_deg = 180.0 / M_PI;
 constexpr double no_bead = -std::numeric_limits<double>::infinity();
 } // namespace
 
-BrushHeight::BrushHeight(const Case &c) : settings_(c.nip), frame_(NipFrame::from_case(c))
+BrushHeight::BrushHeight(const Case &c) : settings_(c.nip), frame_(NipFrame::from_case(c)), bins_(c.nip)
 {
-  bins_half_ = static_cast<int>(std::lround(settings_.chain_half_angle / settings_.chain_bin_angle));
-  const auto n = static_cast<std::size_t>(2 * bins_half_ + 1);
+  const std::size_t n = bins_.size();
   tip_sum_.assign(n, 0.0);
   tip_samples_.assign(n, 0.0);
   mass_sum_.assign(n, 0.0);
@@ -31,14 +30,6 @@ BrushHeight::BrushHeight(const Case &c) : settings_(c.nip), frame_(NipFrame::fro
   tip_now_.assign(n, no_bead);
   for (const auto &p : c.populations)
     species_is_carrier_.push_back(p.kind == ParticleKind::carrier);
-}
-
-int BrushHeight::bin_of(double theta) const
-{
-  const long k = std::lround(theta / settings_.chain_bin_angle);
-  if (std::abs(k) > bins_half_)
-    return -1;
-  return static_cast<int>(k) + bins_half_;
 }
 
 void BrushHeight::sample(const DemSystem &system)
@@ -56,7 +47,7 @@ void BrushHeight::sample(const DemSystem &system)
     const auto s = static_cast<std::size_t>(p.species[i]);
     if (s < species_is_carrier_.size() && !species_is_carrier_[s])
       continue;
-    const int b = bin_of(frame_.sleeve_angle(p.x[i], p.y[i]));
+    const int b = bins_.of(frame_.sleeve_angle(p.x[i], p.y[i]));
     if (b < 0)
       continue;
     const auto k = static_cast<std::size_t>(b);
@@ -77,12 +68,11 @@ std::vector<BrushHeightBin> BrushHeight::bins() const
 {
   std::vector<BrushHeightBin> out;
   const double per_sample = samples_ > 0 ? 1.0 / static_cast<double>(samples_) : nan;
-  const double bin_area = frame_.sleeve_radius * settings_.chain_bin_angle * frame_.slab_depth;
-  for (int k = -bins_half_; k <= bins_half_; ++k)
+  const double bin_area = frame_.sleeve_radius * bins_.width * frame_.slab_depth;
+  for (std::size_t i = 0; i < bins_.size(); ++i)
   {
-    const auto i = static_cast<std::size_t>(k + bins_half_);
     BrushHeightBin b;
-    b.theta = k * settings_.chain_bin_angle;
+    b.theta = bins_.centre(i);
     b.gap = frame_.radial_gap(b.theta);
     b.tip_height = tip_samples_[i] > 0.0 ? tip_sum_[i] / tip_samples_[i] : nan;
     b.mass_per_area = mass_sum_[i] * per_sample / bin_area;

@@ -21,6 +21,7 @@
 
 #include "dem/measurement.h"
 #include "dem/measurements/nip_frame.h"
+#include "dem/measurements/sleeve_angle_bins.h"
 
 #include "coupling/case_model.h"
 
@@ -58,7 +59,7 @@ public:
 private:
   NipSettings settings_;
   NipFrame frame_;
-  int bins_half_ = 0;
+  SleeveAngleBins bins_;
   // Per bin, summed over samples: the highest bead top (in samples where the bin holds one),
   // those samples, the carriers' mass and their number.
   std::vector<double> tip_sum_, tip_samples_, mass_sum_, count_sum_;
@@ -67,7 +68,6 @@ private:
   double t_first_ = -1.0, t_last_ = -1.0;
   std::vector<bool> species_is_carrier_; // by population index
 
-  int bin_of(double theta) const;
 };
 
 } // namespace magbrush::dem

@@ -21,24 +21,15 @@ constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 constexpr double to_deg = 180.0 / M_PI;
 } // namespace
 
-ChainInclination::ChainInclination(const Case &c) : settings_(c.nip), frame_(NipFrame::from_case(c))
+ChainInclination::ChainInclination(const Case &c) : settings_(c.nip), frame_(NipFrame::from_case(c)), bins_(c.nip)
 {
-  bins_half_ = static_cast<int>(std::lround(settings_.chain_half_angle / settings_.chain_bin_angle));
-  const auto n = static_cast<std::size_t>(2 * bins_half_ + 1);
+  const std::size_t n = bins_.size();
   ftt_.assign(n, 0.0);
   fnn_.assign(n, 0.0);
   ftn_.assign(n, 0.0);
   count_.assign(n, 0.0);
   for (const auto &p : c.populations)
     species_is_carrier_.push_back(p.kind == ParticleKind::carrier);
-}
-
-int ChainInclination::bin_of(double theta) const
-{
-  const long k = std::lround(theta / settings_.chain_bin_angle);
-  if (std::abs(k) > bins_half_)
-    return -1;
-  return static_cast<int>(k) + bins_half_;
 }
 
 void ChainInclination::sample(const DemSystem &system)
@@ -73,7 +64,7 @@ void ChainInclination::sample(const DemSystem &system)
 void ChainInclination::add_contact(const Vector3 &a, const Vector3 &d)
 {
   const Vector3 m = a + 0.5 * d;
-  const int b = bin_of(frame_.sleeve_angle(m.x, m.y));
+  const int b = bins_.of(frame_.sleeve_angle(m.x, m.y));
   if (b < 0)
     return;
   const double rx = m.x - frame_.sx, ry = m.y - frame_.sy, r = std::hypot(rx, ry);
@@ -93,11 +84,10 @@ std::vector<ChainBin> ChainInclination::bins() const
 {
   std::vector<ChainBin> out;
   const double per_sample = samples_ > 0 ? 1.0 / static_cast<double>(samples_) : nan;
-  for (int k = -bins_half_; k <= bins_half_; ++k)
+  for (std::size_t i = 0; i < bins_.size(); ++i)
   {
-    const auto i = static_cast<std::size_t>(k + bins_half_);
     ChainBin b;
-    b.theta = k * settings_.chain_bin_angle;
+    b.theta = bins_.centre(i);
     b.contacts = count_[i] * per_sample;
     const double trace = ftt_[i] + fnn_[i];
     if (count_[i] > 0.0 && trace > 0.0)

@@ -19,6 +19,7 @@
 
 #include "dem/measurement.h"
 #include "dem/measurements/nip_frame.h"
+#include "dem/measurements/sleeve_angle_bins.h"
 #include "dem/vector3.h"
 
 #include "coupling/case_model.h"
@@ -56,13 +57,12 @@ public:
 private:
   NipSettings settings_;
   NipFrame frame_;
-  int bins_half_ = 0;
+  SleeveAngleBins bins_;
   std::vector<double> ftt_, fnn_, ftn_, count_;
   long samples_ = 0;
   double t_first_ = -1.0, t_last_ = -1.0;
   std::vector<bool> species_is_carrier_; // by population index: toner is not part of the chains
 
-  int bin_of(double theta) const;
   void add_contact(const Vector3 &a, const Vector3 &d);
 };
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The pipeline's error-against-cost table (issue 15 item 4): every accuracy knob of the
+"""The pipeline's error-against-cost table: every accuracy knob of the
 field solver, the DEM's magnetics and the electrostatics, varied ONE AT A TIME from a
 converged reference, against the observables a user reads, with the wall time of the stage
 the knob affects.

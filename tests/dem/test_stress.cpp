@@ -1,4 +1,4 @@
-// The stress suite (issue 15, item 1): the engine pushed to where it breaks. Each case must
+// The stress suite: the engine pushed to where it breaks. Each case must
 // either give the right answer (checked against an exact result) or stop with a message that
 // names the cause — and, in a run, keep a last good checkpoint and write nothing that is not a
 // number (time series, snapshots and checkpoint are read back). Each case appends a row to the suite's table (stress_table.h; tools/stress,

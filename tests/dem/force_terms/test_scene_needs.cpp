@@ -1,4 +1,4 @@
-// "Skip what a scene doesn't need" (issue 15, item 5), asserted: each force term's rule
+// "Skip what a scene doesn't need", asserted: each force term's rule
 // (dem/force_terms/force_term_registry.h) turns it off, with the reason the log prints, when
 // the scene gives it nothing to do —
 //   no charged population (no toner)     → no Coulomb, no conductor images, no qE;

@@ -1,7 +1,7 @@
 // The ten-line summary of a case (case_at_a_glance.h).
 #include "app/case_at_a_glance.h"
 
-#include "coupling/units.h"
+#include "case/units.h"
 
 #include <cmath>
 #include <sstream>

@@ -4,7 +4,7 @@
 // lines of the resolved case, which go to <run folder>/case_resolved.txt.
 #pragma once
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <string>
 

@@ -4,9 +4,10 @@
 // Exit codes: 0 valid, 1 invalid case, 2 usage error.
 #include "app/subcommand.h"
 
-#include "coupling/case_format.h"
-#include "coupling/case_hash.h"
-#include "coupling/case_parser.h"
+#include "case/case_format.h"
+#include "case/case_hash.h"
+#include "case/case_parser.h"
+#include "fields/pole_field_summary.h"
 
 #include <iostream>
 
@@ -78,7 +79,7 @@ int check(const magbrush::cli::ParsedArguments &args)
     }
     std::cout << "# " << c.source_file << ": valid\n# resolved case (every key, defaults filled in):\n"
               << magbrush::format_case(c) << "\n# derived\n"
-              << magbrush::format_derived(c) << "\n# field input hashes\n"
+              << magbrush::format_derived(c) << magbrush::format_pole_field(c) << "\n# field input hashes\n"
               << "magnetic field  " << magbrush::field_hash(c, magbrush::FieldKind::magnetic) << "\n"
               << "electric field  " << magbrush::field_hash(c, magbrush::FieldKind::electric) << "\n";
     return 0;

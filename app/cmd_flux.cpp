@@ -22,12 +22,12 @@
 #include "calibration/pole_fit.h"
 #include "common/atomic_file.h"
 #include "common/child_process.h"
-#include "coupling/case_hash.h"
-#include "coupling/case_parser.h"
-#include "coupling/field_files.h"
-#include "coupling/field_grid.h"
-#include "coupling/multipole_ring.h"
-#include "coupling/units.h"
+#include "case/case_hash.h"
+#include "case/case_parser.h"
+#include "fields/field_files.h"
+#include "fields/field_grid.h"
+#include "fields/multipole_ring.h"
+#include "case/units.h"
 
 #include <yaml-cpp/yaml.h>
 

@@ -5,8 +5,8 @@
 #include "app/subcommand.h"
 
 #include "common/atomic_file.h"
-#include "coupling/case_hash.h"
-#include "coupling/case_parser.h"
+#include "case/case_hash.h"
+#include "case/case_parser.h"
 #include "geometry/mesh_common.h"
 #include "geometry/mesh_nip.h"
 #include "geometry/mesh_roller.h"
@@ -19,7 +19,7 @@
 namespace {
 
 // A mesh is up to date when it exists and the digest of the inputs it was written from
-// (coupling/case_hash.h mesh_hash, stored next to it as <mesh>.inputs) equals the case's: then
+// (case/case_hash.h mesh_hash, stored next to it as <mesh>.inputs) equals the case's: then
 // it is not rewritten (meshing the roller takes ~10 s). The reason for remeshing is printed.
 std::string inputs_file(const std::string &mesh) { return mesh + ".inputs"; }
 

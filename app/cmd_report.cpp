@@ -17,10 +17,10 @@
 #include "calibration/flux_scan.h"
 #include "common/atomic_file.h"
 #include "common/child_process.h"
-#include "coupling/case_format.h"
-#include "coupling/case_parser.h"
-#include "coupling/field_files.h"
-#include "coupling/run_folder.h"
+#include "case/case_format.h"
+#include "case/case_parser.h"
+#include "fields/field_files.h"
+#include "case/run_folder.h"
 
 #include <cmath>
 #include <cstdio>

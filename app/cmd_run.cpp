@@ -5,7 +5,7 @@
 //
 //   --quick: the case's duration and every window scaled (app/quick_preset.h), as overrides
 //   check: quietly; then the case in ten lines (app/case_at_a_glance.h), the resolved case and
-//   the overrides written into the run folder (coupling/run_folder.h names it)
+//   the overrides written into the run folder (case/run_folder.h names it)
 //   for each stage: announce it (with the time it took last time: its ETA) → run it; the DEM's
 //   output is also kept in <output.directory>/dem/dem.log (the report reads its timing table)
 //   → record the stage's wall time in <output.directory>/run_times.csv
@@ -15,12 +15,12 @@
 #include "app/run_pipeline.h"
 #include "app/subcommand.h"
 
-#include "coupling/case_format.h"
-#include "coupling/case_parser.h"
-#include "coupling/run_folder.h"
+#include "case/case_format.h"
+#include "case/case_parser.h"
+#include "case/run_folder.h"
 #include "common/atomic_file.h"
-#include "coupling/field_files.h"
-#include "coupling/units.h"
+#include "fields/field_files.h"
+#include "case/units.h"
 
 #include <algorithm>
 #include <chrono>

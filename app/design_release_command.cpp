@@ -5,8 +5,8 @@
 
 #include "app/flux_tools.h"
 #include "common/atomic_file.h"
-#include "coupling/case_parser.h"
-#include "coupling/units.h"
+#include "case/case_parser.h"
+#include "case/units.h"
 #include "design/release_criterion.h"
 
 #include <algorithm>

@@ -10,7 +10,7 @@
 #include "app/study_extension.h"
 #include "app/subcommand.h"
 #include "common/child_process.h"
-#include "coupling/units.h"
+#include "case/units.h"
 #include "design/study_inverse.h"
 #include "design/study_refinement.h"
 

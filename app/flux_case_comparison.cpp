@@ -11,8 +11,8 @@
 
 #include "calibration/flux_compare.h"
 #include "common/atomic_file.h"
-#include "coupling/case_parser.h"
-#include "coupling/multipole_ring.h"
+#include "case/case_parser.h"
+#include "fields/multipole_ring.h"
 
 #include <algorithm>
 #include <cmath>

@@ -4,9 +4,9 @@
 #include "app/subcommand.h"
 #include "calibration/flux_scan.h"
 #include "common/child_process.h"
-#include "coupling/case_hash.h"
-#include "coupling/field_files.h"
-#include "coupling/field_grid.h"
+#include "case/case_hash.h"
+#include "fields/field_files.h"
+#include "fields/field_grid.h"
 
 #include <cmath>
 #include <cstdio>

@@ -4,8 +4,8 @@
 // a plotting script under tools/, and editing a case's YAML with --set overrides.
 #pragma once
 
-#include "coupling/case_model.h"
-#include "coupling/multipole_ring.h"
+#include "case/case_model.h"
+#include "fields/multipole_ring.h"
 
 #include <yaml-cpp/yaml.h>
 

@@ -1,6 +1,6 @@
 // magbrush — the user-facing driver. `magbrush <subcommand> --help` explains each step.
 #include "app/subcommand.h"
-#include "coupling/case_schema.h"
+#include "case/case_schema.h"
 
 #include <cstdlib>
 #include <filesystem>

@@ -11,7 +11,7 @@
 // themselves in its variant.txt, and leave the stored fields shared with the full run.
 #pragma once
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <string>
 #include <vector>

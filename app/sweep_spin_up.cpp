@@ -3,8 +3,8 @@
 
 #include "common/atomic_file.h"
 #include "common/command_line.h"
-#include "coupling/case_hash.h"
-#include "coupling/units.h"
+#include "case/case_hash.h"
+#include "case/units.h"
 
 #include <cmath>
 #include <cstdio>

@@ -20,7 +20,7 @@
 // spin-up it came from (folder, duration, the spin-up's case digest).
 #pragma once
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <filesystem>
 #include <optional>

@@ -8,7 +8,7 @@
 #pragma once
 
 #include "calibration/flux_scan.h"
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <string>
 #include <vector>

@@ -32,8 +32,8 @@
 #include "calibration/flux_scan.h"
 #include "calibration/nested_model_test.h"
 #include "calibration/scan_noise.h"
-#include "coupling/case_model.h"
-#include "coupling/multipole_ring.h"
+#include "case/case_model.h"
+#include "fields/multipole_ring.h"
 
 #include <string>
 #include <vector>

@@ -37,7 +37,7 @@
 #include "dem/size_distribution.h"
 #include "dem/wall_contacts.h"
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <random>
 #include <vector>

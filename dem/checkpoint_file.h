@@ -35,7 +35,7 @@
 namespace magbrush::dem {
 
 // Which case wrote a checkpoint: its hash and its resolved inputs, one (key, value) per key
-// (coupling/case_hash.h: case_inputs). Empty when the writer did not say (tests that drive
+// (case/case_hash.h: case_inputs). Empty when the writer did not say (tests that drive
 // the engine directly).
 struct CheckpointIdentity
 {

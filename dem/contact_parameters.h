@@ -4,7 +4,7 @@
 
 #include "dem/contact_law.h"
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <string>
 #include <vector>

@@ -7,7 +7,7 @@
 #include "dem/huge_page_heap.h"
 #include "dem/openmp_waiting.h"
 
-#include "coupling/case_parser.h"
+#include "case/case_parser.h"
 
 #include <cstdlib>
 #include <unistd.h>

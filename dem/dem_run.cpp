@@ -7,7 +7,7 @@
 #include "dem/openmp_waiting.h"
 #include "dem/restart_check.h"
 
-#include "coupling/case_hash.h"
+#include "case/case_hash.h"
 
 #include <omp.h>
 

@@ -21,7 +21,7 @@
 #include "dem/measurement.h"
 #include "dem/snapshot_writer.h"
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <iosfwd>
 #include <memory>

@@ -28,7 +28,7 @@
 #include "dem/wall_contact_slots.h"
 #include "dem/wall_contacts.h"
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <array>
 #include <cstdint>

@@ -11,7 +11,7 @@
 #include "dem/particle_state.h"
 #include "dem/wall_contacts.h"
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <random>
 #include <vector>

@@ -13,7 +13,7 @@
 
 #include "dem/particle_state.h"
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <random>
 #include <vector>

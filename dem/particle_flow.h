@@ -12,7 +12,7 @@
 #include "dem/particle_sink.h"
 #include "dem/particle_source.h"
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <memory>
 

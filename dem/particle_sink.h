@@ -1,5 +1,5 @@
 // The outflow: particles removed from a roller scene during the run (case keys outflow.*,
-// coupling/case_keys_flow.cpp): those in a sector of the sleeve downstream — from
+// case/case_keys_flow.cpp): those in a sector of the sleeve downstream — from
 // outflow.angle over outflow.width in the sense the sleeve turns, at any distance from the
 // axis — and those farther than outflow.outer_radius from the roller axis (they left the
 // window the scene describes). Counts what it removed per population; the counts go into
@@ -8,7 +8,7 @@
 
 #include "dem/particle_state.h"
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <cstdint>
 #include <vector>

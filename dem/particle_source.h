@@ -1,5 +1,5 @@
 // The inflow: developer fed onto the sleeve during the run, the way the sleeve carries it out
-// of the sump past the doctor blade (case keys inflow.*, coupling/case_keys_flow.cpp).
+// of the sump past the doctor blade (case keys inflow.*, case/case_keys_flow.cpp).
 //
 // A layer of developer mass per sleeve area Γ (DMA) rides on the sleeve surface, which moves
 // at v = ω R. Over a time τ the surface carries the arc R Δφ past the entry angle θ_in, with
@@ -50,7 +50,7 @@
 #include "dem/size_distribution.h"
 #include "dem/wall_contacts.h"
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <random>
 #include <vector>

@@ -1,6 +1,6 @@
 #include "dem/restart_check.h"
 
-#include "coupling/case_hash.h"
+#include "case/case_hash.h"
 
 #include <map>
 

@@ -32,7 +32,7 @@
 
 #include "dem/measurement.h"
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <memory>
 #include <string>

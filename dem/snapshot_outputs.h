@@ -5,7 +5,7 @@
 #include "dem/snapshot_writer.h"
 #include "dem/vtu_snapshot_writer.h"
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <optional>
 #include <string>

@@ -15,7 +15,7 @@
 #include "dem/contact_parameters.h"
 #include "dem/particle_state.h"
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <string>
 #include <vector>

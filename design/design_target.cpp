@@ -1,7 +1,7 @@
 // Reading design targets and constraints (see design_target.h).
 #include "design/design_target.h"
 
-#include "coupling/units.h"
+#include "case/units.h"
 
 #include <yaml-cpp/yaml.h>
 

@@ -31,7 +31,7 @@
 #pragma once
 
 #include "calibration/flux_scan.h"
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 #include "design/release_criterion.h"
 
 #include <cmath>

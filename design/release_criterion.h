@@ -23,8 +23,8 @@
 // and its flow; it ranks layouts and places the lift-off, it does not give a released fraction.
 #pragma once
 
-#include "coupling/case_model.h"
-#include "coupling/multipole_ring.h"
+#include "case/case_model.h"
+#include "fields/multipole_ring.h"
 
 #include <vector>
 

@@ -1,7 +1,7 @@
 // The exact ring's profile for fixed pole shapes (see ring_profile.h).
 #include "design/ring_profile.h"
 
-#include "coupling/multipole_ring.h"
+#include "fields/multipole_ring.h"
 
 namespace magbrush {
 

@@ -1,10 +1,10 @@
 #include "field_solver/field_app.h"
 
-#include "coupling/case_hash.h"
-#include "coupling/zero_electric_field.h"
+#include "case/case_hash.h"
+#include "fields/zero_electric_field.h"
 #include "common/atomic_file.h"
-#include "coupling/field_grid.h"
-#include "coupling/multipole_ring.h"
+#include "fields/field_grid.h"
+#include "fields/multipole_ring.h"
 #include "field_solver/nip_electrostatics.h"
 #include "field_solver/roller_magnetostatics.h"
 

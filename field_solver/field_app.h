@@ -1,10 +1,10 @@
 // The production field stage, `magbrush-field CASE`: from the case to the stored field grids
 // (HDF5, with the case hash), the ParaView files and the sleeve flux profile. Each field is
-// regenerated only when the inputs it depends on changed (coupling/case_hash.h).
+// regenerated only when the inputs it depends on changed (case/case_hash.h).
 #pragma once
 
-#include "coupling/case_model.h"
-#include "coupling/field_files.h"
+#include "case/case_model.h"
+#include "fields/field_files.h"
 
 #include <mpi.h>
 

@@ -7,7 +7,7 @@
 #include "field_solver/field_app.h"
 #include "field_solver/field_command_line.h"
 
-#include "coupling/case_parser.h"
+#include "case/case_parser.h"
 
 #include <deal.II/base/mpi.h>
 

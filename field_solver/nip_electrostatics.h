@@ -9,7 +9,7 @@
 // themselves.
 #pragma once
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 #include "field_solver/layered_meshes.h"
 #include "field_solver/potential_problem.h"
 
@@ -37,7 +37,7 @@ struct NipDiscretisation
 // centred on the nip — dark elsewhere; uniformly dark when period = 0. With an edge width w
 // the value changes from dark to light along a raised cosine over w centred on each edge. This is the image at
 // phase 0 (t ≤ 0 in the DEM); once the drum has turned, the value at s is the one this gives
-// at s − u, u the arc length the surface travelled (coupling/nip_potential_field.h).
+// at s − u, u the arc length the surface travelled (fields/nip_potential_field.h).
 double latent_image_value(const LatentImage &image, double s);
 
 class NipElectrostatics

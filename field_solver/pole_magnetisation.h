@@ -10,7 +10,7 @@
 // Header-only, no deal.II.
 #pragma once
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <cmath>
 #include <vector>

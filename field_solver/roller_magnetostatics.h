@@ -13,7 +13,7 @@
 // SphericalManifold per circle.
 #pragma once
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 #include "geometry/mesh_common.h"
 #include "field_solver/potential_problem.h"
 

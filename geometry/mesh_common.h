@@ -3,7 +3,7 @@
 // the Gmsh session guard, and the few Gmsh building blocks both meshes are made of.
 #pragma once
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <cstddef>
 #include <functional>

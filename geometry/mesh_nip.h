@@ -13,7 +13,7 @@
 // the gap has opened to 3× its width), graded to mesh_size_far.
 #pragma once
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 #include "geometry/mesh_common.h"
 #include "geometry/mesh_size.h"
 

@@ -13,7 +13,7 @@
 // edge of the DEM region (the polar field grid), graded to mesh_size_far away from it.
 #pragma once
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 #include "geometry/mesh_common.h"
 #include "geometry/mesh_size.h"
 

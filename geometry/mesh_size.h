@@ -11,7 +11,7 @@
 // the element sizes of the mesh with it.
 #pragma once
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <functional>
 #include <vector>

@@ -6,8 +6,8 @@
 // This header has no Gmsh in it: the DEM links the `magbrush_walls` library only.
 #pragma once
 
-#include "coupling/case_model.h"
-#include "coupling/case_validation.h" // polygon_signed_area, polygon_is_simple (shared with the parser)
+#include "case/case_model.h"
+#include "case/case_validation.h" // polygon_signed_area, polygon_is_simple (shared with the parser)
 
 #include <string>
 #include <utility>

@@ -1,6 +1,6 @@
 #include "magnetics/magnetic_settings.h"
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <stdexcept>
 

@@ -70,9 +70,9 @@ StalenessMode parse_staleness_mode(const std::string &name); // throws std::inva
 std::string to_string(StalenessMode mode);
 
 // The member initialisers are the defaults of a case file (the dem.magnetic_* keys in
-// coupling/case_keys_magnetics.cpp, dem.verlet_skin in coupling/case_keys_dem.cpp): settings
+// case/case_keys_magnetics.cpp, dem.verlet_skin in case/case_keys_dem.cpp): settings
 // built in code run what a user's default case runs, and a test or bench that wants another
-// scene sets it explicitly. tests/coupling/case/test_module_defaults.cpp fails when the two disagree.
+// scene sets it explicitly. tests/case/test_module_defaults.cpp fails when the two disagree.
 // The fields without a case key (torque, max_sweeps, the local-refresh and far-field details)
 // have their defaults only here.
 struct MagneticSettings

@@ -2,7 +2,7 @@
 // a key read back (file, line, key and reason are all in it).
 #pragma once
 
-#include "coupling/case_parser.h"
+#include "case/case_parser.h"
 
 #include <string>
 

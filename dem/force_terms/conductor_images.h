@@ -17,7 +17,7 @@
 #include "dem/force_term.h"
 #include "electrostatics/grounded_surface.h"
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <vector>
 

@@ -32,7 +32,7 @@
 #include "dem/force_term.h"
 #include "electrostatics/periodic_coulomb.h"
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <array>
 #include <cstdint>

@@ -4,8 +4,8 @@
 #include "dem/force_terms/force_term_registry.h"
 #include "dem/force_terms/held_forces.h"
 
-#include "coupling/field_files.h"
-#include "coupling/zero_electric_field.h"
+#include "fields/field_files.h"
+#include "fields/zero_electric_field.h"
 
 #include <cmath>
 #include <cstdio>

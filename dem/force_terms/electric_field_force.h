@@ -1,6 +1,6 @@
 // The force of the nip's applied electric field on the charged particles (Kweon eq. 6, the qE
 // part): F = q E(x, y, u(t)) for every particle with q ≠ 0, E from the stored electric grid
-// (the bias solution plus the latent image carried by the drum surface; coupling/
+// (the bias solution plus the latent image carried by the drum surface; fields/
 // nip_potential_field.h, which also defines the image's phase u(t) and its origin).
 //
 // DEM coordinates are the field's: the cross-section plane is x-y with the roller axis z at the
@@ -19,8 +19,8 @@
 
 #include "dem/force_term.h"
 
-#include "coupling/case_model.h"
-#include "coupling/nip_potential_field.h"
+#include "case/case_model.h"
+#include "fields/nip_potential_field.h"
 
 #include <array>
 #include <memory>

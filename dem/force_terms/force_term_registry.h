@@ -15,7 +15,7 @@
 
 #include "dem/force_term.h"
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <functional>
 #include <memory>

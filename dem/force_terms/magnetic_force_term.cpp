@@ -8,7 +8,7 @@
 #include "dem/dem_system.h"
 #include "dem/force_terms/force_term_registry.h"
 
-#include "coupling/field_files.h"
+#include "fields/field_files.h"
 
 #include <numeric>
 #include <omp.h>

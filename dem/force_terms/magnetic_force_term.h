@@ -29,8 +29,8 @@
 #include "magnetics/induced_dipoles.h"
 #include "magnetics/two_sphere_correction.h"
 
-#include "coupling/applied_magnetic_field.h"
-#include "coupling/case_model.h"
+#include "fields/applied_magnetic_field.h"
+#include "case/case_model.h"
 
 #include <array>
 #include <cstdint>

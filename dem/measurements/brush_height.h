@@ -23,7 +23,7 @@
 #include "dem/measurements/nip_frame.h"
 #include "dem/measurements/sleeve_angle_bins.h"
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <string>
 #include <vector>

@@ -22,7 +22,7 @@
 #include "dem/measurements/sleeve_angle_bins.h"
 #include "dem/vector3.h"
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <string>
 #include <vector>

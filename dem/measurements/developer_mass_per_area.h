@@ -2,7 +2,7 @@
 // area (DMA) on the sleeve between the blade and the nip, which sets how much developer — and
 // so how much toner — reaches the development nip.
 //
-// Every sample (case keys dma.*, coupling/case_keys_measurements.cpp):
+// Every sample (case keys dma.*, case/case_keys_measurements.cpp):
 //  * DMA, areal form: the mass of the particles in the window of width dma.window centred
 //    dma.after_blade past the blade's tip (in the sense the sleeve turns), within dma.height
 //    of the sleeve surface, over the sleeve area of the window, R Δθ L_z;
@@ -35,7 +35,7 @@
 #include "dem/measurements/line_flux.h"
 #include "dem/measurements/sample_series.h"
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <string>
 #include <vector>

@@ -10,7 +10,7 @@
 
 #include "dem/measurements/nip_frame.h"
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 namespace magbrush::dem {
 

@@ -24,7 +24,7 @@
 #include "dem/measurements/line_flux.h"
 #include "dem/measurements/sample_series.h"
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <string>
 #include <vector>

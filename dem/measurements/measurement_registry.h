@@ -13,7 +13,7 @@
 
 #include "dem/measurement.h"
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <functional>
 #include <memory>

@@ -19,7 +19,7 @@
 
 #include "dem/vector3.h"
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 namespace magbrush::dem {
 

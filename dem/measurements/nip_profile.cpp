@@ -4,8 +4,8 @@
 #include "dem/measurements/measurement_registry.h"
 #include "dem/snapshot_writer.h" // write_file_atomically
 
-#include "coupling/applied_magnetic_field.h"
-#include "coupling/field_files.h"
+#include "fields/applied_magnetic_field.h"
+#include "fields/field_files.h"
 
 #include <algorithm>
 #include <cmath>

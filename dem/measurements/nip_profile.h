@@ -41,7 +41,7 @@
 #include "dem/measurements/sample_series.h"
 #include "dem/vector3.h"
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <string>
 #include <vector>

@@ -24,7 +24,7 @@
 #include "dem/measurement.h"
 #include "dem/measurements/nip_frame.h"
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <cstdint>
 #include <string>

@@ -23,8 +23,8 @@
 
 #include "dem/measurement.h"
 
-#include "coupling/applied_magnetic_field.h"
-#include "coupling/case_model.h"
+#include "fields/applied_magnetic_field.h"
+#include "case/case_model.h"
 #include "dem/dem_system.h"
 #include "geometry/wall_primitives.h"
 

@@ -3,7 +3,7 @@
 // ±nip.chain_half_angle. Bin i (0 … size()−1) has its centre at (i − half) × width.
 #pragma once
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <cmath>
 #include <cstddef>

@@ -44,7 +44,7 @@
 #include "dem/measurements/nip_frame.h"
 #include "dem/measurements/sample_series.h"
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 #include "dem/wall_contact_slots.h"
 
 #include <cstdint>

@@ -5,7 +5,7 @@
 //    says what it changed, and the shortened case still passes `check`;
 //  * the case is printed in ten lines, not the ~230 of the resolved case.
 #include "app/quick_preset.h"
-#include "coupling/case_parser.h"
+#include "case/case_parser.h"
 #include "tests/cli_run.h"
 #include "tests/test_temp_dir.h"
 

@@ -77,7 +77,7 @@ TEST(Sweep, TabulatesEveryPointWithItsSIValueRunTimeAndMeasuredComparison)
 TEST(Sweep, PointsWithTheSameFieldInputsShareOneSolvedField)
 {
   const fs::path dir = magbrush::testing::test_temp_dir("app_sweep_fields");
-  const std::string roller = std::string(MAGBRUSH_SOURCE_DIR) + "/tests/coupling/case/valid/minimal_roller.yaml";
+  const std::string roller = std::string(MAGBRUSH_SOURCE_DIR) + "/tests/case/valid/minimal_roller.yaml";
   auto field_folders = [](const fs::path &fields) {
     int n = 0;
     for (const auto &entry : fs::directory_iterator(fields))
@@ -115,7 +115,7 @@ TEST(Sweep, PointsWithTheSameFieldInputsShareOneSolvedField)
 TEST(Sweep, AWithKeyGoesValueForValueWithTheFirstVary)
 {
   const fs::path dir = magbrush::testing::test_temp_dir("app_sweep_with");
-  const std::string roller = std::string(MAGBRUSH_SOURCE_DIR) + "/tests/coupling/case/valid/minimal_roller.yaml";
+  const std::string roller = std::string(MAGBRUSH_SOURCE_DIR) + "/tests/case/valid/minimal_roller.yaml";
   const Result r = run_magbrush(dir, {"sweep", roller, "--vary", "drum.rpm=-100rpm,-120rpm,-120rpm", "--with",
                                       "roller.poles.N1.strength=150kA/m,150kA/m,160kA/m", "--name", "zip", "--skip",
                                       "mesh,dem,report", "--set", "output.directory=" + (dir / "out").string()});

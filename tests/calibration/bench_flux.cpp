@@ -4,7 +4,7 @@
 //  2. the pole fit: harmonics of the forward model → parameter error and fit time;
 //  3. the pole fit: scan noise → parameter error (and the reported uncertainty) and fit time.
 #include "calibration/pole_fit.h"
-#include "coupling/multipole_ring.h"
+#include "fields/multipole_ring.h"
 #include "tests/calibration/test_support.h"
 
 #include <chrono>

@@ -7,9 +7,9 @@
 //  * a finite-element profile in field.output_dir is used when present;
 //  * bad input: unreadable scan, bad cell, probe radius inside the magnet, --fit without a
 //    scan, unknown option — exit status and message; a missing python only warns.
-#include "coupling/case_parser.h"
-#include "coupling/field_grid.h"
-#include "coupling/multipole_ring.h"
+#include "case/case_parser.h"
+#include "fields/field_grid.h"
+#include "fields/multipole_ring.h"
 #include "tests/calibration/test_support.h"
 #include "tests/csv_columns.h"
 

@@ -1,11 +1,11 @@
-// Verification of the exact multipole-ring solution (coupling/multipole_ring.h):
+// Verification of the exact multipole-ring solution (fields/multipole_ring.h):
 //  * the classical μr = 1 ring, B_x − i B_y = μ0 n E_n z^−(n+1), to 1e-12;
 //  * the interface conditions and the field equations themselves for μ ≠ 1 layers;
 //  * the ideal-iron limit μ_s → ∞;
 //  * the convergence of the Fourier series of the Gaussian pole model;
 //  * the example gaussmeter scan (cases/data/sleeve_profile_example.csv), which was generated
 //    from the same exact solution plus 0.4 mT noise: the residual must be that noise.
-#include "coupling/multipole_ring.h"
+#include "fields/multipole_ring.h"
 #include "tests/calibration/test_support.h"
 
 #include <gtest/gtest.h>

@@ -7,7 +7,7 @@
 //  * peaks and errors of the comparison on profiles with a known shift.
 #include "calibration/flux_compare.h"
 #include "calibration/pole_fit.h"
-#include "coupling/multipole_ring.h"
+#include "fields/multipole_ring.h"
 #include "tests/calibration/test_support.h"
 
 #include <gtest/gtest.h>

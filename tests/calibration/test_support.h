@@ -3,7 +3,7 @@
 // α = 10), the pole formula itself, and a plain reader for the example file.
 #pragma once
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <cmath>
 #include <fstream>

@@ -24,9 +24,9 @@
 #include "calibration/nested_model_test.h"
 #include "calibration/pole_fit.h"
 #include "calibration/scan_noise.h"
-#include "coupling/case_hash.h"
-#include "coupling/case_parser.h"
-#include "coupling/multipole_ring.h"
+#include "case/case_hash.h"
+#include "case/case_parser.h"
+#include "fields/multipole_ring.h"
 #include "tests/calibration/unseen_roller.h"
 
 #include <gtest/gtest.h>

@@ -6,7 +6,7 @@
 #pragma once
 
 #include "calibration/pole_fit.h"
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <algorithm>
 #include <cmath>

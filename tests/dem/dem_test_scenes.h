@@ -3,7 +3,7 @@
 
 #include "dem/dem_system.h"
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <algorithm>
 #include <cmath>

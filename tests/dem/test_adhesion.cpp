@@ -20,7 +20,7 @@
 #include "dem/force_term.h"
 #include "dem/pair_kernel.h"
 
-#include "coupling/case_parser.h"
+#include "case/case_parser.h"
 #include "dem/wall_contacts.h"
 #include "geometry/wall_primitives.h"
 
@@ -400,7 +400,7 @@ TEST(Adhesion, HamakerConstantsOfPairsAndTheirErrors)
 
 TEST(Adhesion, CaseKeysParseAndNameTheirErrors)
 {
-  const std::string base = std::string(MAGBRUSH_SOURCE_DIR) + "/tests/coupling/case/valid/minimal_roller.yaml";
+  const std::string base = std::string(MAGBRUSH_SOURCE_DIR) + "/tests/case/valid/minimal_roller.yaml";
   std::ifstream in(base);
   std::stringstream s;
   s << in.rdbuf();

@@ -5,7 +5,7 @@
 // nothing, so the touching test can fail.
 #include "dem/dem_system.h"
 
-#include "coupling/case_parser.h"
+#include "case/case_parser.h"
 
 #include "tests/case_error.h"
 #include "tests/dem/box_developer.h"

@@ -3,7 +3,7 @@
 // its format version, its case identity, the checkpoint kept before the last one, a
 // checkpoint that leaves the run which writes it bit for bit alone, and the snapshots'
 // Fletcher-32 checksums.
-#include "coupling/case_hash.h"
+#include "case/case_hash.h"
 #include "dem/checkpoint_file.h"
 #include "dem/dem_system.h"
 #include "dem/force_terms/gravity.h"

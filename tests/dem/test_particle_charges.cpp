@@ -5,7 +5,7 @@
 #include "dem/particle_charges.h"
 #include "dem/snapshot_writer.h"
 
-#include "coupling/case_parser.h"
+#include "case/case_parser.h"
 
 #include "tests/case_error.h"
 

@@ -14,7 +14,7 @@
 #include "tests/dem/stress_table.h"
 #include "tests/test_temp_dir.h"
 
-#include "coupling/case_parser.h"
+#include "case/case_parser.h"
 
 #include <gtest/gtest.h>
 #include <hdf5.h>

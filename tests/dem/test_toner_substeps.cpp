@@ -7,7 +7,7 @@
 #include "dem/dem_system.h"
 #include "dem/force_terms/gravity.h"
 
-#include "coupling/case_parser.h"
+#include "case/case_parser.h"
 
 #include "tests/dem/dem_test_scenes.h"
 #include "tests/test_temp_dir.h"

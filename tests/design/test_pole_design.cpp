@@ -9,8 +9,8 @@
 //    layer is let go between S2 and S3) met, judged by the release criterion's own profile
 //    (release_criterion.h, an independent code path: B² by field_polar on a 0.05° grid);
 //  * an infeasible specification reported as such, with the bound that binds;
-#include "coupling/case_parser.h"
-#include "coupling/multipole_ring.h"
+#include "case/case_parser.h"
+#include "fields/multipole_ring.h"
 #include "design/pole_design.h"
 #include "design/release_criterion.h"
 #include "tests/cli_run.h"

@@ -5,7 +5,7 @@
 //  * on cases/kweon_release.yaml it ranks the layouts as the DEM does (docs/regulation.md:
 //    S2 at 144° released fraction 0.03 ± 0.03, at 165° 0.999 ± 0.001) and places the release
 //    arc of S2 at 165° where the DEM's layer lifts off (188–204°); within 5 s.
-#include "coupling/case_parser.h"
+#include "case/case_parser.h"
 #include "design/release_criterion.h"
 
 #include <gtest/gtest.h>

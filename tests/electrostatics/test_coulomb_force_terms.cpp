@@ -72,7 +72,7 @@ bool same_bits(const std::vector<double> &a, const std::vector<double> &b)
 
 TEST(CoulombTerm, SettingsOfADefaultCaseAreTheStructDefaults)
 {
-  // The electric keys' defaults (coupling/case_keys_electric.cpp, checked against the Electric
+  // The electric keys' defaults (case/case_keys_electric.cpp, checked against the Electric
   // struct in test_module_defaults) reach the term as its own defaults; no drum: no images.
   const CoulombTermSettings from_case = CoulombTermSettings::from_case(Case{}), built;
   EXPECT_EQ(from_case.far.order, built.far.order);

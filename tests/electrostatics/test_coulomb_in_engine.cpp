@@ -6,7 +6,7 @@
 #include "dem/force_terms/force_term_registry.h"
 #include "dem/force_terms/held_forces.h"
 
-#include "coupling/case_parser.h"
+#include "case/case_parser.h"
 #include "tests/test_temp_dir.h"
 
 #include <gtest/gtest.h>

@@ -4,7 +4,7 @@
 // pole-angle change to a new stored field. Prints tables, asserts nothing, exits 0.
 #include "field_solver/field_app.h"
 #include "field_solver/layered_meshes.h"
-#include "coupling/multipole_ring.h"
+#include "fields/multipole_ring.h"
 #include "field_solver/potential_problem.h"
 #include "field_solver/roller_magnetostatics.h"
 #include "tests/field_solver/five_pole_roller.h"

@@ -10,8 +10,8 @@
 // field |V_dark − V_light| / gap, over the gap from the sleeve down to 40 µm from the drum.
 #include "tests/field_solver/nip_phase_setup.h"
 
-#include "coupling/cartesian_field_interpolator.h"
-#include "coupling/nip_potential_field.h"
+#include "fields/cartesian_field_interpolator.h"
+#include "fields/nip_potential_field.h"
 
 #include <deal.II/base/mpi.h>
 

@@ -3,7 +3,7 @@
 // Fourier-ring solution: one definition, so the test and the benchmark measure the same roller.
 #pragma once
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 namespace magbrush::field::testing {
 

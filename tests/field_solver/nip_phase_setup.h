@@ -6,7 +6,7 @@
 // sampled with air_potential, as field_app.cpp does).
 #pragma once
 
-#include "coupling/field_grid.h"
+#include "fields/field_grid.h"
 #include "field_solver/nip_electrostatics.h"
 
 #include <mpi.h>

@@ -2,8 +2,8 @@
 // the first run stores both fields; an unchanged case is "up to date" and rewrites nothing;
 // moving a pole regenerates only the magnetic field; changing the bias only the electric one; a
 // solid area is stored as one phase.
-#include "coupling/cartesian_field_interpolator.h"
-#include "coupling/field_grid.h"
+#include "fields/cartesian_field_interpolator.h"
+#include "fields/field_grid.h"
 
 #include <gtest/gtest.h>
 #include "tests/test_temp_dir.h"

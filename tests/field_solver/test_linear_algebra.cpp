@@ -9,8 +9,8 @@
 // tolerance of 1e-12 of the right-hand side. The bound is 1e-10 of each field's peak.
 #include "tests/field_solver/mpi_environment.h"
 
-#include "coupling/case_parser.h"
-#include "coupling/field_grid.h"
+#include "case/case_parser.h"
+#include "fields/field_grid.h"
 #include "field_solver/field_app.h"
 #include "field_solver/nip_electrostatics.h"
 #include "field_solver/roller_magnetostatics.h"

@@ -7,9 +7,9 @@
 #include "tests/field_solver/mpi_environment.h"
 
 #include "field_solver/field_app.h"
-#include "coupling/field_files.h"
-#include "coupling/field_grid.h"
-#include "coupling/multipole_ring.h"
+#include "fields/field_files.h"
+#include "fields/field_grid.h"
+#include "fields/multipole_ring.h"
 #include "field_solver/roller_magnetostatics.h"
 #include "tests/test_temp_dir.h"
 
@@ -98,7 +98,7 @@ TEST(FieldMagnetostatics, UniformlyMagnetisedCylinder)
 
 // Ring R_i < r < R_o with M_r = M cos(nθ) in air: exterior B_x − iB_y = μ0 n E_n z^−(n+1),
 // E_n = M R_o^(n+1)(1 − ρ^(n+1))/(2(n+1)). The reference everywhere (core included) is the
-// layered multipole ring (coupling/multipole_ring.h), itself checked here against E_n.
+// layered multipole ring (fields/multipole_ring.h), itself checked here against E_n.
 class FieldMultipoleRing : public ::testing::TestWithParam<int>
 {
 };

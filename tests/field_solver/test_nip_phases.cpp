@@ -1,12 +1,12 @@
-// The stored nip field as the DEM evaluates it (coupling/nip_potential_field.h) against the
+// The stored nip field as the DEM evaluates it (fields/nip_potential_field.h) against the
 // field stage itself: the image between two stored phases against a direct solve at that
 // phase, and the field next to the conductors with and without the smooth extension of the air
 // solution (NipElectrostatics::air_potential) against the exact two-cylinder field.
 #include "tests/field_solver/mpi_environment.h"
 #include "tests/field_solver/nip_phase_setup.h"
 
-#include "coupling/cartesian_field_interpolator.h"
-#include "coupling/nip_potential_field.h"
+#include "fields/cartesian_field_interpolator.h"
+#include "fields/nip_potential_field.h"
 
 #include <gtest/gtest.h>
 

@@ -14,7 +14,7 @@
 #include "tests/field_solver/convergence.h"
 #include "tests/field_solver/mpi_environment.h"
 
-#include "coupling/multipole_ring.h"
+#include "fields/multipole_ring.h"
 #include "field_solver/roller_magnetostatics.h"
 #include "tests/test_temp_dir.h"
 

@@ -3,7 +3,7 @@
 // without a photoconductor layer.
 #pragma once
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <string>
 

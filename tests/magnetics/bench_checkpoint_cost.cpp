@@ -10,7 +10,7 @@
 #include "dem/force_terms/force_term_registry.h"
 #include "dem/force_terms/magnetic_force_term.h"
 
-#include "coupling/case_parser.h"
+#include "case/case_parser.h"
 
 #include <omp.h>
 

@@ -7,8 +7,8 @@
 #include "dem/dem_system.h"
 #include "dem/force_terms/magnetic_force_term.h"
 
-#include "coupling/applied_magnetic_field.h"
-#include "coupling/case_parser.h"
+#include "fields/applied_magnetic_field.h"
+#include "case/case_parser.h"
 
 #include <chrono>
 #include <cmath>

@@ -48,10 +48,10 @@
 // and evaluated its far field once: in a fed brush that reference itself was off by 1-10 %).
 #include "dem/force_terms/magnetic_force_term.h"
 
-#include "coupling/applied_magnetic_field.h"
-#include "coupling/case_parser.h"
+#include "fields/applied_magnetic_field.h"
+#include "case/case_parser.h"
 #include "dem/dem_run.h"
-#include "coupling/field_files.h"
+#include "fields/field_files.h"
 
 #include <omp.h>
 #include <unistd.h>

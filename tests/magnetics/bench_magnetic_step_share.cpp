@@ -19,8 +19,8 @@
 #include "dem/force_terms/magnetic_force_term.h"
 #include "tests/magnetics/brush_configuration.h"
 
-#include "coupling/applied_magnetic_field.h"
-#include "coupling/case_parser.h"
+#include "fields/applied_magnetic_field.h"
+#include "case/case_parser.h"
 
 #include <omp.h>
 

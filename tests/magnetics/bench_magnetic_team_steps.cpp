@@ -22,7 +22,7 @@
 #include "dem/huge_page_heap.h"
 #include "dem/openmp_waiting.h"
 
-#include "coupling/case_parser.h"
+#include "case/case_parser.h"
 
 #include <omp.h>
 #include <unistd.h>

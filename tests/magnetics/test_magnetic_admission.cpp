@@ -7,8 +7,8 @@
 // full evaluations; 1 and 2 threads give the same bits, and a restart continues bit for bit.
 #include "dem/force_terms/magnetic_force_term.h"
 
-#include "coupling/applied_magnetic_field.h"
-#include "coupling/case_parser.h"
+#include "fields/applied_magnetic_field.h"
+#include "case/case_parser.h"
 #include "dem/dem_system.h"
 
 #include <gtest/gtest.h>

@@ -5,8 +5,8 @@
 // solver tolerance, and the warm start needs fewer sweeps than the fresh solve.
 #include "dem/force_terms/magnetic_force_term.h"
 
-#include "coupling/applied_magnetic_field.h"
-#include "coupling/case_parser.h"
+#include "fields/applied_magnetic_field.h"
+#include "case/case_parser.h"
 #include "dem/dem_system.h"
 
 #include <gtest/gtest.h>

@@ -6,8 +6,8 @@
 #include "dem/force_terms/magnetic_force_term.h"
 #include "magnetics/two_sphere_exact.h"
 
-#include "coupling/applied_magnetic_field.h"
-#include "coupling/case_parser.h"
+#include "fields/applied_magnetic_field.h"
+#include "case/case_parser.h"
 #include "dem/dem_system.h"
 
 #include <gtest/gtest.h>

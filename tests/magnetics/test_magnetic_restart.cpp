@@ -11,7 +11,7 @@
 // check (MagneticTeamSteps).
 #include "dem/force_terms/magnetic_force_term.h"
 
-#include "coupling/case_parser.h"
+#include "case/case_parser.h"
 #include "dem/dem_system.h"
 #include "dem/force_terms/force_term_registry.h"
 #include "dem/force_terms/gravity.h"

@@ -4,10 +4,10 @@
 #include "dem/force_terms/electric_field_force.h"
 #include "dem/force_terms/force_term_registry.h"
 
-#include "coupling/case_hash.h"
-#include "coupling/case_parser.h"
-#include "coupling/field_files.h"
-#include "coupling/field_grid.h"
+#include "case/case_hash.h"
+#include "case/case_parser.h"
+#include "fields/field_files.h"
+#include "fields/field_grid.h"
 
 #include "tests/test_temp_dir.h"
 

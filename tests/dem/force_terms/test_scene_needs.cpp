@@ -12,8 +12,8 @@
 #include "dem/force_terms/force_term_registry.h"
 #include "tests/test_temp_dir.h"
 
-#include "coupling/case_parser.h"
-#include "coupling/field_files.h"
+#include "case/case_parser.h"
+#include "fields/field_files.h"
 
 #include <gtest/gtest.h>
 

@@ -5,7 +5,7 @@
 #include "dem/measurements/developer_mass_per_area.h"
 #include "sleeve_ring.h"
 
-#include "coupling/case_parser.h"
+#include "case/case_parser.h"
 
 #include <gtest/gtest.h>
 

@@ -11,7 +11,7 @@
 #include "dem/dem_system.h"
 #include "dem/run_summary.h"
 
-#include "coupling/case_parser.h"
+#include "case/case_parser.h"
 
 #include "common/state_stream.h"
 
@@ -537,7 +537,7 @@ TEST(NipProfile, OneEngineStepOnATurningDrum)
 
 TEST(NipCaseKeys, DefaultsEqualTheContractStruct)
 {
-  const Case c = load_case(std::string(MAGBRUSH_SOURCE_DIR) + "/tests/coupling/case/valid/minimal_roller.yaml");
+  const Case c = load_case(std::string(MAGBRUSH_SOURCE_DIR) + "/tests/case/valid/minimal_roller.yaml");
   const NipSettings d;
   EXPECT_DOUBLE_EQ(c.nip.average_from, d.average_from);
   EXPECT_DOUBLE_EQ(c.nip.sample_interval, d.sample_interval);
@@ -545,7 +545,7 @@ TEST(NipCaseKeys, DefaultsEqualTheContractStruct)
   EXPECT_DOUBLE_EQ(c.nip.half_width, d.half_width);
   EXPECT_NEAR(c.nip.chain_bin_angle, d.chain_bin_angle, 1e-15);
   EXPECT_NEAR(c.nip.chain_half_angle, d.chain_half_angle, 1e-15);
-  const Case o = load_case(std::string(MAGBRUSH_SOURCE_DIR) + "/tests/coupling/case/valid/minimal_roller.yaml",
+  const Case o = load_case(std::string(MAGBRUSH_SOURCE_DIR) + "/tests/case/valid/minimal_roller.yaml",
                            {"nip.average_from=1ms", "nip.bin_width=0.1mm"});
   EXPECT_NEAR(o.nip.average_from, 1e-3, 1e-18);
   EXPECT_NEAR(o.nip.bin_width, 1e-4, 1e-18);

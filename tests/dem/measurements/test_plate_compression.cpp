@@ -7,8 +7,8 @@
 
 #include "dem/measurements/measurement_registry.h"
 
-#include "coupling/applied_magnetic_field.h"
-#include "coupling/case_parser.h"
+#include "fields/applied_magnetic_field.h"
+#include "case/case_parser.h"
 #include "dem/dem_system.h"
 
 #include <gtest/gtest.h>

@@ -9,7 +9,7 @@
 #include "dem/run_summary.h"
 
 #include "common/state_stream.h"
-#include "coupling/case_parser.h"
+#include "case/case_parser.h"
 
 #include <gtest/gtest.h>
 

@@ -17,7 +17,7 @@
 // Prints tables, asserts nothing, exits 0 (a failed run is reported in the table).
 #include "tests/scenes/compression/compression_run.h"
 
-#include "coupling/case_parser.h"
+#include "case/case_parser.h"
 
 #include <cmath>
 #include <cstdio>

@@ -5,8 +5,8 @@
 #include "dem/force_terms/magnetic_force_term.h"
 #include "dem/measurements/measurement_registry.h"
 
-#include "coupling/applied_magnetic_field.h"
-#include "coupling/case_parser.h"
+#include "fields/applied_magnetic_field.h"
+#include "case/case_parser.h"
 
 #include <omp.h>
 

@@ -14,7 +14,7 @@
 
 #include "dem/measurements/plate_compression.h"
 
-#include "coupling/case_model.h"
+#include "case/case_model.h"
 
 #include <string>
 #include <vector>

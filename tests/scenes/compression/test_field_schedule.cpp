@@ -1,9 +1,9 @@
 // The piecewise-linear schedule of the uniform applied field (applied_field.schedule), used by
 // Kawamoto's field sweep at a held plate: values between and outside the samples, the parsed
 // case, and the errors for inconsistent input.
-#include "coupling/applied_magnetic_field.h"
-#include "coupling/case_format.h"
-#include "coupling/case_parser.h"
+#include "fields/applied_magnetic_field.h"
+#include "case/case_format.h"
+#include "case/case_parser.h"
 
 #include <gtest/gtest.h>
 

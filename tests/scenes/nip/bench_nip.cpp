@@ -147,7 +147,7 @@ int main(int argc, char **argv)
       const char *name, *tag, *sets;
     };
     // Ours: the schema's default far field (the reduced case sets the papers' magnetics, so the
-    // default is restated here: keep it in step with coupling/case_keys_magnetics.cpp).
+    // default is restated here: keep it in step with case/case_keys_magnetics.cpp).
     const Variant variants[] = {{"ours (cell-multipole far field)", "ours",
                                  " --set dem.magnetic_far_field=cell_multipole"},
                                 {"papers' (cutoff 4 d, refresh 5 us)", "papers",
